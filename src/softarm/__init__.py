@@ -1,0 +1,31 @@
+"""softarm: static equilibrium of soft robotic arms and slender elastic rods.
+
+Cosserat rods on SE(3) (Grazioso, Di Gironimo & Siciliano, RoboSoft 2018): closed forms where
+they exist (:mod:`softarm.analytic`) and a geometrically exact solver for any load.
+"""
+
+from .equilibrium import Equilibrium
+from .errors import ApproximationWarning, ConvergenceError
+from .loads import DistributedForce, Gravity, PointLoad, TipLoad
+from .model import Arm, Circle, Material, Rectangle, Rigidities, Section, SegmentedArm, Tube
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "ApproximationWarning",
+    "Arm",
+    "Circle",
+    "ConvergenceError",
+    "DistributedForce",
+    "Equilibrium",
+    "Gravity",
+    "Material",
+    "PointLoad",
+    "Rectangle",
+    "Rigidities",
+    "Section",
+    "SegmentedArm",
+    "TipLoad",
+    "Tube",
+    "__version__",
+]

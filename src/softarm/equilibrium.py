@@ -1,0 +1,114 @@
+"""Equilibrium: the one result type of every route (closed forms and the numerical solver)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["Equilibrium"]
+
+
+def _frozen(array) -> np.ndarray:
+    array = np.array(array, dtype=np.float64)
+    array.setflags(write=False)
+    return array
+
+
+@dataclass(frozen=True, eq=False)
+class Equilibrium:
+    """A static equilibrium of an arm under its loads, sampled at stations s.
+
+    Arrays are read-only. With a batch of loads of batch shape B, every array gains the
+    leading axes B; the station axis is the last batch axis.
+
+    Attributes
+    ----------
+    s : ndarray, shape (N,)
+        Arc-length stations in m, increasing in [0, L].
+    poses : ndarray, shape (B..., N, 4, 4)
+        H(s) = [[R, p], [0, 1]]: the material frame R (columns e1, e2, e3 in the spatial frame)
+        and the centreline position p (m).
+    strains : ndarray, shape (B..., N, 6)
+        ε = f - f⁰ = (γ; κ) in the material frame (dimensionless; 1/m).
+    stresses : ndarray, shape (B..., N, 6)
+        σ = K ε = (n; m), internal force (N) and moment (N m) in the material frame, exerted
+        on the part [0, s] by the part [s, L].
+    arm : Arm or SegmentedArm
+    loads : tuple
+        The loads as given.
+    method : str
+        The solution used, e.g. ``"analytic.tip_moment"`` or ``"numeric.shooting"``.
+    exact : bool
+        True only if the result solves the full Cosserat model (eq. 20) for these loads (to
+        the solver's tolerance for numerical results).
+    residual : float or ndarray, shape (B...)
+        Boundary-condition residual, N and N m (0 for closed forms).
+    error_estimate : float or ndarray, shape (B...)
+        Estimated position error at the tip in m (0 for exact closed forms, NaN where the
+        closed form is an approximation of unknown error).
+    """
+
+    s: np.ndarray
+    poses: np.ndarray
+    strains: np.ndarray
+    stresses: np.ndarray
+    arm: object
+    loads: tuple
+    method: str
+    exact: bool
+    residual: float | np.ndarray = 0.0
+    error_estimate: float | np.ndarray = 0.0
+
+    def __post_init__(self):
+        for name in ("s", "poses", "strains", "stresses"):
+            object.__setattr__(self, name, _frozen(getattr(self, name)))
+        n = self.s.shape[-1]
+        if self.poses.shape[-3:] != (n, 4, 4) or self.strains.shape[-2:] != (n, 6) or \
+                self.stresses.shape[-2:] != (n, 6):
+            raise ValueError(
+                f"Equilibrium arrays disagree: s {self.s.shape}, poses {self.poses.shape}, "
+                f"strains {self.strains.shape}, stresses {self.stresses.shape}"
+            )
+        object.__setattr__(self, "loads", tuple(self.loads))
+
+    @property
+    def batch_shape(self) -> tuple[int, ...]:
+        """Leading batch axes B (empty for a single load case)."""
+        return self.poses.shape[:-3]
+
+    @property
+    def positions(self) -> np.ndarray:
+        """Centreline positions p(s) in m, spatial frame, shape (B..., N, 3)."""
+        return self.poses[..., :3, 3]
+
+    @property
+    def rotations(self) -> np.ndarray:
+        """Material frames R(s), shape (B..., N, 3, 3)."""
+        return self.poses[..., :3, :3]
+
+    @property
+    def tip(self) -> np.ndarray:
+        """Pose at the last station, shape (B..., 4, 4)."""
+        return self.poses[..., -1, :, :]
+
+    @property
+    def tip_position(self) -> np.ndarray:
+        """Position of the last station in m, shape (B..., 3)."""
+        return self.poses[..., -1, :3, 3]
+
+    @property
+    def forces_spatial(self) -> np.ndarray:
+        """Internal force R n in the spatial frame (N), shape (B..., N, 3)."""
+        return np.einsum("...ij,...j->...i", self.rotations, self.stresses[..., :3])
+
+    @property
+    def moments_spatial(self) -> np.ndarray:
+        """Internal moment R m in the spatial frame about the centreline point (N m)."""
+        return np.einsum("...ij,...j->...i", self.rotations, self.stresses[..., 3:])
+
+    def __repr__(self) -> str:
+        tip = np.array2string(self.tip_position, precision=6) if not self.batch_shape else \
+            f"batch {self.batch_shape}"
+        return (f"Equilibrium(method={self.method!r}, exact={self.exact}, stations={self.s.size}, "
+                f"tip_position={tip})")

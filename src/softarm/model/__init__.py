@@ -1,0 +1,16 @@
+"""The arm model: materials, cross-sections, uniform and segmented arms (SI units)."""
+
+from .arm import Arm, SegmentedArm
+from .material import Material
+from .sections import Circle, Rectangle, Rigidities, Section, Tube
+
+__all__ = [
+    "Arm",
+    "Circle",
+    "Material",
+    "Rectangle",
+    "Rigidities",
+    "Section",
+    "SegmentedArm",
+    "Tube",
+]

@@ -1,0 +1,169 @@
+"""The arm: a Cosserat rod with constant section, material and initial curvature."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._validate import as_vectors, positive
+from .material import Material
+from .sections import Circle, Rectangle, Rigidities, Section, Tube
+
+__all__ = ["Arm", "SegmentedArm"]
+
+_SECTION_KINDS = (Circle, Tube, Rectangle, Section, Rigidities)
+
+
+@dataclass(frozen=True)
+class Arm:
+    """A uniform Cosserat rod: length, cross-section, material and constant initial curvature.
+
+    The arm axis is the material e1. The reference (stress-free) strain is
+    f⁰ = (1, 0, 0, κ⁰₁, κ⁰₂, κ⁰₃): unit stretch along e1 and the initial twist/curvature κ⁰
+    (1/m, material frame). Strains are measured from it, ε = f - f⁰, and the stress resultants
+    are σ = K ε with K = diag(EA, GAy, GAz, GJ, EIy, EIz) (Grazioso et al. 2018, eqs. 3, 9-12).
+
+    Parameters
+    ----------
+    length : float
+        L in m.
+    section : Circle, Tube, Rectangle or Section
+        Cross-section.
+    material : Material
+        Material (its density gives the weight, if given).
+    curvature : array_like, shape (3,)
+        κ⁰ = (twist, curvature about y, curvature about z) in 1/m, material frame.
+    mass_per_length : float, optional
+        kg/m; overrides ρ A (e.g. for an arm with embedded parts).
+
+    Examples
+    --------
+    >>> arm = Arm(0.3, Circle(0.01), Material(1.0e6, poisson_ratio=0.5, density=1100.0))
+    >>> round(arm.rigidities.EIy, 9)
+    0.007853982
+    >>> arm.reference_strain
+    array([1., 0., 0., 0., 0., 0.])
+    """
+
+    length: float
+    section: Circle | Tube | Rectangle | Section | Rigidities
+    material: Material | None = None
+    curvature: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    mass_per_length: float | None = None
+
+    def __post_init__(self):
+        positive(self.length, "Arm.length", "m")
+        if not isinstance(self.section, _SECTION_KINDS):
+            raise TypeError(
+                "Arm.section must be a Circle, Tube, Rectangle, Section or Rigidities, got "
+                f"{self.section!r}"
+            )
+        if isinstance(self.section, Rigidities):
+            if self.material is not None:
+                raise ValueError(
+                    "Arm.material must be None when the section is given by its Rigidities "
+                    f"(use Arm.from_stiffness), got {self.material!r}"
+                )
+        elif not isinstance(self.material, Material):
+            raise TypeError(f"Arm.material must be a softarm.Material, got {self.material!r}")
+        curvature = as_vectors(self.curvature, "Arm.curvature", 3)
+        if curvature.shape != (3,):
+            raise ValueError(f"Arm.curvature must have shape (3,), got shape {curvature.shape}")
+        object.__setattr__(self, "curvature", tuple(float(c) for c in curvature))
+        if self.mass_per_length is not None:
+            positive(self.mass_per_length, "Arm.mass_per_length", "kg/m")
+
+    @classmethod
+    def from_stiffness(cls, length, EA, GAy, GAz, GJ, EIy, EIz, curvature=(0.0, 0.0, 0.0),
+                       mass_per_length=None) -> Arm:
+        """An arm known only by its stiffnesses (N for EA, GAy, GAz; N m² for GJ, EIy, EIz).
+
+        Examples
+        --------
+        >>> arm = Arm.from_stiffness(1.0, EA=1e6, GAy=1e6, GAz=1e6, GJ=1.0, EIy=1.0, EIz=1.0)
+        >>> arm.stiffness[4, 4]
+        np.float64(1.0)
+        """
+        return cls(length, Rigidities(EA, GAy, GAz, GJ, EIy, EIz), None, curvature,
+                   mass_per_length)
+
+    @property
+    def rigidities(self) -> Rigidities:
+        """The six stiffnesses EA, GAy, GAz, GJ, EIy, EIz."""
+        if isinstance(self.section, Rigidities):
+            return self.section
+        return self.section.rigidities(self.material)
+
+    @property
+    def stiffness(self) -> np.ndarray:
+        """K, the 6×6 stiffness matrix of eqs. 10-12 (N and N m²), linear part first."""
+        return self.rigidities.matrix
+
+    @property
+    def reference_strain(self) -> np.ndarray:
+        """f⁰ = (1, 0, 0, κ⁰), shape (6,): the stress-free strain (eq. 3)."""
+        return np.concatenate([[1.0, 0.0, 0.0], self.curvature])
+
+    @property
+    def linear_density(self) -> float | None:
+        """Mass per unit length in kg/m (``mass_per_length``, else ρ A), or None if unknown."""
+        if self.mass_per_length is not None:
+            return float(self.mass_per_length)
+        if self.material is None or self.material.density is None:
+            return None
+        return self.material.density * self.section.area
+
+    @property
+    def radius(self) -> float | None:
+        """Radius used to draw the arm as a tube (m), None if only stiffnesses are known."""
+        if isinstance(self.section, Rigidities):
+            return None
+        return self.section.envelope_radius
+
+    @property
+    def segments(self) -> tuple[Arm, ...]:
+        """``(self,)``: an Arm is a segmented arm with one segment."""
+        return (self,)
+
+
+@dataclass(frozen=True)
+class SegmentedArm:
+    """Uniform segments joined rigidly end to end (a multi-section soft arm).
+
+    Each segment starts where the previous one ends, tangent to it: the material frame is
+    continuous across a joint, only the section, material and initial curvature change.
+
+    Parameters
+    ----------
+    segments : sequence of Arm
+        From the base to the tip.
+
+    Examples
+    --------
+    >>> soft = Material(1.0e6, poisson_ratio=0.5, density=1100.0)
+    >>> arm = SegmentedArm([Arm(0.25, Circle(0.012), soft), Arm(0.125, Circle(0.008), soft)])
+    >>> arm.length, arm.boundaries
+    (0.375, (0.0, 0.25, 0.375))
+    """
+
+    segments: tuple[Arm, ...]
+
+    def __post_init__(self):
+        segments = tuple(self.segments) if not isinstance(self.segments, Arm) else ()
+        if not segments or not all(isinstance(a, Arm) for a in segments):
+            raise TypeError(
+                f"SegmentedArm.segments must be a non-empty sequence of Arm, got {self.segments!r}"
+            )
+        object.__setattr__(self, "segments", segments)
+
+    @property
+    def length(self) -> float:
+        """Total length in m."""
+        return float(sum(a.length for a in self.segments))
+
+    @property
+    def boundaries(self) -> tuple[float, ...]:
+        """Arc length of each joint, base (0) and tip (L) included, in m."""
+        return tuple(float(b) for b in np.concatenate([[0.0], np.cumsum(
+            [a.length for a in self.segments])]))
