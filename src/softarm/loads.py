@@ -26,10 +26,26 @@ __all__ = [
 
 
 def _vector(obj, name: str) -> np.ndarray:
-    array = as_vectors(getattr(obj, name), f"{type(obj).__name__}.{name}", 3)
+    # A private copy: freezing the caller's own array (np.asarray does not copy) would make it
+    # read-only behind their back, and later writes to it would change the load.
+    array = as_vectors(getattr(obj, name), f"{type(obj).__name__}.{name}", 3).copy()
     array.setflags(write=False)
     object.__setattr__(obj, name, array)
     return array
+
+
+def _force_and_moment(obj) -> None:
+    """Check that ``force`` and ``moment`` have batch shapes that broadcast together."""
+    _vector(obj, "force")
+    _vector(obj, "moment")
+    try:
+        np.broadcast_shapes(obj.force.shape[:-1], obj.moment.shape[:-1])
+    except ValueError:
+        name = type(obj).__name__
+        raise ValueError(
+            f"{name}.force and {name}.moment must have batch shapes that broadcast, got shapes "
+            f"{obj.force.shape} and {obj.moment.shape}"
+        ) from None
 
 
 @dataclass(frozen=True, eq=False)
@@ -56,8 +72,7 @@ class TipLoad:
     follower: bool = False
 
     def __post_init__(self):
-        _vector(self, "force")
-        _vector(self, "moment")
+        _force_and_moment(self)
         if not isinstance(self.follower, (bool, np.bool_)):
             raise TypeError(f"TipLoad.follower must be True or False, got {self.follower!r}")
 
@@ -129,8 +144,7 @@ class PointLoad:
         if s.ndim != 0:
             raise ValueError(f"PointLoad.s must be a single arc length in m, got {self.s!r}")
         object.__setattr__(self, "s", float(s))
-        _vector(self, "force")
-        _vector(self, "moment")
+        _force_and_moment(self)
 
     @property
     def batch_shape(self) -> tuple[int, ...]:

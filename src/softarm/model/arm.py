@@ -150,7 +150,10 @@ class SegmentedArm:
     segments: tuple[Arm, ...]
 
     def __post_init__(self):
-        segments = tuple(self.segments) if not isinstance(self.segments, Arm) else ()
+        try:
+            segments = tuple(self.segments) if not isinstance(self.segments, Arm) else ()
+        except TypeError:  # not iterable (e.g. None): reported below, naming the parameter
+            segments = ()
         if not segments or not all(isinstance(a, Arm) for a in segments):
             raise TypeError(
                 f"SegmentedArm.segments must be a non-empty sequence of Arm, got {self.segments!r}"
