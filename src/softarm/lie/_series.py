@@ -97,13 +97,11 @@ def sinc3(theta2):
 def jinv(theta2):
     """1/θ² - (1 + cos θ)/(2 θ sin θ): ω~² coefficient of the inverse SO(3) Jacobian.
 
-    Above the series range it is evaluated as 1/θ² - sin θ/(2 θ (1 - cos θ)) (the same value,
-    (1 + cos θ)/sin θ = sin θ/(1 - cos θ)): 1 + cos θ cancels near θ = π and would lose all its
-    digits there, 1 - cos θ does not.
+    Above the series range it is evaluated as 1/θ² - 1/(2 θ tan(θ/2)) (the same value, since
+    (1 + cos θ)/sin θ = cot(θ/2)): 1 + cos θ cancels near θ = π and 1 - cos θ near θ = 2π, while
+    tan(θ/2) is accurate on the whole range (θ/2 is exact).
     """
-    return _switch(
-        theta2, _JINV, lambda t, t2: 1.0 / t2 - np.sin(t) / (2.0 * t * (1.0 - np.cos(t)))
-    )
+    return _switch(theta2, _JINV, lambda t, t2: 1.0 / t2 - 1.0 / (2.0 * t * np.tan(0.5 * t)))
 
 
 def tuw3(theta2):
