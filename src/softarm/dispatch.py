@@ -1,0 +1,123 @@
+"""``softarm.solve``: one entry point that picks an exact closed form or the numerical solver.
+
+The two routes, :mod:`softarm.analytic` and :mod:`softarm.statics`, never import each other;
+this module is the only place that knows both.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from . import analytic
+from ._validate import stations
+from .equilibrium import Equilibrium
+from .loads import DistributedForce, Gravity, PointLoad, TipLoad, as_loads, batch_shape
+from .statics import solve_numeric
+from .statics.solver import check_base, check_tol
+
+__all__ = ["METHODS", "solve"]
+
+#: Accepted values of ``method``.
+METHODS = ("auto", "numeric", "analytic")
+
+
+def _in_base_frame(loads, R: np.ndarray) -> tuple:
+    """The dead (spatial) loads with components in the base frame (follower loads unchanged)."""
+
+    def rotate(v):
+        return np.einsum("ji,...j->...i", R, v)  # Rᵀ v
+
+    out = []
+    for load in loads:
+        if isinstance(load, TipLoad):
+            out.append(load if load.follower else TipLoad(rotate(load.force),
+                                                          rotate(load.moment)))
+        elif isinstance(load, Gravity):
+            out.append(Gravity(rotate(load.acceleration)))
+        elif isinstance(load, DistributedForce):
+            out.append(DistributedForce(rotate(load.force)))
+        elif isinstance(load, PointLoad):
+            out.append(PointLoad(load.s, rotate(load.force), rotate(load.moment)))
+    return tuple(out)
+
+
+def _closed_form(arm, loads, s, H0) -> Equilibrium | None:
+    """An exact closed form for these loads, or None (also while softarm.analytic has none)."""
+    exact_closed_form = getattr(analytic, "exact_closed_form", None)
+    if exact_closed_form is None:
+        return None
+    identity = np.array_equal(H0, np.eye(4))
+    result = exact_closed_form(arm, loads if identity else _in_base_frame(loads, H0[:3, :3]),
+                               s=s)
+    if result is None or identity:
+        return result
+    # the same arm clamped at H0: rigidly move the solution; material strains are unchanged
+    return dataclasses.replace(result, poses=H0 @ result.poses, loads=loads)
+
+
+def solve(arm, loads, *, method="auto", s=None, tol=1e-8, base=None, **options) -> Equilibrium:
+    """Static equilibrium of a clamped arm under any combination of loads.
+
+    Parameters
+    ----------
+    arm : Arm or SegmentedArm
+    loads : load or sequence of loads
+        :class:`~softarm.TipLoad`, :class:`~softarm.Gravity`,
+        :class:`~softarm.DistributedForce`, :class:`~softarm.PointLoad`; their force arrays
+        may carry leading batch axes B, which every output array then carries too.
+    method : {"auto", "numeric", "analytic"}
+        "auto" uses an exact closed form (:func:`softarm.analytic.exact_closed_form`) where one
+        applies and the numerical solver otherwise; "numeric" forces the solver (shooting on
+        the base wrench, :mod:`softarm.statics`); "analytic" requires an exact closed form.
+    s : None, int or array_like
+        Output stations in m: default 101 uniform on [0, L]; an int gives that many; or an
+        increasing array in [0, L].
+    tol : float
+        Tolerance of the numerical solver on the tip position, relative to L (the step count
+        is raised until the step-doubling error estimate is ≤ tol·L).
+    base : array_like, shape (4, 4), optional
+        Pose of the clamped base in the spatial frame (default identity).
+    **options
+        Passed to :class:`softarm.statics.Solver` (``max_iterations``, ``continuation``,
+        ``max_step``).
+
+    Returns
+    -------
+    Equilibrium
+        ``method`` says which route was taken (e.g. ``"numeric.shooting"``).
+
+    Raises
+    ------
+    ValueError
+        Bad method, stations, base, tolerance, or loads that do not fit the arm.
+    ConvergenceError
+        The numerical solver failed (never a silently wrong answer).
+
+    Examples
+    --------
+    >>> import softarm
+    >>> arm = softarm.Arm.from_stiffness(1.0, EA=1e9, GAy=1e9, GAz=1e9, GJ=1.0, EIy=1.0,
+    ...                                  EIz=1.0)
+    >>> eq = softarm.solve(arm, softarm.TipLoad(force=[0.0, 0.0, 5.0]), method="numeric")
+    >>> eq.method, round(float(eq.tip_position[2]), 6)  # Mattiasson (1981): w/L = 0.71379
+    ('numeric.shooting', 0.713792)
+    """
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+    loads = as_loads(loads)
+    batch_shape(loads)
+    H0 = check_base(base)
+    check_tol(tol)
+    if method != "numeric":
+        stations(s, float(arm.length))  # validate before any route
+        result = _closed_form(arm, loads, s, H0)
+        if result is not None:
+            return result
+        if method == "analytic":
+            raise ValueError(
+                "method='analytic' but no exact closed form applies to this arm and these "
+                "loads; use method='auto' or 'numeric'"
+            )
+    return solve_numeric(arm, loads, s=s, tol=tol, base=base, **options)
