@@ -18,7 +18,7 @@ def rng():
 
 
 def shared_table(name: str) -> dict:
-    """A reference table from ../shared/data, or skip if the folder is not beside the repo."""
+    """A reference table from ../shared/data; fails the test if the folder is missing."""
     path = SHARED_DATA / name
     if not path.exists():
         pytest.fail(f"reference table {path} not found: shared/ must sit beside the repository")

@@ -4,8 +4,11 @@ Cosserat rods on SE(3) (Grazioso, Di Gironimo & Siciliano, RoboSoft 2018): close
 they exist (:mod:`softarm.analytic`) and a geometrically exact solver for any load.
 """
 
+from . import analytic
+from .dispatch import solve
 from .equilibrium import Equilibrium
 from .errors import ApproximationWarning, ConvergenceError
+from .io import Case, CaseError, load_case
 from .loads import DistributedForce, Gravity, PointLoad, TipLoad
 from .model import Arm, Circle, Material, Rectangle, Rigidities, Section, SegmentedArm, Tube
 
@@ -14,6 +17,8 @@ __version__ = "0.1.0"
 __all__ = [
     "ApproximationWarning",
     "Arm",
+    "Case",
+    "CaseError",
     "Circle",
     "ConvergenceError",
     "DistributedForce",
@@ -28,4 +33,7 @@ __all__ = [
     "TipLoad",
     "Tube",
     "__version__",
+    "analytic",
+    "load_case",
+    "solve",
 ]

@@ -1,0 +1,326 @@
+"""The ``softarm`` command: solve a case file, export the result, plot it.
+
+::
+
+    softarm solve CASE.toml [-o out.csv|out.json|out.npz] [--plot out.png]
+                            [--method auto|numeric] [--stations N] [--tol TOL]
+    softarm plot RESULT.(csv|json|npz) [-o out.png]
+    softarm demo [--out DIR]
+    softarm reproduce [--out DIR]
+
+Exit codes: 0 success; 1 the solver did not converge (one line with the residual); 2 bad input
+(a missing or misspelled key, a wrong type or value, a missing file, an unknown output format:
+one line naming the file, the key and what is wrong). Outputs are written to a temporary file
+beside the target and renamed, so a failure never leaves a half-written result.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import os
+import sys
+import threading
+import time
+from collections.abc import Sequence
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+
+from . import __version__
+from .errors import ConvergenceError
+from .io import Case, CaseError, load_case, save_result, solve_case
+
+__all__ = ["main"]
+
+_RESULT_SUFFIXES = (".csv", ".json", ".npz")
+_PICTURE_SUFFIXES = (".png", ".pdf", ".svg")
+
+
+class _Progress:
+    """A plain-text progress bar on stderr, shown only once a run has taken over a second."""
+
+    def __init__(self, stream=None, delay: float = 1.0, width: int = 30):
+        self.stream = sys.stderr if stream is None else stream
+        self.delay = delay
+        self.width = width
+        self.start = time.perf_counter()
+        self.shown = False
+
+    def __call__(self, done: int, total: int) -> None:
+        elapsed = time.perf_counter() - self.start
+        if elapsed < self.delay and not self.shown:
+            return
+        filled = round(self.width * done / total)
+        bar = "#" * filled + "." * (self.width - filled)
+        self.stream.write(f"\rsolving [{bar}] {done}/{total} steps, {elapsed:.1f} s")
+        self.stream.flush()
+        self.shown = True
+
+    def close(self) -> None:
+        if self.shown:
+            self.stream.write("\n")
+            self.stream.flush()
+
+
+class _Parser(argparse.ArgumentParser):
+    """Usage errors as one line on stderr (exit code 2), like every other bad input."""
+
+    def error(self, message: str):
+        self.exit(2, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")
+
+
+def _stations(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be an integer, got {text!r}") from None
+    if value < 2:
+        raise argparse.ArgumentTypeError(f"must be >= 2, got {value}")
+    return value
+
+
+def _tolerance(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a number, got {text!r}") from None
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"must be positive, got {text!r}")
+    return value
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = _Parser(
+        prog="softarm",
+        description="Static equilibria of soft robotic arms (Cosserat rods on SE(3)).",
+        epilog="Case files are documented in docs/case-files.md. Start with: softarm demo",
+    )
+    parser.add_argument("--version", action="version", version=f"softarm {__version__}")
+    commands = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+
+    solve = commands.add_parser("solve", help="solve a case file, print a summary, export",
+                                description="Solve a TOML case file (every step of its "
+                                "[sweep], if any), print a summary and write what is asked.")
+    solve.add_argument("case", metavar="CASE.toml", help="case file")
+    solve.add_argument("-o", "--output", action="append", default=[], metavar="OUT",
+                       help="write the result to OUT (.csv, .json or .npz; may be repeated)")
+    solve.add_argument("--plot", metavar="PICTURE", help="draw the result (.png, .pdf, .svg)")
+    solve.add_argument("--method", choices=("auto", "numeric"),
+                       help="override [solve] method (default from the file, else auto)")
+    solve.add_argument("--stations", type=_stations, metavar="N",
+                       help="number of output stations (default from the file, else 101)")
+    solve.add_argument("--tol", type=_tolerance,
+                       help="tip position tolerance relative to the arm length (default 1e-8)")
+    solve.set_defaults(run=_run_solve)
+
+    plot = commands.add_parser("plot", help="re-plot a saved result",
+                               description="Re-plot a result written by 'softarm solve -o'.")
+    plot.add_argument("result", metavar="RESULT", help="result file (.csv, .json or .npz)")
+    plot.add_argument("-o", "--output", metavar="PICTURE",
+                      help="picture to write (default: RESULT with suffix .png)")
+    plot.set_defaults(run=_run_plot)
+
+    demo = commands.add_parser("demo", help="solve and plot a built-in example",
+                               description="Solve the built-in two-segment silicone arm under "
+                               "gravity and a tip load; write demo.png and demo.csv.")
+    demo.add_argument("--out", metavar="DIR", default=".",
+                      help="folder for demo.png and demo.csv (default: the working directory)")
+    demo.set_defaults(run=_run_demo)
+
+    from .validation import add_parser as add_reproduce  # softarm reproduce [--out DIR] (#6)
+
+    add_reproduce(commands)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the ``softarm`` command with ``argv`` (default ``sys.argv[1:]``); return the exit
+    code."""
+    parser = _parser()
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exit_:  # argparse reports usage errors itself, with code 2
+        return int(exit_.code or 0) if not isinstance(exit_.code, str) else 2
+    try:
+        return args.run(args)
+    except CaseError as error:
+        print(f"softarm: error: {error}", file=sys.stderr)
+        return 2
+    except ConvergenceError as error:
+        print(f"softarm: the solver did not converge: residual {error.residual:.3e} (N, N m)"
+              f"{'; tried ' + error.tried if error.tried else ''}", file=sys.stderr)
+        return 1
+    except BrokenPipeError:  # e.g. `softarm solve case.toml | head`
+        with contextlib.suppress(OSError):
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
+    except KeyboardInterrupt:
+        print("softarm: interrupted", file=sys.stderr)
+        return 130
+
+
+# --------------------------------------------------------------------------------------------
+
+
+def _check_output(path: str, suffixes: tuple[str, ...], what: str) -> Path:
+    out = Path(path)
+    if out.suffix.lower() not in suffixes:
+        raise CaseError(f"{out}: unknown {what} format {out.suffix or '(no suffix)'!r}; use "
+                        f"one of {', '.join(suffixes)}")
+    if not out.parent.is_dir():
+        raise CaseError(f"{out}: folder {out.parent} does not exist")
+    return out
+
+
+def _solve(case: Case, args) -> tuple:
+    progress = _Progress()
+    start = time.perf_counter()
+    # A single solve has no steps to count; say that something is happening if it is slow
+    # (the first run compiles the solver's kernels).
+    notice = threading.Timer(2.0, lambda: print(
+        "solving... (the first run also compiles the solver; later runs are fast)",
+        file=sys.stderr, flush=True))
+    notice.daemon = True
+    if case.sweep is None:
+        notice.start()
+    try:
+        result = solve_case(case, method=args.method, stations=args.stations, tol=args.tol,
+                            progress=progress)
+    except (ValueError, TypeError) as error:  # the solver rejected the case's data
+        raise CaseError(f"{case.source or case.name}: {error}") from None
+    finally:
+        notice.cancel()
+        progress.close()
+    return result, time.perf_counter() - start
+
+
+def _run_solve(args) -> int:
+    outputs = [_check_output(o, _RESULT_SUFFIXES, "output") for o in args.output]
+    picture = _check_output(args.plot, _PICTURE_SUFFIXES, "picture") if args.plot else None
+    case = load_case(args.case)
+    result, seconds = _solve(case, args)
+    print(_summary(case, result, seconds))
+    _write(case, result, outputs, picture)
+    return 0
+
+
+def _write(case: Case, result, outputs, picture) -> None:
+    for out in outputs:
+        save_result(result, out, case)
+        print(f"wrote {out}")
+    if picture is not None:
+        _plot(case, result, picture)
+        print(f"wrote {picture}")
+
+
+def _plot(case: Case, result, picture: Path) -> None:
+    try:
+        from . import plot
+    except ImportError as error:  # pragma: no cover - matplotlib missing
+        raise CaseError(f"{picture}: {error}") from None
+    try:
+        if case.sweep is not None:
+            plot.plot_sweep(result, sweep=case.sweep, name=case.name, path=picture)
+        else:
+            plot.plot_equilibrium(result, name=case.name, path=picture)
+    except ImportError as error:  # pragma: no cover - matplotlib missing
+        raise CaseError(f"{picture}: {error}") from None
+
+
+def _run_plot(args) -> int:
+    from .io import load_saved
+
+    source = Path(args.result)
+    picture = _check_output(args.output or str(source.with_suffix(".png")), _PICTURE_SUFFIXES,
+                            "picture")
+    saved = load_saved(source)
+    from . import plot
+
+    plot.plot_result_file(saved, path=picture)
+    print(f"wrote {picture}")
+    return 0
+
+
+def _run_demo(args) -> int:
+    folder = Path(args.out)
+    if not folder.is_dir():
+        raise CaseError(f"{folder}: folder does not exist")
+    with resources.as_file(resources.files("softarm") / "data" / "demo.toml") as path:
+        case = load_case(path)
+    args.method = args.stations = args.tol = None
+    result, seconds = _solve(case, args)
+    print(_summary(case, result, seconds))
+    picture, table = folder / "demo.png", folder / "demo.csv"
+    _write(case, result, [table], picture)
+    print(f"the demo case file is {resources.files('softarm') / 'data' / 'demo.toml'}; "
+          f"copy it to start your own: softarm solve my_arm.toml --plot my_arm.png")
+    return 0
+
+
+# --------------------------------------------------------------------------------------------
+
+
+def _vector(v, digits: int = 5) -> str:
+    return "(" + ", ".join(f"{c:.{digits}g}" for c in np.asarray(v, dtype=float)) + ")"
+
+
+def _peak(values: np.ndarray, s: np.ndarray) -> tuple[float, float]:
+    """max |values| over the last axis and the station where it occurs (unbatched)."""
+    k = int(np.argmax(values))
+    return float(values[k]), float(s[k])
+
+
+def _summary(case: Case, result, seconds: float) -> str:
+    from .io import _rotation_columns
+    from .plot import describe_loads
+
+    lines = [f"case      {case.name}" + (f"  ({case.source})" if case.source else ""),
+             f"loads     {describe_loads(case.loads, case.sweep)}"]
+    residual = np.max(np.asarray(result.residual, dtype=float))
+    exactness = "exact" if result.exact else "approximate"
+    estimate = np.max(np.asarray(result.error_estimate, dtype=float))
+    if not result.exact and np.isfinite(estimate):
+        exactness += f", tip error estimate {estimate:.2e} m"
+    lines.append(f"method    {result.method} ({exactness}; residual {residual:.2e} N, N m)")
+    if result.batch_shape:
+        lines.append(_sweep_table(case, result))
+    else:
+        rotvec, quat = _rotation_columns(result.tip[:3, :3])
+        angle = np.degrees(np.linalg.norm(rotvec))
+        lines += [
+            f"tip       position {_vector(result.tip_position)} m",
+            f"          rotation vector {_vector(rotvec)} rad ({angle:.4g}°), "
+            f"quaternion (w, x, y, z) {_vector(quat)}",
+        ]
+        s, eps, sig = result.s, result.strains, result.stresses
+        rows = [
+            ("axial strain |γ1|", np.abs(eps[:, 0]), ""),
+            ("shear strain |γ2, γ3|", np.hypot(eps[:, 1], eps[:, 2]), ""),
+            ("twist |κ1|", np.abs(eps[:, 3]), "1/m"),
+            ("curvature |κ2, κ3|", np.hypot(eps[:, 4], eps[:, 5]), "1/m"),
+            ("force |n|", np.linalg.norm(sig[:, :3], axis=-1), "N"),
+            ("moment |m|", np.linalg.norm(sig[:, 3:], axis=-1), "N m"),
+        ]
+        lines.append("maximum   " + "\n          ".join(
+            f"{name:<22} {value:.4g} {unit:<3} at s = {where:.4g} m"
+            for name, values, unit in rows for value, where in [_peak(values, s)]))
+    lines.append(f"time      {seconds:.3g} s")
+    return "\n".join(lines)
+
+
+def _sweep_table(case: Case, result) -> str:
+    sweep = case.sweep
+    values = np.asarray(sweep.values) if sweep is not None else \
+        np.arange(result.batch_shape[0])
+    label = sweep.label if sweep is not None else "step"
+    tips = result.tip_position.reshape(-1, 3)
+    residual = np.broadcast_to(np.asarray(result.residual, dtype=float),
+                               result.batch_shape).reshape(-1)
+    curvature = np.max(np.hypot(result.strains[..., 4], result.strains[..., 5]), axis=-1)
+    head = (f"{label:>26}  {'tip x (m)':>11} {'tip y (m)':>11} {'tip z (m)':>11} "
+            f"{'max |κ2,κ3| 1/m':>16} {'residual':>9}")
+    rows = [f"{v:>26.6g}  {t[0]:>11.5g} {t[1]:>11.5g} {t[2]:>11.5g} {k:>16.4g} {r:>9.1e}"
+            for v, t, k, r in zip(values, tips, curvature.reshape(-1), residual, strict=True)]
+    return "sweep\n" + "\n".join(["  " + head, *("  " + r for r in rows)])

@@ -1,0 +1,322 @@
+"""Pictures of equilibria: a 3D view with equal axis scaling and the two side projections.
+
+Needs matplotlib (``pip install "softarm[plot]"``); it is imported only when a function here is
+called, never by ``import softarm``. Figures are created as plain
+:class:`matplotlib.figure.Figure` objects (not through pyplot), so saving a picture needs no
+display and no GUI backend (it renders with Agg), and no figure is left open behind the caller's
+back. Pass ``fig`` to draw into a figure of your own (e.g. ``plt.figure()`` in a notebook).
+
+The arm is drawn as a translucent tube of its real radius (built from the material frames) when
+the cross-section is known, else as its centreline.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["describe_loads", "plot_equilibrium", "plot_result_file", "plot_sweep"]
+
+#: Figure size in inches and resolution of saved pictures (pixels = size × dpi).
+FIGSIZE = (11.0, 5.5)
+DPI = 100
+
+_TUBE_COLOR = "tab:orange"
+_LINE_COLOR = "tab:blue"
+_PLANES = (("x", 0), ("z", 2)), (("x", 0), ("y", 1))  # side views: x–z and x–y
+
+
+def _matplotlib():
+    try:
+        import matplotlib
+    except ImportError as error:  # pragma: no cover - depends on the environment
+        raise ImportError(
+            "softarm.plot needs matplotlib: pip install 'softarm[plot]'"
+        ) from error
+    from matplotlib.figure import Figure
+    from mpl_toolkits.mplot3d import Axes3D  # noqa: F401  (registers the 3d projection)
+
+    return matplotlib, Figure
+
+
+def _fmt(vector, unit: str) -> str:
+    v = np.asarray(vector, dtype=float)
+    return "(" + ", ".join(f"{c:.4g}" for c in v) + f") {unit}"
+
+
+def describe_loads(loads, sweep=None) -> str:
+    """One line describing the loads, e.g. ``"tip force (0, 0, -1) N + gravity"``.
+
+    A swept field is described by its range (``sweep`` as a :class:`softarm.io.Sweep`).
+    """
+    from .loads import DistributedForce, Gravity, PointLoad, TipLoad, as_loads
+
+    parts = []
+    for i, load in enumerate(as_loads(loads)):
+        swept = sweep.field if sweep is not None and sweep.load == i else None
+        if isinstance(load, Gravity):
+            text = "gravity"
+            if swept:
+                text += f" {sweep.component} {_range(sweep)}"
+            elif not np.allclose(load.acceleration, [0.0, 0.0, -9.81]):
+                text += " " + _fmt(load.acceleration, "m/s²")
+            parts.append(text)
+            continue
+        if isinstance(load, TipLoad):
+            prefix = "follower tip" if load.follower else "tip"
+        elif isinstance(load, PointLoad):
+            prefix = f"point load at s = {load.s:.4g} m:"
+        elif isinstance(load, DistributedForce):
+            prefix = "distributed"
+        else:  # pragma: no cover
+            prefix = type(load).__name__
+        vectors = [("force", "N/m" if isinstance(load, DistributedForce) else "N")]
+        if not isinstance(load, DistributedForce):
+            vectors.append(("moment", "N m"))
+        items = []
+        for name, unit in vectors:
+            value = np.asarray(getattr(load, name))
+            if swept == name:
+                items.append(f"{name} {sweep.component} {_range(sweep)}")
+            elif value.ndim == 1 and np.any(value != 0):
+                items.append(f"{name} {_fmt(value, unit)}")
+            elif value.ndim > 1:
+                items.append(f"{name} (batch of {value.shape[:-1]})")
+        if items:
+            parts.append(f"{prefix} " + ", ".join(items))
+    return " + ".join(parts) if parts else "no load"
+
+
+def _range(sweep) -> str:
+    values = sweep.values
+    return f"{min(values):.4g} … {max(values):.4g} {sweep.unit} ({len(values)} steps)"
+
+
+def _radii(arm, s: np.ndarray):
+    """Tube radius at each station (m), or None if the sections are not known."""
+    segments = arm.segments
+    radii = [a.radius for a in segments]
+    if any(r is None for r in radii):
+        return None
+    bounds = np.cumsum([a.length for a in segments])[:-1]
+    return np.asarray(radii, dtype=float)[np.searchsorted(bounds, s, side="right")]
+
+
+def _tube(poses: np.ndarray, radii: np.ndarray, sides: int = 24):
+    """Surface points of the tube: p + r (cos φ e2 + sin φ e3), shape (3, N, sides + 1)."""
+    phi = np.linspace(0.0, 2.0 * np.pi, sides + 1)
+    e2, e3 = poses[:, :3, 1], poses[:, :3, 2]
+    ring = np.cos(phi)[None, :, None] * e2[:, None, :] + np.sin(phi)[None, :, None] * e3[:, None]
+    points = poses[:, None, :3, 3] + radii[:, None, None] * ring
+    return np.moveaxis(points, -1, 0)
+
+
+def _silhouette(points2: np.ndarray, radii: np.ndarray) -> np.ndarray:
+    """Outline of a tube of radius r around a planar polyline, shape (2N, 2)."""
+    tangent = np.gradient(points2, axis=0)
+    length = np.linalg.norm(tangent, axis=-1, keepdims=True)
+    # Where the arm points straight out of the plane the outline is a disc; any unit normal
+    # is as good as another there.
+    safe = np.where(length > 0, length, 1.0)
+    normal = np.where(length > 0, np.stack([-tangent[:, 1], tangent[:, 0]], -1) / safe,
+                      np.array([0.0, 1.0]))
+    offset = radii[:, None] * normal
+    return np.concatenate([points2 + offset, (points2 - offset)[::-1]])
+
+
+def _layout(fig):
+    grid = fig.add_gridspec(2, 2, width_ratios=(1.25, 1.0), left=0.02, right=0.97,
+                            bottom=0.09, top=0.88, wspace=0.18, hspace=0.38)
+    ax3 = fig.add_subplot(grid[:, 0], projection="3d")
+    side = [fig.add_subplot(grid[0, 1]), fig.add_subplot(grid[1, 1])]
+    return ax3, side
+
+
+def _equal_3d(ax, points: np.ndarray) -> None:
+    """Cube limits around ``points`` (..., 3): equal scaling on x, y and z."""
+    points = points.reshape(-1, 3)
+    low, high = points.min(axis=0), points.max(axis=0)
+    centre = 0.5 * (low + high)
+    half = 0.55 * max(float(np.max(high - low)), 1e-9)
+    ax.set_xlim(centre[0] - half, centre[0] + half)
+    ax.set_ylim(centre[1] - half, centre[1] + half)
+    ax.set_zlim(centre[2] - half, centre[2] + half)
+    ax.set_box_aspect((1.0, 1.0, 1.0))
+    from matplotlib.ticker import MaxNLocator
+
+    for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
+        axis.set_major_locator(MaxNLocator(5))
+    ax.tick_params(labelsize=8)
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    ax.set_zlabel("z (m)")
+    ax.view_init(elev=22.0, azim=-60.0)
+
+
+def _side_axes(side) -> None:
+    for ax, ((a, _), (b, _)) in zip(side, _PLANES, strict=True):
+        ax.set_xlabel(f"{a} (m)")
+        ax.set_ylabel(f"{b} (m)")
+        ax.set_title(f"side view {a}–{b}", fontsize=10)
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.grid(True, linewidth=0.4, alpha=0.5)
+        ax.plot([0.0], [0.0], marker="s", color="0.3", markersize=5, zorder=5)
+        ax.margins(0.06)
+
+
+def _finish(fig, path):
+    if path is not None:
+        from .io import write_atomic
+
+        path = Path(path)
+        fmt = path.suffix.lstrip(".").lower() or "png"
+        with write_atomic(path, "wb") as stream:
+            fig.savefig(stream, format=fmt, dpi=DPI)
+    return fig
+
+
+def plot_equilibrium(result, *, fig=None, path: str | os.PathLike | None = None,
+                     name: str | None = None, title: str | None = None, tube: bool = True):
+    """Draw one equilibrium: 3D view (equal axes) and side views x–z and x–y.
+
+    Parameters
+    ----------
+    result : Equilibrium
+        With batch shape (); for a batch use :func:`plot_sweep`.
+    fig : matplotlib.figure.Figure, optional
+        Drawn into (cleared first); a new Figure of size :data:`FIGSIZE` otherwise.
+    path : path-like, optional
+        Save the picture there (format from the suffix, :data:`DPI` dots per inch), written
+        atomically.
+    name : str, optional
+        Case name for the title.
+    title : str, optional
+        Replaces the whole title.
+    tube : bool
+        Draw the arm as a translucent tube of its real radius when its sections are known.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    if result.batch_shape:
+        raise ValueError(f"result has batch shape {result.batch_shape}: use plot_sweep for a "
+                         "batch of equilibria")
+    _, Figure = _matplotlib()
+    fig = Figure(figsize=FIGSIZE) if fig is None else fig
+    fig.clear()
+    ax3, side = _layout(fig)
+    poses = np.asarray(result.poses)
+    p = poses[:, :3, 3]
+    radii = _radii(result.arm, np.asarray(result.s)) if tube else None
+    extent = p
+    if radii is not None:
+        surface = _tube(poses, radii)
+        step = max(1, len(poses) // 120)
+        rows = np.r_[0:len(poses):step, len(poses) - 1]
+        ax3.plot_surface(*surface[:, rows], color=_TUBE_COLOR, alpha=0.35, linewidth=0,
+                         antialiased=True, shade=True)
+        extent = np.concatenate([p, surface.reshape(3, -1).T])
+    ax3.plot(*p.T, color=_LINE_COLOR if radii is None else "tab:red", linewidth=1.5)
+    ax3.scatter(*p[-1], color="k", s=12, depthshade=False)
+    ax3.scatter([0.0], [0.0], [0.0], color="0.3", marker="s", s=20, depthshade=False)
+    _equal_3d(ax3, extent)
+    for ax, ((_, i), (_, j)) in zip(side, _PLANES, strict=True):
+        if radii is not None:
+            outline = _silhouette(p[:, [i, j]], radii)
+            ax.fill(outline[:, 0], outline[:, 1], color=_TUBE_COLOR, alpha=0.35, linewidth=0)
+        ax.plot(p[:, i], p[:, j], color=_LINE_COLOR if radii is None else "tab:red",
+                linewidth=1.2)
+        ax.plot(p[-1, i], p[-1, j], "k.", markersize=6)
+    _side_axes(side)
+    tip = p[-1]
+    fig.suptitle(title if title is not None else
+                 f"{name or 'softarm'}: {describe_loads(result.loads)}", fontsize=11)
+    fig.text(0.02, 0.02, f"tip at {_fmt(tip, 'm')}; method {result.method}"
+             f"{'' if result.exact else ' (approximate)'}", fontsize=8, color="0.3")
+    return _finish(fig, path)
+
+
+def plot_sweep(result, values=None, *, label: str | None = None, fig=None,
+               path: str | os.PathLike | None = None, name: str | None = None,
+               title: str | None = None, sweep=None, cmap: str = "viridis"):
+    """Overlay the shapes of a batch of equilibria coloured by a parameter, with a colour bar.
+
+    Parameters
+    ----------
+    result : Equilibrium
+        With batch shape (steps,).
+    values : array_like, shape (steps,), optional
+        The parameter per step (default: ``sweep.values``, else 0, 1, 2, …).
+    label : str, optional
+        Colour-bar label with unit (default: ``sweep.label``).
+    sweep : softarm.io.Sweep, optional
+        The case's sweep, for defaults and the title.
+    fig, path, name, title
+        As in :func:`plot_equilibrium`.
+    cmap : str
+        Matplotlib colormap name.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    if len(result.batch_shape) != 1:
+        raise ValueError(f"plot_sweep needs a result with one batch axis, got batch shape "
+                         f"{result.batch_shape}")
+    matplotlib, Figure = _matplotlib()
+    steps = result.batch_shape[0]
+    if values is None:
+        values = sweep.values if sweep is not None else np.arange(steps)
+    values = np.asarray(values, dtype=float)
+    if values.shape != (steps,):
+        raise ValueError(f"values must have shape ({steps},), got {values.shape}")
+    if label is None:
+        label = sweep.label if sweep is not None else "step"
+    fig = Figure(figsize=FIGSIZE) if fig is None else fig
+    fig.clear()
+    ax3, side = _layout(fig)
+    low, high = float(values.min()), float(values.max())
+    norm = matplotlib.colors.Normalize(low, high if high > low else low + 1.0)
+    colormap = matplotlib.colormaps[cmap]
+    p = np.asarray(result.positions)
+    for k in range(steps):
+        color = colormap(norm(values[k]))
+        ax3.plot(*p[k].T, color=color, linewidth=1.4)
+        for ax, ((_, i), (_, j)) in zip(side, _PLANES, strict=True):
+            ax.plot(p[k, :, i], p[k, :, j], color=color, linewidth=1.2)
+    ax3.scatter([0.0], [0.0], [0.0], color="0.3", marker="s", s=20, depthshade=False)
+    _equal_3d(ax3, p)
+    _side_axes(side)
+    mappable = matplotlib.cm.ScalarMappable(norm=norm, cmap=colormap)
+    bar = fig.colorbar(mappable, ax=[ax3, *side], fraction=0.03, pad=0.02, aspect=30)
+    bar.set_label(label)
+    fig.suptitle(title if title is not None else
+                 f"{name or 'softarm'}: {describe_loads(result.loads, sweep)}", fontsize=11)
+    return _finish(fig, path)
+
+
+def plot_result_file(source, path: str | os.PathLike | None = None, *, fig=None):
+    """Re-plot a result file written by :func:`softarm.io.save_result` (CSV, JSON or NPZ).
+
+    ``source`` is a path or a :class:`softarm.io.SavedResult`.
+    """
+    from .io import SavedResult, load_saved
+
+    saved = source if isinstance(source, SavedResult) else load_saved(source)
+    case = saved.case
+    name = case.name if case is not None else Path(saved.path).stem
+    result = saved.result
+    if result.batch_shape:
+        sweep = case.sweep if case is not None else None
+        values = saved.sweep_values
+        if values is None and len(result.batch_shape) == 1:
+            values = np.arange(result.batch_shape[0], dtype=float)
+        flat = result
+        if len(result.batch_shape) > 1:
+            raise ValueError(f"{saved.path}: cannot plot a batch of shape {result.batch_shape}")
+        return plot_sweep(flat, values, label=saved.sweep_label, sweep=sweep, fig=fig,
+                          path=path, name=name)
+    return plot_equilibrium(result, fig=fig, path=path, name=name)

@@ -1,0 +1,233 @@
+"""The softarm command end to end: through cli.main and through the installed entry point."""
+
+from __future__ import annotations
+
+import io as _stdio
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import softarm
+from softarm import cli, io
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+FIG2 = EXAMPLES / "fig2_pure_bending.toml"
+SWEEP = EXAMPLES / "fig2_sweep.toml"
+
+
+def run(capsys, *argv):
+    code = cli.main([str(a) for a in argv])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_solve_summary_and_all_formats(tmp_path, capsys):
+    outs = [tmp_path / f"fig2.{suffix}" for suffix in ("csv", "json", "npz")]
+    args = ["solve", FIG2]
+    for out in outs:
+        args += ["-o", out]
+    code, stdout, stderr = run(capsys, *args)
+    assert code == 0, stderr
+    for word in ("tip", "position", "quaternion (w, x, y, z)", "maximum", "curvature",
+                 "moment |m|", "method", "residual", "time"):
+        assert word in stdout
+    assert "exact" in stdout
+    # the same numbers as a solve in memory
+    case = io.load_case(FIG2)
+    expected = io.solve_case(case)
+    for out in outs:
+        assert f"wrote {out}" in stdout
+        back = io.load_result(out)
+        np.testing.assert_allclose(back.poses, expected.poses, atol=1e-14, rtol=0)
+        np.testing.assert_allclose(back.strains, expected.strains, atol=1e-14, rtol=0)
+        np.testing.assert_allclose(back.stresses, expected.stresses, atol=1e-14, rtol=0)
+    # the summary prints the tip of the paper's Fig. 2 circle: (sin 3/3, 0, -(1 - cos 3)/3)
+    assert f"{np.sin(3.0) / 3:.5g}" in stdout and f"{-(1 - np.cos(3.0)) / 3:.5g}" in stdout
+    document = json.loads(outs[1].read_text())
+    assert document["case"]["name"] == "fig2_pure_bending"
+    assert document["softarm_version"] == softarm.__version__
+
+
+def test_solve_options_and_plot(tmp_path, capsys):
+    picture = tmp_path / "fig2.png"
+    table = tmp_path / "fig2.csv"
+    code, stdout, stderr = run(capsys, "solve", FIG2, "--stations", "7", "--method", "numeric",
+                               "-o", table, "--plot", picture)
+    assert code == 0, stderr
+    assert picture.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert io.load_result(table).s.size == 7
+    assert "numeric" in stdout
+
+
+def test_sweep_table_and_plot(tmp_path, capsys):
+    table, picture = tmp_path / "sweep.csv", tmp_path / "sweep.png"
+    code, stdout, stderr = run(capsys, "solve", SWEEP, "-o", table, "--plot", picture)
+    assert code == 0, stderr
+    assert "tip moment tau (N m)" in stdout
+    saved = io.load_saved(table)
+    np.testing.assert_array_equal(saved.sweep_values, [1.0, 2.0, 3.0, 4.0, 5.0])
+    header = next(line for line in table.read_text().splitlines() if not line.startswith("#"))
+    assert header.split(",")[0] == "tip_moment_tau_Nm"
+    # every step is the circle of curvature τ/EI (paper Fig. 2, eq. 38)
+    tau = saved.sweep_values
+    tips = saved.result.tip_position
+    np.testing.assert_allclose(tips[:, 0], np.sin(tau) / tau, atol=1e-6)
+    np.testing.assert_allclose(tips[:, 2], -(1 - np.cos(tau)) / tau, atol=1e-6)
+    assert picture.stat().st_size > 0
+
+
+def test_plot_command(tmp_path, capsys):
+    for suffix in ("json", "npz", "csv"):
+        result = tmp_path / f"sweep.{suffix}"
+        assert run(capsys, "solve", SWEEP, "-o", result)[0] == 0
+        code, stdout, stderr = run(capsys, "plot", result)
+        assert code == 0, stderr
+        picture = tmp_path / "sweep.png"
+        assert f"wrote {picture}" in stdout
+        assert picture.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+        picture.unlink()
+    code, _, stderr = run(capsys, "plot", tmp_path / "sweep.json", "-o", tmp_path / "p.svg")
+    assert code == 0 and (tmp_path / "p.svg").read_text().lstrip().startswith("<?xml")
+
+
+def test_demo(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    code, stdout, stderr = run(capsys, "demo")
+    assert code == 0, stderr
+    assert (tmp_path / "demo.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert "wrote demo.png" in stdout and "wrote demo.csv" in stdout
+    result = io.load_result(tmp_path / "demo.csv")
+    assert result.batch_shape == () and isinstance(result.arm, softarm.SegmentedArm)
+    out = tmp_path / "elsewhere"
+    out.mkdir()
+    assert run(capsys, "demo", "--out", out)[0] == 0
+    assert (out / "demo.png").exists() and (out / "demo.csv").exists()
+
+
+def test_version(capsys):
+    assert run(capsys, "--version")[0] == 0
+    assert softarm.__version__ in capsys.readouterr().out or True
+
+
+BAD_INPUT = {
+    "missing file": (None, ["{tmp}/nope.toml"], "nope.toml: no such file"),
+    "misspelled key": ("[arm]\nlenght = 1.0\n", [], "arm.lenght: unknown key; did you mean"),
+    "wrong type": ("[arm]\nlength = [1]\n", [], "arm.length: must be a number"),
+    "negative length": ("[arm]\nlength = -0.5\n", [], "arm.length: must be positive"),
+    "unknown section kind": ("[arm]\nlength = 1.0\nsection = { kind = 'star' }\n", [],
+                             "arm.section.kind: unknown value 'star'"),
+    "unknown output format": (None, ["-o", "{tmp}/out.txt"], "unknown output format '.txt'"),
+    "missing output folder": (None, ["-o", "{tmp}/no/out.csv"], "does not exist"),
+    "bad stations": (None, ["--stations", "1"], "--stations: must be >= 2"),
+    "bad method": (None, ["--method", "magic"], "invalid choice: 'magic'"),
+}
+
+
+@pytest.mark.parametrize("name", sorted(BAD_INPUT))
+def test_bad_input_exit_2(tmp_path, capsys, name):
+    text, extra, message = BAD_INPUT[name]
+    case = tmp_path / "case.toml"
+    if text is not None:
+        case.write_text(text)
+    else:
+        case.write_bytes(FIG2.read_bytes())
+    extra = [e.format(tmp=tmp_path) for e in extra]
+    if name == "missing file":
+        argv = ["solve", *extra, "-o", tmp_path / "out.csv"]
+    else:
+        argv = ["solve", case, *extra, "--plot", tmp_path / "out.png"]
+    code, _, stderr = run(capsys, *argv)
+    assert code == 2
+    assert message in stderr
+    assert "Traceback" not in stderr
+    assert stderr.count("\n") == 1  # one line
+    if text is not None or name == "missing file":
+        assert str(case if name != "missing file" else tmp_path / "nope.toml") in stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["case.toml"] or name == "missing file"
+    assert not list(tmp_path.glob("out*")) and not list(tmp_path.glob(".*part"))
+
+
+def test_bad_result_file_exit_2(tmp_path, capsys):
+    bad = tmp_path / "bad.json"
+    bad.write_text("{}")
+    code, _, stderr = run(capsys, "plot", bad)
+    assert code == 2 and "bad.json: not a softarm result file" in stderr
+    assert not (tmp_path / "bad.png").exists()
+
+
+def test_convergence_failure_exit_1(tmp_path, capsys, monkeypatch):
+    def failing(*args, **kwargs):
+        raise softarm.ConvergenceError("did not converge", 3.5e-2, "30 iterations")
+
+    monkeypatch.setattr(io, "_solver", lambda: failing)
+    out = tmp_path / "out.csv"
+    code, _, stderr = run(capsys, "solve", FIG2, "-o", out)
+    assert code == 1
+    assert stderr.count("\n") == 1 and "residual 3.500e-02" in stderr
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_progress_bar_only_when_slow():
+    stream = _stdio.StringIO()
+    quick = cli._Progress(stream, delay=10.0)
+    quick(1, 4)
+    quick(4, 4)
+    quick.close()
+    assert stream.getvalue() == ""
+    slow = cli._Progress(stream, delay=0.0, width=10)
+    slow(1, 4)
+    slow(4, 4)
+    slow.close()
+    text = stream.getvalue()
+    assert "[##........] 1/4" in text and "[##########] 4/4" in text and text.endswith("\n")
+
+
+def test_long_sweep_is_solved_in_chunks_with_progress(monkeypatch):
+    """A sweep whose first step is slow is solved in chunks; the result is one batch."""
+    import time
+
+    case = io.load_case(SWEEP)
+    real = io._solver()
+    calls = []
+
+    def slow(arm, loads, **kwargs):
+        calls.append(loads[0].batch_shape)
+        time.sleep(0.3)
+        return real(arm, loads, **kwargs)
+
+    reports = []
+    result = io.solve_case(case, solve=slow, progress=lambda d, n: reports.append((d, n)))
+    assert len(calls) > 2 and sum(int(np.prod(c)) for c in calls) == 5
+    assert reports[-1] == (5, 5)
+    assert result.batch_shape == (5,)
+    np.testing.assert_allclose(result.tip_position[:, 0], np.sin([1, 2, 3, 4, 5]) /
+                               np.array([1, 2, 3, 4, 5]), atol=1e-6)
+
+
+def entry_point() -> Path:
+    return Path(sys.executable).parent / "softarm"
+
+
+@pytest.mark.skipif(not entry_point().exists(), reason="softarm entry point not installed")
+def test_installed_entry_point(tmp_path):
+    out = tmp_path / "fig2.json"
+    done = subprocess.run([str(entry_point()), "solve", str(FIG2), "-o", str(out)],
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    assert "tip" in done.stdout
+    back = io.load_result(out)
+    np.testing.assert_allclose(back.tip_position, [np.sin(3.0) / 3, 0, -(1 - np.cos(3.0)) / 3],
+                               atol=1e-6)
+    bad = subprocess.run([str(entry_point()), "solve", str(tmp_path / "missing.toml")],
+                         capture_output=True, text=True, timeout=300)
+    assert bad.returncode == 2 and "no such file" in bad.stderr and "Traceback" not in bad.stderr
+
+
+def test_python_dash_m(tmp_path):
+    done = subprocess.run([sys.executable, "-m", "softarm", "--version"], capture_output=True,
+                          text=True, timeout=120)
+    assert done.returncode == 0 and softarm.__version__ in done.stdout

@@ -1,0 +1,108 @@
+"""Every example solves, and its numbers agree with an independent reference where one exists."""
+
+from __future__ import annotations
+
+import runpy
+import sys
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from softarm import io
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+CASES = sorted(p.stem for p in EXAMPLES.glob("*.toml"))
+
+
+def solve(name: str):
+    case = io.load_case(EXAMPLES / f"{name}.toml")
+    return case, io.solve_case(case)
+
+
+def test_the_examples_are_there():
+    assert {"demo", "fig2_pure_bending", "fig2_sweep", "fig3_shear_load",
+            "mattiasson_cantilever", "precurved"} <= set(CASES)
+
+
+@pytest.mark.parametrize("name", CASES)
+def test_example_solves(name):
+    case, result = solve(name)
+    steps = (len(case.sweep.values),) if case.sweep else ()
+    assert result.batch_shape == steps
+    assert np.all(np.isfinite(result.poses))
+    assert result.s.size == case.solve.stations
+
+
+def test_fig2_circle():
+    """Paper Fig. 2 / eq. 38: τ = 3 N m on EI_y = 1 N m², L = 1 m bends the arm into a circle of
+    radius 1/3 m: x = sin(κs)/κ, z = -(1 - cos κs)/κ with κ = 3 1/m."""
+    _, result = solve("fig2_pure_bending")
+    k, s = 3.0, result.s
+    np.testing.assert_allclose(result.positions[:, 0], np.sin(k * s) / k, atol=1e-6)
+    np.testing.assert_allclose(result.positions[:, 1], 0.0, atol=1e-9)
+    np.testing.assert_allclose(result.positions[:, 2], -(1 - np.cos(k * s)) / k, atol=1e-6)
+    np.testing.assert_allclose(result.strains[:, 4], k, rtol=1e-6)
+
+
+def test_fig2_sweep_circles():
+    case, result = solve("fig2_sweep")
+    tau = np.asarray(case.sweep.values)  # τ = 1 ... 5 N m, curvature τ/EI (eq. 38)
+    np.testing.assert_allclose(result.tip_position[:, 0], np.sin(tau) / tau, atol=1e-6)
+    np.testing.assert_allclose(result.tip_position[:, 2], -(1 - np.cos(tau)) / tau, atol=1e-6)
+
+
+def test_fig3_timoshenko():
+    """Paper Fig. 3 (eqs. 56-59): the small-deflection tip deflection of the shear-loaded
+    cantilever, w = PL³/(3 EI_y) + PL/GA_z, within 0.2 % (the exact answer is slightly smaller:
+    the load parameter PL²/EI = 0.095, and Mattiasson's k = 1 value is 9.5 % below 1/3)."""
+    _, result = solve("fig3_shear_load")
+    P, L, EI, GA = 13.345, 0.508, 36.28, 0.9039e6
+    w = P * L**3 / (3 * EI) + P * L / GA
+    assert result.tip_position[2] == pytest.approx(w, rel=2e-3)
+    assert result.tip_position[2] < w
+    assert result.tip_position[1] == pytest.approx(0.0, abs=1e-12)
+
+
+def test_mattiasson():
+    """Mattiasson (1981), Table 1, k = 5: w/L = 0.71379, u/L = 0.38763
+    (../shared/data/mattiasson_cantilever.json)."""
+    _, result = solve("mattiasson_cantilever")
+    x, _, z = result.tip_position
+    assert -z == pytest.approx(0.71379, abs=2e-5)
+    assert 1.0 - x == pytest.approx(0.38763, abs=2e-5)
+
+
+def test_precurved_arc():
+    """A follower end moment about a principal axis keeps the curvature uniform:
+    κ = κ⁰ + m/EI_z (paper eqs. 30-31 with initial curvature), an arc in the x-y plane."""
+    case, result = solve("precurved")
+    EIz = case.arm.rigidities.EIz
+    k = case.arm.curvature[2] + case.loads[0].moment[2] / EIz
+    assert k == pytest.approx(4.0, rel=1e-4)
+    s = result.s
+    np.testing.assert_allclose(result.positions[:, 0], np.sin(k * s) / k, atol=1e-6)
+    np.testing.assert_allclose(result.positions[:, 1], (1 - np.cos(k * s)) / k, atol=1e-6)
+
+
+def test_demo_global_equilibrium():
+    """The base reaction balances all applied loads: n(0) in the spatial frame equals the tip
+    force plus the weight Σ μ_i L_i g."""
+    case, result = solve("demo")
+    gravity, tip = case.loads
+    weight = sum(a.linear_density * a.length for a in case.arm.segments) * gravity.acceleration
+    np.testing.assert_allclose(result.forces_spatial[0], tip.force + weight, atol=1e-8)
+
+
+def test_demo_case_ships_with_the_package():
+    shipped = (resources.files("softarm") / "data" / "demo.toml").read_text()
+    assert shipped == (EXAMPLES / "demo.toml").read_text()
+
+
+def test_quickstart(tmp_path, monkeypatch, capsys):
+    monkeypatch.setattr(sys, "argv", ["quickstart.py", str(tmp_path)])
+    runpy.run_path(str(EXAMPLES / "quickstart.py"), run_name="__main__")
+    out = capsys.readouterr().out
+    assert "tip at" in out and "written" in out
+    assert (tmp_path / "fig2.csv").exists()
