@@ -216,8 +216,11 @@ def plot_equilibrium(result, *, fig=None, path: str | os.PathLike | None = None,
         surface = _tube(poses, radii)
         step = max(1, len(poses) // 120)
         rows = np.r_[0:len(poses):step, len(poses) - 1]
-        ax3.plot_surface(*surface[:, rows], color=_TUBE_COLOR, alpha=0.35, linewidth=0,
-                         antialiased=True, shade=True)
+        # rstride = cstride = 1: every face is a quad. With coarser strides matplotlib pads
+        # ragged faces with uninitialised memory, whose garbage makes its projection warn
+        # ("overflow encountered in dot") at random.
+        ax3.plot_surface(*surface[:, rows], rstride=1, cstride=1, color=_TUBE_COLOR, alpha=0.35,
+                         linewidth=0, antialiased=True, shade=True)
         extent = np.concatenate([p, surface.reshape(3, -1).T])
     ax3.plot(*p.T, color=_LINE_COLOR if radii is None else "tab:red", linewidth=1.5)
     ax3.scatter(*p[-1], color="k", s=12, depthshade=False)
