@@ -273,7 +273,7 @@ def _peak(values: np.ndarray, s: np.ndarray) -> tuple[float, float]:
 
 
 def _summary(case: Case, result, seconds: float) -> str:
-    from .io import _rotation_columns
+    from .lie import so3
     from .plot import describe_loads
 
     lines = [f"case      {case.name}" + (f"  ({case.source})" if case.source else ""),
@@ -287,7 +287,7 @@ def _summary(case: Case, result, seconds: float) -> str:
     if result.batch_shape:
         lines.append(_sweep_table(case, result))
     else:
-        rotvec, quat = _rotation_columns(result.tip[:3, :3])
+        rotvec, quat = so3.log(result.tip[:3, :3]), so3.to_quaternion(result.tip[:3, :3])
         angle = np.degrees(np.linalg.norm(rotvec))
         lines += [
             f"tip       position {_vector(result.tip_position)} m",

@@ -38,6 +38,7 @@ from pathlib import Path
 import numpy as np
 
 from .equilibrium import Equilibrium
+from .lie import so3
 from .loads import DistributedForce, Gravity, PointLoad, TipLoad, as_loads
 from .model import Arm, Circle, Material, Rectangle, Rigidities, Section, SegmentedArm, Tube
 
@@ -566,7 +567,7 @@ def _parse(data, source, *, name=None, batched=False) -> Case:
         if isinstance(load, PointLoad) and load.s > arm.length:
             raise CaseError(f"{where}: load[{i + 1}].s: must lie on the arm, in [0, "
                             f"{arm.length!r}] m, got {load.s!r}")
-        if isinstance(load, Gravity) and _linear_density(arm) is None:
+        if isinstance(load, Gravity) and any(a.linear_density is None for a in arm.segments):
             raise CaseError(f"{where}: load[{i + 1}]: gravity needs the arm's mass: give "
                             "material.density or mass_per_length")
     options = _solve_options(top.table("solve")) if top.has("solve") else SolveOptions()
@@ -576,11 +577,6 @@ def _parse(data, source, *, name=None, batched=False) -> Case:
     clean.setdefault("name", case_name)
     return Case(case_name, arm, loads, options, sweep,
                 Path(source) if source is not None else None, copy.deepcopy(clean), description)
-
-
-def _linear_density(arm) -> float | None:
-    densities = [a.linear_density for a in arm.segments]
-    return None if any(d is None for d in densities) else densities[0]
 
 
 def load_case(path: str | os.PathLike) -> Case:
@@ -778,32 +774,9 @@ def _concatenate(parts: list[Equilibrium], loads: tuple) -> Equilibrium:
 # --------------------------------------------------------------------------------------------
 
 
-def _rotation_columns(rotations: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Rotation vectors (rad) and unit quaternions (w, x, y, z), w >= 0, of R (..., 3, 3)."""
-    from .lie import so3
-
-    rotvec = so3.log(rotations)
-    theta = np.linalg.norm(rotvec, axis=-1)
-    # sin(θ/2)/θ = ½ sinc(θ/2), no division by θ
-    xyz = (0.5 * np.sinc(theta / (2 * np.pi)))[..., None] * rotvec
-    quat = np.concatenate([np.cos(0.5 * theta)[..., None], xyz], axis=-1)
-    return rotvec, quat
-
-
-def _quaternion_matrix(q: np.ndarray) -> np.ndarray:
-    """Rotation matrices from unit quaternions (w, x, y, z), shape (..., 4) -> (..., 3, 3)."""
-    q = q / np.linalg.norm(q, axis=-1, keepdims=True)
-    w, x, y, z = np.moveaxis(q, -1, 0)
-    return np.stack([
-        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
-        np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
-        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1),
-    ], axis=-2)
-
-
 def _table(result: Equilibrium) -> np.ndarray:
     """The per-station columns of :data:`COLUMNS`, shape (B..., N, 23)."""
-    rotvec, quat = _rotation_columns(result.rotations)
+    rotvec, quat = so3.log(result.rotations), so3.to_quaternion(result.rotations)
     s = np.broadcast_to(result.s, result.poses.shape[:-2])[..., None]
     return np.concatenate([s, result.positions, rotvec, quat, result.strains,
                            result.stresses], axis=-1)
@@ -1083,7 +1056,7 @@ def _read_csv(path: Path):
     positions = np.stack([columns[c] for c in ("x_m", "y_m", "z_m")], axis=-1)
     quat = np.stack([columns[c] for c in ("quat_w", "quat_x", "quat_y", "quat_z")], axis=-1)
     poses = np.zeros((*shape, 4, 4))
-    poses[..., :3, :3] = _quaternion_matrix(quat)
+    poses[..., :3, :3] = so3.from_quaternion(quat)
     poses[..., :3, 3] = positions
     poses[..., 3, 3] = 1.0
     sweep = None

@@ -21,6 +21,8 @@ FUNCTIONS = {
     "so3.jac_right_inv": (so3.jac_right_inv, "w", "w", (3,), (3, 3)),
     "so3.jac_left": (so3.jac_left, "w", "w", (3,), (3, 3)),
     "so3.jac_left_inv": (so3.jac_left_inv, "w", "w", (3,), (3, 3)),
+    "so3.to_quaternion": (so3.to_quaternion, "R", "rotation", (3, 3), (4,)),
+    "so3.from_quaternion": (so3.from_quaternion, "q", "quaternion", (4,), (3, 3)),
     "se3.hat": (se3.hat, "h", "h", (6,), (4, 4)),
     "se3.vee": (se3.vee, "X", "twist_matrix", (4, 4), (6,)),
     "se3.exp": (se3.exp, "h", "h", (6,), (4, 4)),
@@ -61,6 +63,7 @@ def make_input(kind, rng, batch) -> np.ndarray:
         "h": h,
         "twist_matrix": se3.hat(h),
         "pose": se3.exp(h),
+        "quaternion": so3.to_quaternion(so3.exp(w)),
     }[kind]
 
 

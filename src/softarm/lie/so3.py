@@ -20,12 +20,14 @@ from ._series import cosc, jinv, sinc, sinc3
 
 __all__ = [
     "exp",
+    "from_quaternion",
     "hat",
     "jac_left",
     "jac_left_inv",
     "jac_right",
     "jac_right_inv",
     "log",
+    "to_quaternion",
     "vee",
 ]
 
@@ -200,3 +202,55 @@ def jac_left(w):
 def jac_left_inv(w):
     """Inverse of :func:`jac_left`: I - ½ ω~ + (1/θ² - (1 + cos θ)/(2θ sin θ)) ω~²."""
     return _jac_inv(as_vectors(w, "w", 3), 1.0)
+
+
+def to_quaternion(R):
+    """Unit quaternion (w, x, y, z) of a rotation matrix, with w >= 0.
+
+    Scalar first, as in jaxlie and Sophus (scipy's ``Rotation.as_quat`` puts it last). Computed
+    from the rotation vector ω = log(R): (cos(θ/2), sin(θ/2) ω/θ), with sin(θ/2)/θ = ½ sinc(θ/2)
+    so that nothing divides by θ.
+
+    Parameters
+    ----------
+    R : array_like, shape (..., 3, 3)
+
+    Returns
+    -------
+    ndarray, shape (..., 4)
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> np.round(to_quaternion(exp([0.0, 0.0, np.pi / 2])), 12)
+    array([0.70710678, 0.        , 0.        , 0.70710678])
+    """
+    w = _log(as_matrices(R, "R", 3))
+    theta2 = np.einsum("...i,...i->...", w, w)
+    half_sinc = 0.5 * sinc(0.25 * theta2)  # sin(θ/2)/θ
+    return np.concatenate([np.cos(0.5 * np.sqrt(theta2))[..., None], half_sinc[..., None] * w],
+                          axis=-1)
+
+
+def from_quaternion(q):
+    """Rotation matrix of a quaternion (w, x, y, z) (normalised first).
+
+    Parameters
+    ----------
+    q : array_like, shape (..., 4)
+        Scalar first; any non-zero norm.
+
+    Returns
+    -------
+    ndarray, shape (..., 3, 3)
+    """
+    q = as_vectors(q, "q", 4)
+    norm = np.linalg.norm(q, axis=-1, keepdims=True)
+    if np.any(norm == 0):
+        raise ValueError("q must be non-zero quaternions (w, x, y, z), got a zero quaternion")
+    w, x, y, z = np.moveaxis(q / norm, -1, 0)
+    return np.stack([
+        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
+        np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
+        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1),
+    ], axis=-2)
