@@ -9,7 +9,8 @@ from pathlib import Path
 import numpy as np
 
 import softarm
-from softarm.io import load_case, save_result
+from softarm.case import load_case
+from softarm.io import save_result
 
 out = Path(sys.argv[1]) if len(sys.argv) > 1 else Path.cwd()
 

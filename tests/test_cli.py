@@ -12,7 +12,9 @@ import numpy as np
 import pytest
 
 import softarm
+import softarm.case
 from softarm import cli, io
+from softarm.case import load_case, solve_case
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 FIG2 = EXAMPLES / "fig2_pure_bending.toml"
@@ -37,8 +39,8 @@ def test_solve_summary_and_all_formats(tmp_path, capsys):
         assert word in stdout
     assert "exact" in stdout
     # the same numbers as a solve in memory
-    case = io.load_case(FIG2)
-    expected = io.solve_case(case)
+    case = load_case(FIG2)
+    expected = solve_case(case)
     for out in outs:
         assert f"wrote {out}" in stdout
         back = io.load_result(out)
@@ -163,7 +165,7 @@ def test_convergence_failure_exit_1(tmp_path, capsys, monkeypatch):
     def failing(*args, **kwargs):
         raise softarm.ConvergenceError("did not converge", 3.5e-2, "30 iterations")
 
-    monkeypatch.setattr(io, "_solver", lambda: failing)
+    monkeypatch.setattr(softarm.case, "_solver", lambda: failing)
     out = tmp_path / "out.csv"
     code, _, stderr = run(capsys, "solve", FIG2, "-o", out)
     assert code == 1
@@ -190,8 +192,8 @@ def test_long_sweep_is_solved_in_chunks_with_progress(monkeypatch):
     """A sweep whose first step is slow is solved in chunks; the result is one batch."""
     import time
 
-    case = io.load_case(SWEEP)
-    real = io._solver()
+    case = load_case(SWEEP)
+    real = softarm.case._solver()
     calls = []
 
     def slow(arm, loads, **kwargs):
@@ -200,7 +202,7 @@ def test_long_sweep_is_solved_in_chunks_with_progress(monkeypatch):
         return real(arm, loads, **kwargs)
 
     reports = []
-    result = io.solve_case(case, solve=slow, progress=lambda d, n: reports.append((d, n)))
+    result = solve_case(case, solve=slow, progress=lambda d, n: reports.append((d, n)))
     assert len(calls) > 2 and sum(int(np.prod(c)) for c in calls) == 5
     assert reports[-1] == (5, 5)
     assert result.batch_shape == (5,)

@@ -10,15 +10,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from softarm import io
+from softarm.case import load_case, solve_case
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 CASES = sorted(p.stem for p in EXAMPLES.glob("*.toml"))
 
 
 def solve(name: str):
-    case = io.load_case(EXAMPLES / f"{name}.toml")
-    return case, io.solve_case(case)
+    case = load_case(EXAMPLES / f"{name}.toml")
+    return case, solve_case(case)
 
 
 def test_the_examples_are_there():

@@ -5,10 +5,10 @@ they exist (:mod:`softarm.analytic`) and a geometrically exact solver for any lo
 """
 
 from . import analytic
+from .case import Case, CaseError, load_case
 from .dispatch import solve
 from .equilibrium import Equilibrium
 from .errors import ApproximationWarning, ConvergenceError
-from .io import Case, CaseError, load_case
 from .loads import DistributedForce, Gravity, PointLoad, TipLoad
 from .model import Arm, Circle, Material, Rectangle, Rigidities, Section, SegmentedArm, Tube
 

@@ -29,12 +29,12 @@ from pathlib import Path
 import numpy as np
 
 from . import __version__
+from .case import Case, CaseError, load_case, solve_case
 from .errors import ConvergenceError
-from .io import Case, CaseError, load_case, save_result, solve_case
+from .io import FORMATS, load_saved, save_result
 
 __all__ = ["main"]
 
-_RESULT_SUFFIXES = (".csv", ".json", ".npz")
 _PICTURE_SUFFIXES = (".png", ".pdf", ".svg")
 
 
@@ -197,7 +197,7 @@ def _solve(case: Case, args) -> tuple:
 
 
 def _run_solve(args) -> int:
-    outputs = [_check_output(o, _RESULT_SUFFIXES, "output") for o in args.output]
+    outputs = [_check_output(o, FORMATS, "output") for o in args.output]
     picture = _check_output(args.plot, _PICTURE_SUFFIXES, "picture") if args.plot else None
     case = load_case(args.case)
     result, seconds = _solve(case, args)
@@ -230,8 +230,6 @@ def _plot(case: Case, result, picture: Path) -> None:
 
 
 def _run_plot(args) -> int:
-    from .io import load_saved
-
     source = Path(args.result)
     picture = _check_output(args.output or str(source.with_suffix(".png")), _PICTURE_SUFFIXES,
                             "picture")

@@ -49,7 +49,7 @@ def _fmt(vector, unit: str) -> str:
 def describe_loads(loads, sweep=None) -> str:
     """One line describing the loads, e.g. ``"tip force (0, 0, -1) N + gravity"``.
 
-    A swept field is described by its range (``sweep`` as a :class:`softarm.io.Sweep`).
+    A swept field is described by its range (``sweep`` as a :class:`softarm.case.Sweep`).
     """
     from .loads import DistributedForce, Gravity, PointLoad, TipLoad, as_loads
 
@@ -255,7 +255,7 @@ def plot_sweep(result, values=None, *, label: str | None = None, fig=None,
         The parameter per step (default: ``sweep.values``, else 0, 1, 2, …).
     label : str, optional
         Colour-bar label with unit (default: ``sweep.label``).
-    sweep : softarm.io.Sweep, optional
+    sweep : softarm.case.Sweep, optional
         The case's sweep, for defaults and the title.
     fig, path, name, title
         As in :func:`plot_equilibrium`.
