@@ -4,6 +4,8 @@ Cosserat rods on SE(3) (Grazioso, Di Gironimo & Siciliano, RoboSoft 2018): close
 they exist (:mod:`softarm.analytic`) and a geometrically exact solver for any load.
 """
 
+__version__ = "0.1.0"  # first, so that submodules may import it
+
 from . import analytic
 from .case import Case, CaseError, load_case
 from .dispatch import solve
@@ -11,8 +13,6 @@ from .equilibrium import Equilibrium
 from .errors import ApproximationWarning, ConvergenceError
 from .loads import DistributedForce, Gravity, PointLoad, TipLoad
 from .model import Arm, Circle, Material, Rectangle, Rigidities, Section, SegmentedArm, Tube
-
-__version__ = "0.1.0"
 
 __all__ = [
     "ApproximationWarning",
