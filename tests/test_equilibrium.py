@@ -109,3 +109,44 @@ def test_mismatched_arrays_are_refused(name):
     fields[name] = fields[name][:-1]  # one station short
     with pytest.raises(ValueError, match=r"Equilibrium arrays disagree: s \(11,\)"):
         Equilibrium(**fields)
+
+
+def test_writable_inputs_are_copied_and_isolated():
+    fields = arc(0.7)
+    given = {name: fields[name] for name in ("s", "poses", "strains", "stresses")}
+    kept = {name: array.copy() for name, array in given.items()}
+    result = Equilibrium(**fields)
+    for name, array in given.items():
+        assert array.flags.writeable  # the caller's array is left writable
+        assert not np.shares_memory(getattr(result, name), array)
+        array[...] = -1.0  # later writes do not reach the result
+        assert np.array_equal(getattr(result, name), kept[name])
+
+
+def test_read_only_inputs_are_taken_without_copy():
+    fields = arc(0.7)
+    for name in ("s", "poses", "strains", "stresses"):
+        fields[name] = np.array(fields[name])  # owns its memory (linspace's s is a view)
+        fields[name].setflags(write=False)
+    # A constant field as a zero-stride read-only view of a frozen array.
+    row = np.array([[0.0, 0.0, 0.0, 0.0, 0.7, 0.0]])
+    row.setflags(write=False)
+    fields["strains"] = np.broadcast_to(row, (11, 6))
+    result = Equilibrium(**fields)
+    for name in ("s", "poses", "stresses"):
+        assert getattr(result, name) is fields[name]
+    assert result.strains is fields["strains"] and np.shares_memory(result.strains, row)
+
+
+def test_read_only_view_of_a_writable_array_is_copied():
+    fields = arc(0.7)
+    writable = fields["poses"]
+    fields["poses"] = writable.view()
+    fields["poses"].setflags(write=False)
+    fields["strains"] = fields["strains"].astype(np.float32)  # another dtype: converted
+    fields["strains"].setflags(write=False)
+    result = Equilibrium(**fields)
+    assert not np.shares_memory(result.poses, writable)
+    assert result.strains.dtype == np.float64 and not result.strains.flags.writeable
+    writable[0, 0, 3] = 99.0
+    assert result.poses[0, 0, 3] == 0.0

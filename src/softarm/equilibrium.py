@@ -9,7 +9,25 @@ import numpy as np
 __all__ = ["Equilibrium"]
 
 
+def _read_only_throughout(array: np.ndarray) -> bool:
+    """Neither ``array`` nor any array or buffer it views can be written through."""
+    base = array
+    while isinstance(base, np.ndarray):
+        if base.flags.writeable:
+            return False
+        base = base.base
+    if base is None:
+        return True
+    try:
+        return memoryview(base).readonly
+    except TypeError:  # an object that exposes no buffer: it cannot be checked
+        return False
+
+
 def _frozen(array) -> np.ndarray:
+    """``array`` itself if it is a read-only float64 ndarray throughout, else a frozen copy."""
+    if type(array) is np.ndarray and array.dtype == np.float64 and _read_only_throughout(array):
+        return array
     array = np.array(array, dtype=np.float64)
     array.setflags(write=False)
     return array
@@ -21,6 +39,17 @@ class Equilibrium:
 
     Arrays are read-only. With a batch of loads of batch shape B, every array gains the
     leading axes B; the station axis is the last batch axis.
+
+    Ownership: an array given as a read-only float64 ``numpy.ndarray`` that views no writable
+    memory (it and every array or buffer it is a view of are read-only) is taken as it is, with
+    no copy; any other input (a writable array, a read-only view of a writable one, another
+    dtype, a list, an ndarray subclass) is copied once and the copy frozen, so later writes to
+    the caller's array never reach the result. Producers (the closed forms, the solver) create
+    fresh arrays, make them read-only and hand them over without a copy; a field that is
+    constant along the arm may be a read-only ``np.broadcast_to`` view of a frozen (B..., 1, 6)
+    or (B..., 6) array, which costs no memory. Treat the arrays as read-only views: they may
+    share memory with each other (never with a writable caller's array) and may have zero
+    strides.
 
     Attributes
     ----------

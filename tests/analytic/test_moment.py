@@ -7,6 +7,7 @@ import pytest
 
 from softarm import ApproximationWarning, Arm, Circle, Material, SegmentedArm
 from softarm.analytic import linear, tip_moment
+from softarm.lie import se3, so3
 
 
 def _arm(GJ=1.0, EIy=1.0, EIz=1.0, curvature=(0.0, 0.0, 0.0), L=1.0):
@@ -138,3 +139,86 @@ def test_bad_inputs():
         tip_moment(SegmentedArm([arm, arm]), [0.0, 1.0, 0.0])
     with pytest.raises(TypeError, match="arm"):
         tip_moment("arm", [0.0, 1.0, 0.0])
+
+
+def _slow_helix(arm, moment, follower, s):
+    """NOTES.md note 4 by the generic maps: exp_SE3(s (e1; M/B)) · exp_SE3(s (0; c e1))."""
+    GJ, B = arm.rigidities.GJ, arm.rigidities.EIy
+    c = arm.curvature[0] + moment[..., 0] * (1.0 / GJ - 1.0 / B)
+    if follower:
+        moment = np.einsum("...ij,...j->...i", so3.exp(arm.length * c[..., None] * [1, 0, 0]),
+                           moment)
+    zeta = np.concatenate(np.broadcast_arrays([1.0, 0.0, 0.0], moment / B), axis=-1)
+    twist = np.zeros((*c.shape, s.size, 6))
+    twist[..., 3] = c[..., None] * s
+    return se3.exp(s[:, None] * zeta[..., None, :]) @ se3.exp(twist), moment
+
+
+def _moments(rng, shape):
+    """Random moments of all sizes, with zero, tiny and axis-aligned ones mixed in."""
+    m = rng.normal(size=(*shape, 3)) * 10.0 ** rng.uniform(-3, 0.7, size=(*shape, 1))
+    flat = m.reshape(-1, 3)
+    flat[0] = 0.0
+    flat[1] = [1e-300, 0.0, 0.0]
+    flat[2] = [0.0, 1e-9, 0.0]
+    flat[3] = [2e-12, -1e-12, 3e-12]
+    flat[4] = [0.0, 0.0, 2.5]
+    flat[5] = [1e-160, 1e-160, 0.0]
+    return m
+
+
+@pytest.mark.parametrize("follower", [False, True])
+def test_helix_fast_path_matches_generic_maps(follower, rng):
+    # The direct pose kernel against se3.exp / so3.exp evaluated the slow way (their series
+    # coefficients of _series.py), for a batch with zero, tiny and large moments.
+    arm = _arm(GJ=0.6, EIy=1.3, EIz=1.3, curvature=(0.4, 0.0, 0.0), L=0.9)
+    s = np.linspace(0.0, 0.9, 23)
+    moment = _moments(rng, (4, 10))
+    eq = tip_moment(arm, moment, follower=follower, s=s)
+    assert eq.method == "analytic.tip_moment.helix"
+    ref, M = _slow_helix(arm, moment, follower, s)
+    np.testing.assert_allclose(eq.poses, ref, rtol=0, atol=2e-15)
+    # strains from the rotations: m = Rᵀ M, ε = (0; m / (GJ, B, B))
+    m = np.einsum("...nji,...j->...ni", ref[..., :3, :3], M)
+    np.testing.assert_allclose(eq.stresses[..., 3:], m, rtol=0, atol=4e-14)
+    np.testing.assert_allclose(eq.strains[..., 3:], m / [0.6, 1.3, 1.3], rtol=0, atol=4e-14)
+    assert np.all(eq.stresses[..., :3] == 0.0) and np.all(eq.strains[..., :3] == 0.0)
+
+
+def test_principal_fast_path_matches_generic_maps(rng):
+    # Eqs. 30-34, H(s) = exp_SE3(s (f⁰ + ε)), against se3.exp for moments about the principal
+    # axes (and zero, tiny ones) on a twisted arm: exact for moments about e1 (parallel to κ⁰).
+    arm = _arm(GJ=0.5, EIy=1.0, EIz=2.0, curvature=(0.7, 0.0, 0.0), L=1.2)
+    s = np.linspace(0.0, 1.2, 17)
+    moment = np.zeros((30, 3))
+    moment[:, 0] = rng.normal(size=30) * 10.0 ** rng.uniform(-12, 0.5, size=30)
+    moment[:3, 0] = [0.0, 1e-300, -4e-9]
+    eq = tip_moment(arm, moment, s=s)
+    assert eq.method == "analytic.tip_moment.principal"
+    f = arm.reference_strain + np.concatenate([np.zeros_like(moment), moment / [0.5, 1, 2]], -1)
+    np.testing.assert_allclose(eq.poses, se3.exp(s[:, None] * f[:, None, :]), rtol=0,
+                               atol=2e-15)
+    straight = _arm(EIy=1.0, EIz=2.0, L=1.2)
+    for axis in (1, 2):
+        moment = np.zeros((30, 3))
+        moment[:, axis] = rng.normal(size=30) * 10.0 ** rng.uniform(-12, 0.7, size=30)
+        moment[:2, axis] = [0.0, 3e-200]
+        eq = tip_moment(straight, moment, s=s)
+        assert eq.exact
+        f = np.concatenate([np.broadcast_to([1.0, 0, 0], (30, 3)), moment / [1, 1, 2]], -1)
+        ref = se3.exp(s[:, None] * f[:, None, :])
+        np.testing.assert_allclose(eq.poses, ref, rtol=0, atol=2e-15)
+        np.testing.assert_allclose(eq.rotations, so3.exp(s[:, None] * f[:, None, 3:]), rtol=0,
+                                   atol=2e-15)
+        # constant strain: a read-only broadcast view, no memory per station
+        assert eq.strains.strides[-2] == 0 and not eq.strains.flags.writeable
+
+
+def test_results_are_read_only_and_not_copied():
+    eq = tip_moment(_arm(GJ=0.6), [[0.2, 0.5, -0.1], [0.0, 1.0, 0.3]])
+    for name in ("poses", "strains", "stresses"):
+        array = getattr(eq, name)
+        with pytest.raises(ValueError, match="read-only"):
+            array[..., 0] = 1.0
+    assert eq.poses.base is eq.strains.base is eq.stresses.base  # one buffer, written once
+    assert eq.poses.base.flags.owndata and not eq.poses.base.flags.writeable

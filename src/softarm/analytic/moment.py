@@ -8,17 +8,16 @@ import numpy as np
 
 from .._validate import stations
 from ..errors import ApproximationWarning
-from ..lie import se3, so3
 from ..loads import TipLoad
 from ._common import (
     E1,
     build,
     check_arm,
     check_follower,
-    constant_strain_poses,
     moment_is_principal,
     negligible,
     rotational_stiffness,
+    screw_poses,
     vectors,
 )
 
@@ -36,33 +35,45 @@ def helix_applies(arm) -> bool:
 
 
 def _helix(arm, moment, follower, s):
-    """Poses and strains of the exact pure-moment solution for EIy = EIz = B (note 4).
+    """Poses, strains and stresses of the exact pure-moment solution for EIy = EIz = B (note 4).
 
     With n = 0 the spatial moment M is constant. The material moment m = Rᵀ M gives the
     curvature κ⁰ + K⁻¹ m = m/B + c e1 with c = κ⁰₁ + M₁ (1/GJ - 1/B) constant (m₁' = 0), so
     R(s) = exp(s M/B) exp(s c e1) and p' = R e1 = exp(s M/B) e1:
-    H(s) = exp_SE3(s (e1; M/B)) · exp_SE3(s (0; c e1)).
+    H(s) = exp_SE3(s (e1; M/B)) · exp_SE3(s (0; c e1)). Since exp(s M/B) fixes M,
+    m(s) = exp(-s c e1) M = M + (1 - cos cs) (0, -M₂, -M₃) + sin(cs) (0, M₃, -M₂).
     """
-    k = rotational_stiffness(arm)
-    GJ, B = k[0], k[1]
+    k = np.diagonal(arm.stiffness)
+    GJ, B = k[3], k[4]
     c = arm.curvature[0] + moment[..., 0] * (1.0 / GJ - 1.0 / B)
     if follower:  # the tip material components g = R(L)ᵀ M = exp(-L c e1) M are given
-        moment = np.einsum("...ij,...j->...i", so3.exp(arm.length * c[..., None] * E1), moment)
-    sc = s * c[..., None]                                                   # (B..., N)
-    zeta = np.concatenate(np.broadcast_arrays(E1, moment / B), axis=-1)     # (B..., 6)
-    twist = np.concatenate(np.broadcast_arrays(np.zeros(3), sc[..., None] * E1), axis=-1)
-    poses = constant_strain_poses(zeta, s) @ se3.exp(twist)
-    m = np.einsum("...ji,...j->...i", poses[..., :3, :3], moment[..., None, :])
-    strains = np.concatenate(np.broadcast_arrays(np.zeros(3), m / k), axis=-1)
-    return poses, strains
+        cos, sin = np.cos(arm.length * c), np.sin(arm.length * c)
+        g2, g3 = moment[..., 1], moment[..., 2]
+        moment = np.stack([moment[..., 0], cos * g2 - sin * g3, sin * g2 + cos * g3], axis=-1)
+    # σ = (0; m) = Σ_y b_y(cs) rows y, b = (1, 1 - cos, sin); ε = K⁻¹ σ, in one buffer
+    fields = np.zeros((*moment.shape[:-1], 3, 12))
+    stress = fields[..., 6:]
+    stress[..., 0, 3:] = moment
+    stress[..., 1, 4:] = -moment[..., 1:]
+    stress[..., 2, 4] = moment[..., 2]
+    stress[..., 2, 5] = -moment[..., 1]
+    fields[..., :6] = stress / k
+    poses, extra = screw_poses(E1, moment / B, s, twist=c, fields=fields)
+    return poses, extra[..., :6], extra[..., 6:]
 
 
 def _constant_strain(arm, moment, s):
     """Eqs. 30-34: ε = K⁻¹ (0; moment), constant, and H(s) = exp_SE3(s (f⁰ + ε))."""
-    kappa = moment / rotational_stiffness(arm)
-    strain = np.concatenate(np.broadcast_arrays(np.zeros(3), kappa), axis=-1)
-    poses = constant_strain_poses(arm.reference_strain + strain, s)
-    return poses, np.broadcast_to(strain[..., None, :], (*strain.shape[:-1], s.size, 6))
+    k = np.diagonal(arm.stiffness)
+    kappa = moment / k[3:]
+    poses, _ = screw_poses(E1, np.asarray(arm.curvature) + kappa, s)
+    strain = np.zeros((*moment.shape[:-1], 1, 6))
+    strain[..., 0, 3:] = kappa
+    stress = strain * k
+    strain.setflags(write=False)  # frozen before the views, which the Equilibrium then keeps
+    stress.setflags(write=False)
+    shape = (*moment.shape[:-1], s.size, 6)
+    return poses, np.broadcast_to(strain, shape), np.broadcast_to(stress, shape)
 
 
 def tip_moment(arm, moment, follower=False, s=None):
@@ -145,9 +156,10 @@ def tip_moment(arm, moment, follower=False, s=None):
     s = stations(s, arm.length)
     loads = (TipLoad(moment=moment, follower=follower),)
     if helix_applies(arm):
-        poses, strains = _helix(arm, moment, follower, s)
-        return build(arm, s, poses, strains, loads, "analytic.tip_moment.helix", True)
-    poses, strains = _constant_strain(arm, moment, s)
+        poses, strains, stresses = _helix(arm, moment, follower, s)
+        return build(arm, s, poses, strains, loads, "analytic.tip_moment.helix", True,
+                     stresses=stresses)
+    poses, strains, stresses = _constant_strain(arm, moment, s)
     exact = bool(np.all(moment_is_principal(arm, moment)))
     if not exact:
         warnings.warn(
@@ -162,4 +174,4 @@ def tip_moment(arm, moment, follower=False, s=None):
         method = "analytic.tip_moment.constant_strain"
     else:
         method = "analytic.tip_moment.principal"
-    return build(arm, s, poses, strains, loads, method, exact)
+    return build(arm, s, poses, strains, loads, method, exact, stresses=stresses)
