@@ -106,18 +106,19 @@ def solve(arm, loads, *, method="auto", s=None, tol=1e-8, base=None, **options) 
     """
     if method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+    if method == "numeric":  # the solver validates everything itself, once
+        return solve_numeric(arm, loads, s=s, tol=tol, base=base, **options)
     loads = as_loads(loads)
     batch_shape(loads)
     H0 = check_base(base)
     check_tol(tol)
-    if method != "numeric":
-        stations(s, float(arm.length))  # validate before any route
-        result = _closed_form(arm, loads, s, H0)
-        if result is not None:
-            return result
-        if method == "analytic":
-            raise ValueError(
-                "method='analytic' but no exact closed form applies to this arm and these "
-                "loads; use method='auto' or 'numeric'"
-            )
+    stations(s, float(arm.length))  # validate before any route
+    result = _closed_form(arm, loads, s, H0)
+    if result is not None:
+        return result
+    if method == "analytic":
+        raise ValueError(
+            "method='analytic' but no exact closed form applies to this arm and these "
+            "loads; use method='auto' or 'numeric'"
+        )
     return solve_numeric(arm, loads, s=s, tol=tol, base=base, **options)

@@ -375,6 +375,50 @@ def test_batched_equals_looped(shape, rng):
         np.testing.assert_allclose(eq.stresses[index], one.stresses, atol=1e-10)
 
 
+def test_batch_of_every_load_kind_equals_looped(rng):
+    # Consecutive cases change every load kind at once (point loads, distributed force,
+    # gravity, dead and follower tip loads): each case starts from the previous one's
+    # first-order prediction, which must not change the answer.
+    arm, _ = general_case()
+    count = 4
+
+    def loads(index):
+        pick = slice(None) if index is None else index
+        return [Gravity(gravity[pick]), DistributedForce(dist[pick]),
+                PointLoad(0.1, force=point[pick], moment=[0.002, 0.0, 0.001]),
+                TipLoad(force=dead[pick], moment=[0.0, 0.001, 0.0]),
+                TipLoad(moment=follower[pick], follower=True)]
+
+    gravity = rng.normal(size=(count, 3)) * 5
+    dist = rng.normal(size=(count, 3)) * 0.05
+    point = rng.normal(size=(count, 3)) * 0.05
+    dead = rng.normal(size=(count, 3)) * 0.03
+    follower = rng.normal(size=(count, 3)) * 1e-3
+    batched = numeric(arm, loads(None), s=11, tol=1e-10)
+    for index in range(count):
+        one = numeric(arm, loads(index), s=11, tol=1e-10)
+        np.testing.assert_allclose(batched.poses[index], one.poses, atol=1e-10)
+        np.testing.assert_allclose(batched.stresses[index], one.stresses, atol=1e-10)
+
+
+def test_solver_object_follows_moving_point_loads():
+    # The warm start of a Solver survives a change of the cut of the arm (a point load that
+    # moves between calls): each answer equals a fresh solve.
+    arm = Arm(0.3, Circle(0.01), Material(1.0e6, poisson_ratio=0.5, density=1100.0))
+    solver = Solver(arm, s=7, tol=1e-10)
+    for station in (0.1, 0.2, 0.2, 0.3):
+        loads = [Gravity(), PointLoad(station, force=[0.0, 0.05, -0.02])]
+        np.testing.assert_allclose(solver.solve(loads).poses,
+                                   numeric(arm, loads, s=7, tol=1e-10).poses, atol=1e-10)
+
+
+def test_results_are_read_only():
+    arm = rigid_arm()
+    eq = numeric(arm, TipLoad(force=np.ones((2, 3))), s=3)
+    for array in (eq.s, eq.poses, eq.strains, eq.stresses, eq.residual, eq.error_estimate):
+        assert not array.flags.writeable
+
+
 def test_solver_object_reuses_the_previous_solution():
     arm = rigid_arm()
     solver = Solver(arm, s=2, tol=1e-10)

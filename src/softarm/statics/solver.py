@@ -7,6 +7,7 @@ whole batch at once, is :func:`softarm.statics._kernels.solve_cases`.
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -24,12 +25,14 @@ __all__ = ["METHOD", "Solver", "check_base", "check_tol", "solve_numeric"]
 METHOD = "numeric.shooting"
 
 _N_MAX = 1 << 15  # largest step count of the fine solution is 2 * _N_MAX / 2
+_IDENTITY = np.eye(4)
+_IDENTITY.setflags(write=False)
 
 
 def check_base(base) -> np.ndarray:
     """The base pose as a (4, 4) rigid transform, or ValueError naming ``base``."""
     if base is None:
-        return np.eye(4)
+        return _IDENTITY
     H = as_matrices(base, "base", 4)
     if H.shape != (4, 4):
         raise ValueError(f"base must be a single 4×4 rigid transform, got shape {H.shape}")
@@ -69,12 +72,74 @@ def _check_count(value, name: str, low: int) -> int:
     return int(value)
 
 
+class _ArmData:
+    """What the solver needs of an arm, computed once per arm (see :func:`_arm_data`).
+
+    The arrays go to the compiled kernel as they are: they are private and never written.
+    """
+
+    def __init__(self, arm):
+        segments = arm.segments
+        self.length = float(arm.length)
+        self.bounds = np.concatenate([[0.0], np.cumsum([seg.length for seg in segments])])
+        self.bounds[-1] = self.length
+        self.K = np.array([seg.stiffness for seg in segments], dtype=np.float64)
+        self.C = np.linalg.inv(self.K)
+        self.f0 = np.array([seg.reference_strain for seg in segments], dtype=np.float64)
+        mu = [seg.linear_density for seg in segments]
+        self.massless = any(m is None for m in mu)
+        self.mu = np.array([0.0 if m is None else m for m in mu], dtype=np.float64)
+        bending = float(np.max(self.K[:, [3, 4, 5], [3, 4, 5]]))
+        self.force_scale = bending / self.length**2
+        self.scale = np.array([self.force_scale] * 3 + [bending / self.length] * 3)
+        # the pieces without interior point loads: the segments themselves
+        self.pieces = self.cut(np.empty(0))
+
+    def cut(self, point_s):
+        """Cut the segments at interior point-load stations.
+
+        Returns (starts, lengths, C, f0, mu), one row per piece.
+        """
+        cuts = np.unique(np.concatenate([self.bounds, point_s]))
+        cuts = cuts[(cuts >= 0.0) & (cuts <= self.length)]
+        lengths = np.diff(cuts)
+        keep = lengths > 0.0
+        starts, lengths = cuts[:-1][keep], lengths[keep]
+        middle = starts + 0.5 * lengths
+        segment = np.clip(np.searchsorted(self.bounds, middle) - 1, 0, len(self.K) - 1)
+        return (starts, lengths, np.ascontiguousarray(self.C[segment]),
+                np.ascontiguousarray(self.f0[segment]), self.mu[segment])
+
+
+@functools.lru_cache(maxsize=64)
+def _cached_arm_data(arm) -> _ArmData:
+    return _ArmData(arm)
+
+
+def _arm_data(arm) -> _ArmData:
+    """The solver's data of ``arm``, cached per (equal) arm: arms are frozen dataclasses."""
+    try:
+        return _cached_arm_data(arm)
+    except TypeError:  # an unhashable field (never with the model's own types)
+        return _ArmData(arm)
+
+
+@functools.lru_cache(maxsize=64)
+def _uniform_stations(length: float, count: int):
+    """``count`` uniform stations on [0, L]: (read-only for results, private for the kernel)."""
+    s = np.linspace(0.0, length, count)
+    public = s.copy()
+    public.setflags(write=False)
+    return public, s
+
+
 class Solver:
     """A prepared problem: an arm, output stations, a tolerance and a base pose.
 
     Calling :meth:`solve` with a list of loads returns an :class:`~softarm.Equilibrium`. The
     arm-side preparation is done once, and each call starts from the previous call's solution
-    and step count: the fast path for control loops that solve the same arm many times.
+    and step count, corrected to first order for the change of the loads (the previous
+    Jacobian): the fast path for control loops that solve the same arm many times.
 
     Parameters
     ----------
@@ -119,10 +184,18 @@ class Solver:
                  continuation=True, max_step=4.0, steps=None, max_steps=_N_MAX,
                  max_shootings=2000):
         self.arm = _check_arm(arm)
-        self.length = float(arm.length)
-        self.s = stations(s, self.length)
+        self._data = _arm_data(arm)
+        self.length = self._data.length
+        if s is None or (isinstance(s, (int, np.integer)) and not isinstance(s, bool)
+                         and s >= 2):
+            self.s, self._s_kernel = _uniform_stations(self.length, 101 if s is None else int(s))
+        else:
+            self._s_kernel = stations(s, self.length)  # writable: one kernel type
+            self.s = self._s_kernel.copy()
+            self.s.setflags(write=False)
         self.tol = check_tol(tol)
         self.base = check_base(base)
+        self._base_kernel = self.base.copy()  # private and writable (one kernel type)
         self.max_iterations = _check_count(max_iterations, "max_iterations", 1)
         if not isinstance(continuation, (bool, np.bool_)):
             raise TypeError(f"continuation must be True or False, got {continuation!r}")
@@ -135,58 +208,39 @@ class Solver:
         self.steps = steps
         self.max_steps = _check_count(max_steps, "max_steps", 4)
         self.max_shootings = _check_count(max_shootings, "max_shootings", 1)
-        segments = arm.segments
-        self._bounds = np.concatenate([[0.0], np.cumsum([seg.length for seg in segments])])
-        self._bounds[-1] = self.length
-        self._K = np.array([seg.stiffness for seg in segments], dtype=np.float64)
-        self._C = np.linalg.inv(self._K)
-        self._f0 = np.array([seg.reference_strain for seg in segments], dtype=np.float64)
-        self._mu = [seg.linear_density for seg in segments]
-        bending = max(float(np.max(np.diag(K)[3:])) for K in self._K)
-        self._force_scale = bending / self.length**2
-        self._scale = np.array([self._force_scale] * 3 + [bending / self.length] * 3)
-        self._n = None  # step count and base wrench of the last solve (warm start)
-        self._x = np.zeros(6)
-        self._warm = False
-
-    def _pieces(self, point_s):
-        """Cut the segments at interior point-load stations: (starts, lengths, segment)."""
-        cuts = np.unique(np.concatenate([self._bounds, point_s]))
-        cuts = cuts[(cuts >= 0.0) & (cuts <= self.length)]
-        lengths = np.diff(cuts)
-        keep = lengths > 0.0
-        starts, lengths = cuts[:-1][keep], lengths[keep]
-        middle = starts + 0.5 * lengths
-        segment = np.clip(np.searchsorted(self._bounds, middle) - 1, 0, len(self._K) - 1)
-        return starts, lengths, segment
+        # warm start: step count, and what the last solved case left for the next one
+        self._n = None
+        self._memory = np.zeros(_kernels.MEMORY)
+        self._memory_level = np.zeros(1, dtype=np.int64)
+        self._piece_memory = None
+        self._piece_lengths = None
 
     def _prepare(self, loads):
         loads = as_loads(loads)
         shape = batch_shape(loads)
         count = math.prod(shape)
-
-        def flat(vector):
-            return np.broadcast_to(vector, (*shape, 3)).reshape(count, 3)
-
+        data = self._data
         tip_dead = np.zeros((count, 6))
         tip_fol = np.zeros((count, 6))
         gravity = np.zeros((count, 3))
         dist = np.zeros((count, 3))
+        # views with the batch shape: the loads broadcast into them (no broadcast copies)
+        dead_b, fol_b = tip_dead.reshape(*shape, 6), tip_fol.reshape(*shape, 6)
         points = []
         for load in loads:
             if isinstance(load, TipLoad):
-                target = tip_fol if load.follower else tip_dead
-                target[:, :3] += flat(load.force)
-                target[:, 3:] += flat(load.moment)
+                target = fol_b if load.follower else dead_b
+                target[..., :3] += load.force
+                target[..., 3:] += load.moment
             elif isinstance(load, Gravity):
-                if any(mu is None for mu in self._mu):
+                if data.massless:
                     raise ValueError(
                         "Gravity needs the arm's mass: give the material a density or the arm "
                         "a mass_per_length (Arm.linear_density is None)"
                     )
-                gravity += flat(load.acceleration)
+                gravity.reshape(*shape, 3)[...] += load.acceleration
             elif isinstance(load, DistributedForce):
-                dist += flat(load.force)
+                dist.reshape(*shape, 3)[...] += load.force
             elif isinstance(load, PointLoad):
                 if not 0.0 <= load.s <= self.length:
                     raise ValueError(
@@ -195,32 +249,19 @@ class Solver:
                     )
                 points.append(load)
         interior = [p.s for p in points if p.s < self.length]
-        starts, lengths, segment = self._pieces(np.array(interior, dtype=np.float64))
+        pieces = data.cut(np.array(interior, dtype=np.float64)) if interior else data.pieces
+        starts = pieces[0]
         jumps = np.zeros((count, starts.size, 6))
+        jumps_b = jumps.reshape(*shape, starts.size, 6)
         for point in points:
-            wrench = np.concatenate([flat(point.force), flat(point.moment)], axis=1)
             if point.s >= self.length:
-                tip_dead += wrench
+                dead_b[..., :3] += point.force
+                dead_b[..., 3:] += point.moment
             else:
-                j = int(np.searchsorted(starts, point.s, side="right") - 1)
-                jumps[:, max(j, 0)] += wrench
-        mu = np.array([0.0 if self._mu[k] is None else self._mu[k] for k in segment])
-        return loads, shape, count, (starts, lengths, segment, mu), (
-            gravity, dist, jumps, tip_dead, tip_fol)
-
-    def _initial_steps(self, lengths, segment, mu, gravity, dist, jumps, tip_dead, tip_fol):
-        """A first step count from an estimate of the total turning of the arm."""
-        L = self.length
-        bend = self._force_scale * L**2
-        kappa0 = float(np.sum(lengths * np.linalg.norm(self._f0[segment, 3:], axis=1)))
-        fd = np.max(np.linalg.norm(gravity, axis=1)) * max(mu.max(), 0.0) + np.max(
-            np.linalg.norm(dist, axis=1))
-        wrench = (np.max(np.linalg.norm(tip_dead[:, :3] + tip_fol[:, :3], axis=1)) * L**2 / 2
-                  + np.max(np.linalg.norm(tip_dead[:, 3:] + tip_fol[:, 3:], axis=1)) * L
-                  + np.max(np.abs(jumps)) * L**2 + fd * L**3 / 6) / bend
-        turning = kappa0 + wrench
-        return int(min(256, max(2, math.ceil(
-            0.1 * (1.0 + turning) * self.tol ** -0.25))))
+                j = max(int(np.searchsorted(starts, point.s, side="right") - 1), 0)
+                jumps_b[..., j, :3] += point.force
+                jumps_b[..., j, 3:] += point.moment
+        return loads, shape, count, pieces, (gravity, dist, jumps, tip_dead, tip_fol)
 
     def solve(self, loads) -> Equilibrium:
         """The equilibrium under ``loads`` (a load or a list of loads, possibly batched).
@@ -232,24 +273,19 @@ class Solver:
         ValueError
             For loads that do not fit the arm (point load off the arm, gravity without mass).
         """
-        loads, shape, count, pieces, data = self._prepare(loads)
-        _, lengths, segment, mu = pieces
-        gravity, dist, jumps, tip_dead, tip_fol = data
+        loads, shape, count, pieces, (gravity, dist, jumps, tip_dead, tip_fol) = \
+            self._prepare(loads)
+        _, lengths, piece_C, piece_f0, piece_mu = pieces
         if self.steps is not None:
-            n_initial, tol = self.steps // 2, np.inf
-        else:
-            n_initial = min(self._n or self._initial_steps(lengths, segment, mu, *data),
-                            self.max_steps // 2)
+            n_initial, tol = self.steps // 2, math.inf
+        else:  # 0: the kernel estimates it from the loads
+            n_initial = min(self._n, self.max_steps // 2) if self._n else 0
             tol = self.tol * self.length
-        load_scale = max(
-            np.max(np.abs(tip_dead[:, :3]) + np.abs(tip_fol[:, :3])) / self._force_scale,
-            np.max(np.abs(tip_dead[:, 3:]) + np.abs(tip_fol[:, 3:])) / self._scale[3],
-            np.max(np.abs(jumps)) / self._force_scale,
-            (np.max(np.abs(gravity)) * mu.max() + np.max(np.abs(dist))) * self.length
-            / self._force_scale,
-            1.0,
-        ) if count else 1.0
-        threshold = 1e-12 * load_scale
+        if self._piece_lengths is None or not np.array_equal(self._piece_lengths, lengths):
+            # a different cut of the arm (point loads moved): keep only the base wrench
+            self._piece_memory = np.zeros((lengths.size, _kernels.PIECE_MEMORY))
+            self._piece_lengths = lengths
+            self._memory_level[0] = min(self._memory_level[0], 1)
         S = self.s.size
         poses = np.empty((count, S, 4, 4))
         strains = np.empty((count, S, 6))
@@ -259,15 +295,16 @@ class Solver:
         status = np.empty(count, dtype=np.int64)
         work = np.zeros((count, 2), dtype=np.int64)
         _kernels.solve_cases(
-            self.base, self.length, lengths, self._C[segment], self._f0[segment], mu,
-            gravity, dist, jumps, tip_dead, tip_fol, self.s, self._scale, threshold,
-            tol, self.max_iterations, self.continuation, self.max_step,
-            n_initial, max(self.max_steps, 2 * n_initial), self.max_shootings, self._x,
-            self._warm, poses, strains, stresses, residual,
+            self._base_kernel, self.length, lengths, piece_C, piece_f0, piece_mu, gravity,
+            dist, jumps, tip_dead, tip_fol, self._s_kernel, self._data.scale, tol,
+            self.max_iterations, self.continuation, self.max_step, n_initial,
+            max(self.max_steps, 2 * n_initial), self.max_shootings, self._memory,
+            self._piece_memory, self._memory_level, poses, strains, stresses, residual,
             estimate, status, work)
         failed = np.flatnonzero(status != _kernels.OK)
         if failed.size:
-            self._n, self._warm = None, False
+            self._n = None
+            self._memory_level[0] = 0
             b = int(failed[0])
             where = f" for load case {np.unravel_index(b, shape)}" if shape else ""
             if status[b] == _kernels.TOO_MANY_STEPS:
@@ -286,7 +323,10 @@ class Solver:
                 + f", {2 * int(work[b, 1])} RK4 steps",
             )
         self._n = int(work[-1, 1]) if count else None
-        self._warm = count > 0
+        # fresh arrays, frozen before reshaping (the views are read-only throughout):
+        # Equilibrium takes them as they are, with no copy
+        for array in (poses, strains, stresses, residual, estimate):
+            array.setflags(write=False)
         out_shape = (*shape, S)
         return Equilibrium(
             s=self.s,
