@@ -8,7 +8,8 @@ equilibrium on the fundamental (stable, no interior inflection point) branch:
 * inextensible and unshearable (Euler elastica): fully closed form;
 * extensible and shearable (planar Reissner rod, linear law N = EA ε, Q = GA γ, M = EI θ'):
   closed form for the angle, the curvature and the position across the force line, one
-  Gauss-Legendre quadrature in arc length for the position along the force line.
+  Clenshaw-Curtis (Chebyshev) cumulative quadrature in arc length for the position along the
+  force line.
 
 Derivation (the notation of the code)
 -------------------------------------
@@ -29,19 +30,23 @@ Hamiltonian, conserved because the load is dead) is
 
     θ'² = 4 k (p² − w²) f(w²),   p = cos(δ_L/2),   f(y) = 1 − e (sin²(δ_L/2) − y),
 
-a quartic in w: s(θ) is an elliptic integral of the first kind. In Carlson's symmetric form
-(DLMF 19.29.4 with the four linear factors y, 1 − y, p² − y, f(y) of y = w²) the arc length from a
-station with angle d to the tip is
+a quartic in w: s(θ) is an elliptic integral of the first kind. Parametrise every station by
+χ through tan(d/2) = tan(δ_L/2)/cos χ (χ = 0 at the tip). Then cos²(d/2) = m cos²χ/(1 − m sin²χ)
+with m = p², f(w²) (1 − m sin²χ) = f_L (1 − m' sin²χ) and ds = −dχ/(√(k f_L) (1 − m' sin²χ)^½),
 
-    √k (1 − s) = sqrt(sin((d−δ_L)/2) sin((d+δ_L)/2))
-                 · R_F(p² m1 f(cos²(d/2)), cos²(d/2) m1 f_L, p² sin²(d/2) f_L),
+    m' = m (1 + e m)/f_L,   1 − m' = m1 (1 − e m1)/f_L,   m1 = sin²(δ_L/2) = 1 − m,
+    f_L = f(p²) = 1 + e cos δ_L,
 
-m1 = sin²(δ_L/2) = 1 − p², f_L = f(p²) = 1 + e cos δ_L. The tip condition is this relation at
-the clamp (d = a, s = 0); it fixes δ_L. For e = 0 it is Legendre's F(χ | m) = √k with m = p² and
-tan(δ_L/2) = tan(a/2) cos χ, the classical form of Frisch-Fay (1962) ch. 2 and Bisshopp &
-Drucker (1945): for φ = π/2, sqrt(k) = K(p) − F(ψ0, p) with sin ψ0 = 1/(√2 p). Every station
-uses the same parametrisation: tan(d/2) = tan(δ_L/2)/cos χ_s with √k (1 − s) = F(χ_s | m)
-(the Jacobi amplitude am of the arc length measured from the tip when e = 0).
+so that the arc length from a station to the tip is Legendre's integral of the first kind
+
+    √(k f_L) (1 − s) = F(χ_s | m') = sin χ_s R_F(cos²χ_s, 1 − m' sin²χ_s, 1)   (DLMF §19.25),
+
+(0 ≤ m' ≤ 1 because |e| < 1): χ_s = am(√(k f_L)(1 − s) | m'), Jacobi's amplitude. This is the
+Carlson form of DLMF 19.29.4 for the four linear factors y, 1 − y, p² − y, f(y) of y = w². The
+tip condition is this relation at the clamp (d = a, s = 0, χ = χ_0 with tan(δ_L/2) = tan(a/2)
+cos χ_0); it fixes δ_L. For e = 0 it is F(χ_0 | m) = √k with m = p², the classical form of
+Frisch-Fay (1962) ch. 2 and Bisshopp & Drucker (1945): for φ = π/2, sqrt(k) = K(p) − F(ψ0, p)
+with sin ψ0 = 1/(√2 p).
 
 Positions, in the force frame e_F = (cos a, sin a), e_⊥ = (−sin a, cos a):
 
@@ -51,13 +56,21 @@ Positions, in the force frame e_F = (cos a, sin a), e_⊥ = (−sin a, cos a):
   cos δ = cos δ_L − θ'²/(2k), and ∫ θ'² ds = 4 √k m m1 [J(χ) − J(χ_s)] with
   J(χ) = ∫_0^χ sin²t (1 − m sin²t)^(−3/2) dt = (1/3) sin³χ R_D(cos²χ, 1, 1 − m sin²χ)
   (m m1 ∫ sd² du, Byrd & Friedman 316.02 in Carlson form); so
-  ξ(s) = s (cos δ_L + k a_r) − (2/√k) m m1 [J(χ) − J(χ_s)]. For e ≠ 0 the same integrand is
-  integrated over s by Gauss-Legendre quadrature at nodes where δ is known in closed form.
+  ξ(s) = s (cos δ_L + k a_r) − (2/√k) m m1 [J(χ) − J(χ_s)]. For e ≠ 0 the same integrand needs
+  elliptic integrals of the third kind whose reduction divides by m' − m ∝ e (cancellation for
+  the common e ≪ 1); it is instead integrated in s by the Chebyshev (Clenshaw-Curtis) cumulative
+  rule at Chebyshev points of [0, 1], where δ is known in closed form.
 
-The unknowns are solved by bisection on ρ = log tan χ (sin χ and cos χ both keep full relative
-precision, for loads from k ~ 1e-300 to strongly aligned tension), to the last bit of ρ. All
-half-angle differences are written as products of sines so that small loads keep full relative
-precision (no 1 − cos cancellation).
+The unknowns are solved in ρ = log tan χ (sin χ and cos χ both keep full relative precision, for
+loads from k ~ 1e-300 to strongly aligned tension) by Newton's method with the analytic slope,
+safeguarded by a bracket (a bisection step whenever Newton would leave it), to a step of a few
+ulps of ρ. The slope of the station relation is dF/dρ = sin χ cos χ/(1 − m' sin²χ)^½; the tip
+condition also moves m' with χ_0, with ∂F/∂m' = J(χ | m')/2 and dm/dρ = 2 m m1 sin²χ_0. The
+stations start from scipy's am(u | m') (``ellipj``), and converge in one or two steps; the tip
+starts from the lower bound tan χ_0 ≥ sinh(√(k (1 − |e|))) (from F(χ | m') ≤ F(χ | 1) =
+asinh tan χ), exact for strongly aligned loads and for small ones. All half-angle differences
+are written as products of sines so that small loads keep full relative precision (no 1 − cos
+cancellation).
 
 References
 ----------
@@ -78,7 +91,8 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
-from scipy.special import elliprd, elliprf, roots_legendre
+from scipy.fft import dct
+from scipy.special import ellipj, elliprd, elliprf
 
 __all__ = ["ElasticaSolution", "planar_elastica"]
 
@@ -88,10 +102,12 @@ _RHO_MAX = 700.0
 K_MAX = 1.0e5
 #: Below this angle from axial tension (rad) the linearised tension solution is exact to 1e-17.
 _A_LINEAR = 1.0e-8
-#: Gauss-Legendre nodes per station for the shearable position quadrature, before √k scaling.
-_N_QUAD = 48
-#: Extra nodes per unit of √k (the clamp boundary layer has width ~ L/√k).
-_N_QUAD_PER_ROOT_K = 2
+#: Chebyshev points on [0, 1] for the shearable position quadrature, before √k scaling.
+_N_CHEB = 64
+#: Extra points per unit of √k (the clamp boundary layer has width ~ L/√k).
+_N_CHEB_PER_ROOT_K = 4
+#: Newton steps before giving up (bisection alone needs ~60 to resolve ρ ∈ ±700 to an ulp).
+_MAX_STEPS = 100
 
 
 class ElasticaSolution(NamedTuple):
@@ -115,10 +131,16 @@ class ElasticaSolution(NamedTuple):
 def _sin_cos_from_rho(rho):
     """(sin χ, cos χ) for tan χ = exp(ρ), both with full relative precision."""
     t = np.exp(-np.abs(rho))
-    small = t / np.sqrt(1.0 + t * t)
     big = 1.0 / np.sqrt(1.0 + t * t)
+    small = t * big
     positive = rho >= 0.0
     return np.where(positive, big, small), np.where(positive, small, big)
+
+
+def _tip_half_angle(ca, sa, c_chi):
+    """sin and cos of δ_L/2 from tan(δ_L/2) = tan(a/2) cos χ."""
+    h = np.hypot(ca, sa * c_chi)
+    return sa * c_chi / h, ca / h
 
 
 def _tip_geometry(ca, sa, s_chi, c_chi):
@@ -126,11 +148,16 @@ def _tip_geometry(ca, sa, s_chi, c_chi):
 
     tan(δ_L/2) = tan(a/2) cos χ; θ_L = a − δ_L written without cancellation.
     """
-    h = np.hypot(ca, sa * c_chi)
-    s_dl, c_dl = sa * c_chi / h, ca / h  # sin, cos of δ_L/2
+    s_dl, c_dl = _tip_half_angle(ca, sa, c_chi)
     # tan(θ_L/2) = sa ca (1 − cos χ) / (ca² + sa² cos χ), 1 − cos χ = sin²χ/(1 + cos χ)
     half_tip = np.arctan2(sa * ca * s_chi * s_chi / (1.0 + c_chi), ca * ca + sa * sa * c_chi)
     return s_dl, c_dl, half_tip
+
+
+def _station_half_angle(s_dl, c_dl, c_chs):
+    """sin and cos of d/2 at a station, tan(d/2) = tan(δ_L/2)/cos χ_s."""
+    h = np.hypot(s_dl, c_dl * c_chs)
+    return s_dl / h, c_dl * c_chs / h
 
 
 def _station_geometry(s_dl, c_dl, s_chs, c_chs):
@@ -138,8 +165,7 @@ def _station_geometry(s_dl, c_dl, s_chs, c_chs):
 
     Returns sin(d/2), cos(d/2) and the product sin((d−δ_L)/2) sin((d+δ_L)/2) = p² − cos²(d/2).
     """
-    h = np.hypot(s_dl, c_dl * c_chs)
-    s_d, c_d = s_dl / h, c_dl * c_chs / h
+    s_d, c_d = _station_half_angle(s_dl, c_dl, c_chs)
     half_diff = np.arctan2(
         s_dl * c_dl * s_chs * s_chs / (1.0 + c_chs), c_dl * c_dl * c_chs + s_dl * s_dl
     )
@@ -147,14 +173,20 @@ def _station_geometry(s_dl, c_dl, s_chs, c_chs):
     return s_d, c_d, np.sin(half_diff) * np.sin(half_sum)
 
 
-def _arc_to_tip(s_d, c_d, prod, s_dl, c_dl, e):
-    """√k (1 − s) at a station of half-angle d/2 (Carlson form of the quartic first integral)."""
-    m, m1 = c_dl * c_dl, s_dl * s_dl
-    f_d = 1.0 - e * (m1 - c_d * c_d)
-    f_l = 1.0 + e * (m - m1)
-    rf = elliprf(m * m1 * f_d, c_d * c_d * m1 * f_l, m * s_d * s_d * f_l)
-    # prod = 0 (station at the tip) with m1 = 0 would be 0·inf: the arc length is then 0.
-    return np.where(prod > 0.0, np.sqrt(np.maximum(prod, 0.0)) * rf, 0.0)
+def _modulus(s_dl, c_dl, e):
+    """f_L = 1 + e cos δ_L and the complementary parameter 1 − m' = m1 (1 − e m1)/f_L."""
+    m1 = s_dl * s_dl
+    f_l = 1.0 + e * (c_dl - s_dl) * (c_dl + s_dl)
+    return f_l, m1 * (1.0 - e * m1) / f_l
+
+
+def _legendre_f(s_ch, c_ch, mc):
+    """F(χ | m) = sin χ R_F(cos²χ, Δ², 1), Δ² = 1 − m sin²χ, from mc = 1 − m (DLMF §19.25).
+
+    Returns F and Δ² (written as cos²χ + mc sin²χ, without cancellation).
+    """
+    delta2 = c_ch * c_ch + mc * s_ch * s_ch
+    return s_ch * elliprf(c_ch * c_ch, delta2, 1.0), delta2
 
 
 def _curvature(prod, c_d, s_dl, sqrt_k, e):
@@ -163,33 +195,101 @@ def _curvature(prod, c_d, s_dl, sqrt_k, e):
     return 2.0 * sqrt_k * np.sqrt(np.maximum(prod, 0.0) * f_d)
 
 
-def _bisect(residual, lo, hi):
-    """Root of an increasing ``residual`` in [lo, hi], elementwise, to the last bit of ρ."""
-    eps = np.finfo(np.float64).eps
-    for _ in range(200):
-        mid = 0.5 * (lo + hi)
-        below = residual(mid) < 0.0
-        lo = np.where(below, mid, lo)
-        hi = np.where(below, hi, mid)
-        if np.all(hi - lo <= 4.0 * eps * np.maximum(1.0, np.maximum(np.abs(lo), np.abs(hi)))):
-            break
-    return 0.5 * (lo + hi)
+def _newton(residual_and_slope, x, lo, hi, curvature=None):
+    """Root of an increasing function in [lo, hi], elementwise, to a few ulps of x.
+
+    Newton's method safeguarded by the bracket: every evaluation shrinks [lo, hi], and a Newton
+    step that would leave it (non-positive or non-finite slope included) becomes a bisection
+    step. An element stops after a Newton step δ below 4 ulps of max(1, |x|), or, given
+    ``curvature`` ≥ |R''/R'| on the bracket, after one whose quadratic error bound
+    (curvature/2) δ² is that small; or once its bracket is that narrow. Returns the root and
+    the number of evaluations (the batch runs in lock step; converged elements stay put).
+    """
+    tol = 4.0 * np.finfo(np.float64).eps
+    done = np.zeros(np.shape(x), dtype=bool)
+    count = 0
+    # Guarded below: an overflowing residual or a 0/0 slope (cos²χ underflows near ρ = ±700)
+    # only turns its Newton step into a bisection step.
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore", under="ignore"):
+        while count < _MAX_STEPS and not done.all():
+            count += 1
+            residual, slope = residual_and_slope(x)
+            below = residual < 0.0
+            lo = np.where(below, x, lo)
+            hi = np.where(below, hi, x)
+            step = residual / slope
+            newton = x - step
+            size, scale = np.abs(step), tol * np.maximum(1.0, np.abs(x))
+            last = size <= scale
+            if curvature is not None:
+                last |= 0.5 * curvature * size * size <= scale
+            take = last | (newton > lo) & (newton < hi)
+            x = np.where(done, x, np.where(take, newton, 0.5 * (lo + hi)))
+            done |= last | (hi - lo <= scale)
+    return x, count
 
 
 def _solve_stations(s, sqrt_k, rho_tip, s_dl, c_dl, e):
-    """(sin χ_s, cos χ_s) with arc-to-tip(χ_s) = √k (1 − s); exact at s = 0 and s = 1."""
+    """(sin χ_s, cos χ_s) with F(χ_s | m') = √(k f_L) (1 − s); exact at s = 0 and s = 1.
+
+    Starts from Jacobi's amplitude am(√(k f_L)(1 − s) | m') (scipy ``ellipj``, accurate to a few
+    ulps) and polishes it by Newton in ρ = log tan χ_s, bracketed by [−700, ρ_tip]: usually one
+    step. In ρ the residual R = F − √(k f_L)(1 − s) has R' = sin χ cos χ/Δ' > 0 and
+    d log R'/dρ = cos 2χ + m' sin²χ cos²χ/Δ'² ∈ [−1, 2] (Δ'² ≥ cos²χ), so |R''/R'| ≤ 2 bounds
+    the error a Newton step leaves. Returns the number of evaluations too.
+    """
     shape = np.broadcast_shapes(np.shape(s), np.shape(rho_tip))
+    f_l, mc = _modulus(s_dl, c_dl, e)
+    target = np.broadcast_to(sqrt_k * np.sqrt(f_l) * (1.0 - s), shape)
 
-    def residual(rho):
+    def residual_and_slope(rho):
         s_ch, c_ch = _sin_cos_from_rho(rho)
-        s_d, c_d, prod = _station_geometry(s_dl, c_dl, s_ch, c_ch)
-        return _arc_to_tip(s_d, c_d, prod, s_dl, c_dl, e) - sqrt_k * (1.0 - s)
+        arc, delta2 = _legendre_f(s_ch, c_ch, mc)
+        return arc - target, s_ch * c_ch / np.sqrt(delta2)
 
-    rho = _bisect(residual, np.full(shape, -_RHO_MAX), np.broadcast_to(rho_tip, shape))
+    lo, hi = np.full(shape, -_RHO_MAX), np.broadcast_to(rho_tip, shape)
+    sn, cn, _, _ = ellipj(target, np.broadcast_to(1.0 - mc, shape))
+    # cn = cos χ_s is only accurate to ~1e-16 absolute. Near χ = π/2 (there mc ≪ 1 too), the
+    # leading term of R_F(x, y, z) for x, y ≪ z, F = log(4/(c + (c² + mc)^½)) + O(c² log c),
+    # inverts to c = 2 e^(−u) − mc e^u/8: the better start once c³ < ulp (errors c² vs ulp/c).
+    asymptotic = 2.0 * np.exp(-target) - mc * np.exp(target) / 8.0
+    use_asymptotic = (asymptotic > 0.0) & (asymptotic**3 < np.finfo(np.float64).eps)
+    with np.errstate(divide="ignore", invalid="ignore"):  # sn = 0 at the tip, cn ≤ 0 by rounding
+        start = np.where(use_asymptotic, -np.log(asymptotic), np.log(sn) - np.log(cn))
+    start = np.where(start > lo, start, lo)  # NaN goes to a bracket end as well
+    start = np.where((start < hi) & (s > 0.0), start, hi)  # s = 0: the clamp, χ_s = χ_0
+    rho, count = _newton(residual_and_slope, start, lo, hi, curvature=2.0)
     rho = np.where(s == 0.0, rho_tip, rho)
     s_ch, c_ch = _sin_cos_from_rho(rho)
     at_tip = s == 1.0
-    return np.where(at_tip, 0.0, s_ch), np.where(at_tip, 1.0, c_ch), rho
+    return np.where(at_tip, 0.0, s_ch), np.where(at_tip, 1.0, c_ch), count
+
+
+def _solve_tip(ca, sa, sqrt_k, e):
+    """ρ_0 = log tan χ_0 of the tip condition F(χ_0 | m'(χ_0)) = √(k f_L(χ_0)), and the count.
+
+    The residual F/√f_L − √k increases with ρ_0; its slope carries the motion of m' and f_L
+    through m = cos²(δ_L/2): dm/dρ = 2 m m1 sin²χ, df_L/dm = 2e, dm'/dm = (1 − 2e² m m1/f_L)/f_L
+    and ∂F/∂m' = J(χ | m')/2 = sin³χ R_D(cos²χ, 1, Δ'²)/6, J as in ``_j_integral``.
+    """
+
+    def residual_and_slope(rho):
+        s_ch, c_ch = _sin_cos_from_rho(rho)
+        s_dl, c_dl = _tip_half_angle(ca, sa, c_ch)
+        f_l, mc = _modulus(s_dl, c_dl, e)
+        arc, delta2 = _legendre_f(s_ch, c_ch, mc)
+        mm1 = (s_dl * c_dl) ** 2  # m m1
+        dm_f = 2.0 * mm1 * s_ch * s_ch / f_l  # (dm/dρ)/f_L; dm'/dρ = dm_f (1 − 2 e² m m1/f_L)
+        half_j = s_ch**3 * elliprd(c_ch * c_ch, 1.0, delta2) / 6.0
+        slope = s_ch * c_ch / np.sqrt(delta2) + dm_f * (
+            half_j * (1.0 - 2.0 * e * e * mm1 / f_l) - e * arc
+        )
+        root_f = np.sqrt(f_l)
+        return arc / root_f - sqrt_k, slope / root_f
+
+    shape = np.shape(sqrt_k)
+    start = np.log(np.sinh(sqrt_k * np.sqrt(1.0 - np.abs(e))))
+    return _newton(residual_and_slope, start, np.full(shape, -_RHO_MAX), np.full(shape, _RHO_MAX))
 
 
 def _j_integral(s_ch, c_ch, m1):
@@ -255,13 +355,15 @@ def planar_elastica(k, phi, s_over_L, *, axial_ratio=None, shear_ratio=None):
     carries an imperfection of 1.2e-16 rad, which within ~1e-5 of k = π²/4 shows as a deflection
     of order (1e-16)^(1/3) L, as it physically should.
 
-    Accuracy: the unknowns are solved to the last bit; angles and positions are accurate to a
-    few units of 1e-15 (absolute, in rad and L), angles keep full relative precision for small
-    loads. The inextensible case is closed form throughout; with shear or extension the position
-    along the force line is a Gauss-Legendre quadrature (48 + 2 ⌈√k⌉ nodes per station) of a
-    smooth integrand, the rest closed form. Within 1e-8 rad of axial tension the problem is
-    linear in that angle to relative 1e-17 and the beam-column closed form is used instead
-    (the elliptic route would underflow there).
+    Accuracy: the unknowns are solved by safeguarded Newton steps to a few ulps; angles and
+    positions are accurate to a few units of 1e-15 (absolute, in rad and L), angles keep full
+    relative precision for small loads. The inextensible case is closed form throughout; with
+    shear or extension the position along the force line is a Clenshaw-Curtis cumulative
+    quadrature (64 + 4 ⌈√k⌉ Chebyshev points on [0, L]) of a smooth integrand, the rest closed
+    form. Beyond k f_L ≈ 1.2e5 cos²χ_0 ~ e^(−2√(k f_L)) would underflow and the boundary layer at
+    the clamp lose accuracy, so k (1 + |e|) ≤ ``K_MAX`` is required (ValueError). Within 1e-8
+    rad of axial tension the problem is linear in that angle to relative 1e-17 and the
+    beam-column closed form is used instead (the elliptic route would underflow there).
 
     References
     ----------
@@ -293,6 +395,14 @@ def planar_elastica(k, phi, s_over_L, *, axial_ratio=None, shear_ratio=None):
         )
     k, phi, a_r, g_r = np.broadcast_arrays(k, phi, a_r, g_r)
     e = k * (a_r - g_r)
+    if np.any(k * (1.0 + np.abs(e)) > K_MAX):
+        # beyond k f_L ≈ 1.2e5, cos²χ_0 ~ exp(-2√(k f_L)) underflows and the clamp's boundary
+        # layer loses accuracy (checked against mpmath): refuse rather than be silently wrong
+        raise ValueError(
+            f"need k (1 + |k (axial_ratio - shear_ratio)|) <= {K_MAX:g}, got k up to "
+            f"{float(np.max(k))!r} with k (axial_ratio - shear_ratio) up to "
+            f"{float(np.max(np.abs(e)))!r}"
+        )
     if np.any(k * a_r >= 1.0) or np.any(np.abs(e) >= 1.0):
         raise ValueError(
             "need P/EA = k*axial_ratio < 1 and |k*(axial_ratio - shear_ratio)| < 1, got "
@@ -313,20 +423,24 @@ def planar_elastica(k, phi, s_over_L, *, axial_ratio=None, shear_ratio=None):
     ca, sa = np.cos(0.5 * a_safe), np.sin(0.5 * a_safe)
 
     # Tip condition: arc length from the clamp (d = a) to the tip equals √k.
-    def tip_residual(rho):
-        s_ch, c_ch = _sin_cos_from_rho(rho)
-        s_dl, c_dl, half_tip = _tip_geometry(ca, sa, s_ch, c_ch)
-        prod = np.sin(half_tip) * np.sin(a_safe - half_tip)
-        return _arc_to_tip(sa, ca, prod, s_dl, c_dl, e) - sqrt_k
-
-    rho_tip = _bisect(tip_residual, np.full(k.shape, -_RHO_MAX), np.full(k.shape, _RHO_MAX))
+    rho_tip, _ = _solve_tip(ca, sa, sqrt_k, e)
     s_chi, c_chi = _sin_cos_from_rho(rho_tip)
     s_dl, c_dl, half_tip = _tip_geometry(ca, sa, s_chi, c_chi)
     prod0 = np.sin(half_tip) * np.sin(a_safe - half_tip)
 
-    # Stations (batch axis B..., station axis last).
+    # Stations (batch axis B..., station axis last), with the Chebyshev points of the position
+    # quadrature when it is needed (one solve for both).
     ex = (..., None)
-    s_chs, c_chs, _ = _solve_stations(s, sqrt_k[ex], rho_tip[ex], s_dl[ex], c_dl[ex], e[ex])
+    quadrature = not np.all(e == 0.0)
+    n_cheb = _N_CHEB + _N_CHEB_PER_ROOT_K * int(np.ceil(np.max(sqrt_k))) if quadrature else 0
+    s_all = np.concatenate([s, _chebyshev_points(n_cheb)]) if quadrature else s
+    s_chs, c_chs, _ = _solve_stations(s_all, sqrt_k[ex], rho_tip[ex], s_dl[ex], c_dl[ex], e[ex])
+    if quadrature:
+        ka = (k * a_r)[ex]
+        s_dn, c_dn = _station_half_angle(s_dl[ex], c_dl[ex], c_chs[..., s.size :])
+        integrand = (c_dn - s_dn) * (c_dn + s_dn) + ka - e[ex] * (2.0 * s_dn * c_dn) ** 2
+        xi = _cumulative_chebyshev(integrand, s)
+        s_chs, c_chs = s_chs[..., : s.size], c_chs[..., : s.size]
     s_d, c_d, prod = _station_geometry(s_dl[ex], c_dl[ex], s_chs, c_chs)
     dcos = _cos_difference(s_chi[ex], c_chi[ex], s_chs, c_chs)
     ca_, sa_ = ca[ex], sa[ex]
@@ -339,11 +453,9 @@ def planar_elastica(k, phi, s_over_L, *, axial_ratio=None, shear_ratio=None):
     m, m1 = c_dl * c_dl, s_dl * s_dl
     tip = 2.0 * half_tip
     cos_dl = np.cos(a_safe) * np.cos(tip) + np.sin(a_safe) * np.sin(tip)  # cos(a − θ_L)
-    if np.all(e == 0.0):
+    if not quadrature:
         j_diff = _j_integral(s_chi, c_chi, m1)[ex] - _j_integral(s_chs, c_chs, m1[ex])
         xi = s * (cos_dl + k * a_r)[ex] - (2.0 / sqrt_k * m * m1)[ex] * j_diff
-    else:
-        xi = _xi_quadrature(s, sqrt_k, rho_tip, s_dl, c_dl, e, k * a_r)
 
     cos_d = (c_d - s_d) * (c_d + s_d)  # cos δ(s) and sin δ(s) = 2 sin(d/2) cos(d/2)
     sin_d = 2.0 * s_d * c_d
@@ -353,15 +465,16 @@ def planar_elastica(k, phi, s_over_L, *, axial_ratio=None, shear_ratio=None):
 
     sg, st = sign[ex], straight[ex]
     ka, kg = (k * a_r)[ex], (k * g_r)[ex]
-    lin = _tension_linear(s, k_safe[ex], np.where(near_tension, a, 0.0)[ex], e[ex], ka, kg)
-    lin_tip = _tension_linear(1.0, k_safe, np.where(near_tension, a, 0.0), e, k * a_r, k * g_r)
-    nt = near_tension[ex]
-    theta_a, x_a, z_a = (
-        np.where(nt, u, v) for u, v in zip(lin[:3], (theta_a, x_a, z_a), strict=True)
-    )
-    kappa, cos_d = np.where(nt, lin[3], kappa), np.where(nt, 1.0, cos_d)
-    sin_d = np.where(nt, lin[4], sin_d)
-    tip = np.where(near_tension, lin_tip[0], tip)
+    if np.any(near_tension):  # it only replaces values: skipped when no load needs it
+        lin = _tension_linear(s, k_safe[ex], np.where(near_tension, a, 0.0)[ex], e[ex], ka, kg)
+        lin_tip = _tension_linear(1.0, k_safe, np.where(near_tension, a, 0.0), e, k * a_r, k * g_r)
+        nt = near_tension[ex]
+        theta_a, x_a, z_a = (
+            np.where(nt, u, v) for u, v in zip(lin[:3], (theta_a, x_a, z_a), strict=True)
+        )
+        kappa, cos_d = np.where(nt, lin[3], kappa), np.where(nt, 1.0, cos_d)
+        sin_d = np.where(nt, lin[4], sin_d)
+        tip = np.where(near_tension, lin_tip[0], tip)
     theta = np.where(st, 0.0, sg * theta_a)
     x = np.where(st, s * (1.0 + ka), x_a)
     z = np.where(st, 0.0, sg * z_a)
@@ -397,15 +510,29 @@ def _tension_linear(s, k, a, e, ka, kg):
     return theta, x, z, a * mu * ratio_sinh, a * ratio_cosh
 
 
-def _xi_quadrature(s, sqrt_k, rho_tip, s_dl, c_dl, e, ka):
-    """ξ(s) = ∫_0^s (cos δ + k a_r − e sin²δ) ds by Gauss-Legendre on [0, s] per station."""
-    n = _N_QUAD + _N_QUAD_PER_ROOT_K * int(np.ceil(np.max(sqrt_k)))
-    nodes, weights = roots_legendre(n)
-    ex2 = (..., None, None)
-    s_nodes = 0.5 * s[:, None] * (nodes + 1.0)  # (N, n)
-    s_ch, c_ch, _ = _solve_stations(
-        s_nodes, sqrt_k[ex2], rho_tip[ex2], s_dl[ex2], c_dl[ex2], e[ex2]
-    )
-    s_d, c_d, _ = _station_geometry(s_dl[ex2], c_dl[ex2], s_ch, c_ch)
-    integrand = (c_d - s_d) * (c_d + s_d) + ka[ex2] - e[ex2] * (2.0 * s_d * c_d) ** 2
-    return 0.5 * s * np.sum(integrand * weights, axis=-1)
+def _chebyshev_points(n):
+    """Chebyshev points of [0, 1], s_j = cos²(π j / (2(n − 1))), j = 0 … n − 1 (tip to clamp).
+
+    Written as sin²(π (n − 1 − j) / (2(n − 1))) so that both ends are exact.
+    """
+    return np.sin(0.5 * np.pi * np.arange(n - 1, -1, -1) / (n - 1)) ** 2
+
+
+def _cumulative_chebyshev(values, s):
+    """∫_0^s f for f sampled at ``_chebyshev_points(n)`` on the last axis (Clenshaw-Curtis).
+
+    f ≈ Σ c_j T_j(2s − 1) with c from a DCT-I of the samples; the series is integrated term by
+    term (∫T_0 = T_1, ∫T_j = T_{j+1}/(2(j+1)) − T_{j−1}/(2(j−1))) and evaluated at the stations s
+    with T_j(cos ϑ) = cos jϑ, 2s − 1 = cos ϑ. Shapes: values (B..., n), s (N,) → (B..., N).
+    """
+    n = values.shape[-1]
+    halve_ends = np.ones(n)
+    halve_ends[[0, -1]] = 0.5
+    c = dct(values, type=1, axis=-1) * (halve_ends / (n - 1))
+    c = np.concatenate([c, np.zeros((*c.shape[:-1], 2))], axis=-1)  # c_0 … c_{n+1}
+    j = np.arange(1, n + 1)
+    below = c[..., :n] * np.where(j == 1, 2.0, 1.0)  # c_{j−1}, doubled for ∫T_0 = T_1
+    b = (below - c[..., 2:]) / (2.0 * j)  # coefficients of T_1 … T_n in the antiderivative
+    angle = 2.0 * np.arctan2(np.sqrt(1.0 - s), np.sqrt(s))
+    t_minus_clamp = np.cos(angle[:, None] * j) - np.where(j % 2 == 0, 1.0, -1.0)
+    return 0.5 * (b @ t_minus_clamp.T)

@@ -57,7 +57,7 @@ def elastica(arm, force, s=None, *, extensible=True):
 
     * ``extensible=True`` (default): the planar Reissner rod with the arm's EA and GA, which
       is the full Cosserat model (eq. 20) for this load: ``exact=True`` (positions along the
-      force line by a Gauss-Legendre quadrature to ~1e-15 L). Needs P/EA < 1 and
+      force line by a Clenshaw-Curtis quadrature to ~1e-15 L). Needs P/EA < 1 and
       |P/EA - P/GA| < 1.
     * ``extensible=False``: the Euler elastica (inextensible, unshearable), ``exact=False``;
       strains have γ = 0 and the stresses are the true internal forces n = Rᵀ F (the
