@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import csv
 import json
+import os
+import stat
 from pathlib import Path
 
 import numpy as np
@@ -123,3 +125,13 @@ def test_atomic_write_leaves_nothing_on_failure(tmp_path):
         raise RuntimeError("boom")
     assert target.read_text() == "old"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out.csv"]
+
+
+def test_written_files_get_normal_permissions(tmp_path):
+    """An atomic write must not leave the private 0600 mode of its temporary file behind."""
+    umask = os.umask(0o022)
+    try:
+        path = io.save_result(arc(), tmp_path / "r.json")
+    finally:
+        os.umask(umask)
+    assert stat.S_IMODE(path.stat().st_mode) == 0o644

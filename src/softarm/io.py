@@ -113,6 +113,10 @@ def write_atomic(path: str | os.PathLike, mode: str = "w"):
     handle, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part",
                                    dir=path.parent if str(path.parent) else ".")
     try:
+        # mkstemp makes the file private (0600); give it the permissions of a normal new file
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)
         with os.fdopen(handle, mode, **({"newline": ""} if "b" not in mode else {})) as stream:
             yield stream
         os.replace(tmp, path)
