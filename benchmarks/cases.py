@@ -150,13 +150,14 @@ def _princeton() -> Case:
     return Case("princeton_shear_P13.345", problem, None, "")
 
 
-def _soft_arm_3d() -> Case:
+def soft_arm_problem() -> RodProblem:
+    """The 3D soft arm: silicone-like, L = 0.3 m, r = 1 cm, gravity and an oblique tip force."""
     L, r, E, rho, g = 0.3, 0.01, 1.0e6, 1100.0, 9.81
     G = E / 3.0  # nu = 0.5
     area, inertia = math.pi * r**2, math.pi * r**4 / 4
     # Shear coefficient 27/28: Hutchinson's (2001) circle value at nu = 0.5, the value PyElastica
     # uses, so that the PyElastica peer solves the same continuum model.
-    problem = RodProblem(
+    return RodProblem(
         length=L,
         EA=E * area,
         GAy=27.0 / 28.0 * G * area,
@@ -169,7 +170,29 @@ def _soft_arm_3d() -> Case:
         radius=r,
         density=rho,
     )
-    return Case("soft_arm_3d_gravity_oblique", problem, None, "")
+
+
+def _soft_arm_3d() -> Case:
+    return Case("soft_arm_3d_gravity_oblique", soft_arm_problem(), None, "")
+
+
+def to_softarm(problem: RodProblem):
+    """The same rod and loads as softarm objects: (arm, loads)."""
+    import softarm
+
+    if problem.follower:
+        raise NotImplementedError("follower tip forces are not used by the benchmark cases")
+    gravity = np.asarray(problem.gravity_per_length)
+    mu, loads = None, []
+    if np.any(gravity):
+        mu = problem.density * math.pi * problem.radius**2
+        loads.append(softarm.Gravity(gravity / mu))
+    arm = softarm.Arm.from_stiffness(
+        problem.length, EA=problem.EA, GAy=problem.GAy, GAz=problem.GAz, GJ=problem.GJ,
+        EIy=problem.EIy, EIz=problem.EIz, curvature=problem.curvature, mass_per_length=mu,
+    )
+    loads.insert(0, softarm.TipLoad(force=problem.tip_force, moment=problem.tip_moment))
+    return arm, loads
 
 
 def _with_tight_reference(case: Case, tol: float = 1e-12) -> Case:

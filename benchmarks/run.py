@@ -88,27 +88,8 @@ def environment() -> dict:
 
 
 # --------------------------------------------------------------------------------------------
-# softarm set-up
+# softarm compilation
 # --------------------------------------------------------------------------------------------
-def to_softarm(problem: peers.RodProblem):
-    """The same rod and loads as softarm objects: (arm, loads)."""
-    import softarm
-
-    if problem.follower:
-        raise NotImplementedError("follower tip forces are not used by the benchmark cases")
-    gravity = np.asarray(problem.gravity_per_length)
-    mu, loads = None, []
-    if np.any(gravity):
-        mu = problem.density * math.pi * problem.radius**2
-        loads.append(softarm.Gravity(gravity / mu))
-    arm = softarm.Arm.from_stiffness(
-        problem.length, EA=problem.EA, GAy=problem.GAy, GAz=problem.GAz, GJ=problem.GJ,
-        EIy=problem.EIy, EIz=problem.EIz, curvature=problem.curvature, mass_per_length=mu,
-    )
-    loads.insert(0, softarm.TipLoad(force=problem.tip_force, moment=problem.tip_moment))
-    return arm, loads
-
-
 def compile_report(cold: bool) -> dict:
     """Import time, first-call time of softarm.solve and whether numba loaded it from cache."""
     w0 = time.perf_counter()
@@ -203,7 +184,7 @@ def references(all_cases, quick: bool) -> tuple[dict, list[str]]:
 
     refs, notes = {}, []
     for case in all_cases:
-        arm, loads = to_softarm(case.problem)
+        arm, loads = bench_cases.to_softarm(case.problem)
         L = case.problem.length
         if case.name.startswith(("mattiasson", "pure_bending")):
             refs[case.name] = case.reference
@@ -249,7 +230,7 @@ def run_cases(all_cases, refs, repeats: int, peer_repeats: int, quick: bool) -> 
     for case in all_cases:
         name, problem, L = case.name, case.problem, case.problem.length
         ref = refs[name]
-        arm, loads = to_softarm(problem)
+        arm, loads = bench_cases.to_softarm(problem)
 
         def run_softarm(tol, arm=arm, loads=loads):
             return softarm.solve(arm, loads, method="numeric", tol=tol).tip_position

@@ -17,7 +17,6 @@ from __future__ import annotations
 import argparse
 import gc
 import json
-import math
 import resource
 import subprocess
 import sys
@@ -30,27 +29,17 @@ __all__ = ["batch_solver", "closed_form_throughput", "soft_arm", "soft_arm_loads
 
 _HERE = Path(__file__).resolve()
 
-# The 3D soft arm of benchmarks/cases.py (_soft_arm_3d): silicone-like, L = 0.3 m, r = 1 cm.
-_L, _R, _E, _RHO = 0.3, 0.01, 1.0e6, 1100.0
-_BASE_FORCE = np.array([0.05, 0.1, -0.05])  # N, spatial, the case's oblique tip force
+sys.path.insert(0, str(_HERE.parent))
+from cases import soft_arm_problem, to_softarm  # noqa: E402  (benchmarks/ is not a package)
+
+_PROBLEM = soft_arm_problem()
+_L = _PROBLEM.length
+_BASE_FORCE = np.array(_PROBLEM.tip_force)  # N, spatial, the case's oblique tip force
 
 
 def soft_arm():
     """The 3D soft arm of the benchmark cases as a :class:`softarm.Arm` (with its mass)."""
-    import softarm
-
-    G = _E / 3.0
-    area, inertia = math.pi * _R**2, math.pi * _R**4 / 4
-    return softarm.Arm.from_stiffness(
-        _L,
-        EA=_E * area,
-        GAy=27.0 / 28.0 * G * area,
-        GAz=27.0 / 28.0 * G * area,
-        GJ=G * 2 * inertia,
-        EIy=_E * inertia,
-        EIz=_E * inertia,
-        mass_per_length=_RHO * area,
-    )
+    return to_softarm(_PROBLEM)[0]
 
 
 def soft_arm_loads(n_cases: int, seed: int = 7):
