@@ -645,9 +645,32 @@ def loads_to_dict(loads) -> list[dict]:
 
 
 def _solver():
-    from . import dispatch  # the solver is imported when first needed
+    """``softarm.solve`` that warm-starts each call from the previous one (sweep chunks).
 
-    return dispatch.solve
+    Where an exact closed form applies (``method="auto"``) it is used as by ``softarm.solve``;
+    otherwise one prepared :class:`softarm.statics.Solver` per (arm, stations, tol) serves every
+    call, so each chunk of a sweep starts from the last solution of the previous chunk instead
+    of from the unloaded arm.
+    """
+    from . import dispatch  # the solver is imported when first needed
+    from .analytic import exact_closed_form
+    from .statics import Solver
+
+    prepared = {}
+
+    def solve(arm, loads, *, method="auto", s=None, tol=1e-8):
+        if method == "auto":
+            closed = exact_closed_form(arm, loads, s=s)
+            if closed is not None:
+                return closed
+        elif method != "numeric":
+            return dispatch.solve(arm, loads, method=method, s=s, tol=tol)
+        key = (arm, s, tol)
+        if key not in prepared:
+            prepared[key] = Solver(arm, s=s, tol=tol)
+        return prepared[key].solve(loads)
+
+    return solve
 
 
 def solve_case(case: Case, *, method: str | None = None, stations: int | None = None,
@@ -656,9 +679,9 @@ def solve_case(case: Case, *, method: str | None = None, stations: int | None = 
     """Solve a case (every step of its sweep, if it has one).
 
     A sweep is solved as batched calls of ``softarm.solve`` (warm-started along the batch inside
-    the solver). When the first step shows that the whole sweep will take more than about a
-    second, the rest is solved in a few consecutive chunks so that ``progress(done, total)`` can
-    report; otherwise in one call.
+    the solver, and from one call to the next). When the first step shows that the whole sweep
+    will take more than about a second, the rest is solved in a few consecutive chunks so that
+    ``progress(done, total)`` can report; otherwise in one call.
 
     Parameters
     ----------
