@@ -366,6 +366,17 @@ def _figure_fig3(plots):
 # ------------------------------------------------------------------------------------------
 # Mattiasson cantilever (Euler elastica under a dead tip force)
 # ------------------------------------------------------------------------------------------
+def _table_or_skip(tables: DataTables, file: str, case: str, items: str, quantity: str,
+                   key: str) -> tuple[dict | None, CaseResult]:
+    """The reference table ``file`` and a fresh result; without the table, a skipped check."""
+    result = CaseResult()
+    data = tables.get(file)
+    if data is None:
+        result.checks.append(skipped(case, items, NUMERIC, quantity, key,
+                                     tables.missing_reason(file)))
+    return data, result
+
+
 def _mattiasson_values(eq, L):
     """(w/L, u/L, tip slope) of a cantilever bent towards +z, NaN without a result."""
     return (value(eq, tip, 2, L), 1.0 - value(eq, tip, 0, L), value(eq, tip_angle, 1, -1.0))
@@ -373,12 +384,10 @@ def _mattiasson_values(eq, L):
 
 def mattiasson_cantilever(tables: DataTables) -> CaseResult:
     case = "mattiasson_cantilever"
-    result = CaseResult()
-    data = tables.get(_MATTIASSON)
     key = f"{_MATTIASSON}: computed_here.table"
+    data, result = _table_or_skip(tables, _MATTIASSON, case, "k = 0.1 ... 20",
+                                  "w/L, u/L, tip rotation", key)
     if data is None:
-        result.checks.append(skipped(case, "k = 0.1 ... 20", NUMERIC, "w/L, u/L, tip rotation",
-                                     key, tables.missing_reason(_MATTIASSON)))
         return result
     L, EI = 1.0, 1.0
     arm = _nearly_rigid_arm(L, EI)
@@ -452,17 +461,14 @@ def rollup(tables: DataTables) -> CaseResult:
     case, L, EI = "rollup", 1.0, 1.0
     arm = _stiff_arm(L, EI)
     s = np.linspace(0.0, L, 201)
-    result = CaseResult()
     shapes = {}
     cases = [(1.0, "M = 2π EI/L (closed circle)", (0.0, 0.0, 2 * math.pi),
               "closed form, rod_benchmarks.json rollup_end_moment.analytic (Simo & Vu-Quoc "
               "1986): a full circle, the tip back at the root")]
-    data = tables.get(_RODS)
     key = f"{_RODS}: rollup_end_moment.computed_here_table"
-    if data is None:
-        result.checks.append(skipped(case, "λ = 0.05 ... 0.95", NUMERIC,
-                                     "tip x/L, y/L, rotation", key, tables.missing_reason(_RODS)))
-    else:
+    data, result = _table_or_skip(tables, _RODS, case, "λ = 0.05 ... 0.95",
+                                  "tip x/L, y/L, rotation", key)
+    if data is not None:
         cases += [(float(row["lambda"]), f"λ = {row['lambda']:g}",
                    (row["x_tip_over_L"], row["y_tip_over_L"], row["tip_angle_rad"]),
                    f"{key} (the closed form evaluated; computed, not published)")
@@ -518,12 +524,10 @@ def _figure_rollup(shapes, exact):
 # ------------------------------------------------------------------------------------------
 def follower_tip_force(tables: DataTables) -> CaseResult:
     case = "follower_tip_force"
-    result = CaseResult()
-    data = tables.get(_RODS)
     key = f"{_RODS}: follower_tip_force_planar.computed_here"
+    data, result = _table_or_skip(tables, _RODS, case, "k = 0.5 ... 10",
+                                  "tip x/L, y/L, rotation", key)
     if data is None:
-        result.checks.append(skipped(case, "k = 0.5 ... 10", NUMERIC, "tip x/L, y/L, rotation",
-                                     key, tables.missing_reason(_RODS)))
         return result
     L, EI = 1.0, 1.0
     arm = _nearly_rigid_arm(L, EI)
@@ -550,13 +554,10 @@ def follower_tip_force(tables: DataTables) -> CaseResult:
 # ------------------------------------------------------------------------------------------
 def shear_deformable_tip_force(tables: DataTables) -> CaseResult:
     case = "shear_deformable_tip_force"
-    result = CaseResult()
-    data = tables.get(_RODS)
     key = f"{_RODS}: shear_deformable_tip_force.computed_here"
+    data, result = _table_or_skip(tables, _RODS, case, "GA = 500, 10, ∞ N",
+                                  "tip x, z, section rotation", key)
     if data is None:
-        result.checks.append(skipped(case, "GA = 500, 10, ∞ N", NUMERIC,
-                                     "tip x, z, section rotation", key,
-                                     tables.missing_reason(_RODS)))
         return result
     entry = data["shear_deformable_tip_force"]
     params = entry["found"]["params"]
