@@ -189,3 +189,12 @@ def test_bad_case_names_file_key_and_fault(tmp_path, name):
 def test_missing_file(tmp_path):
     with pytest.raises(CaseError, match="no such file"):
         load_case(tmp_path / "nope.toml")
+
+
+def test_solver_tolerance_is_checked_with_its_key_path(tmp_path):
+    """tol is the tip-position tolerance / L of softarm.solve, in [1e-13, 0.1]."""
+    path = tmp_path / "case.toml"
+    path.write_text(f"[arm]\nlength = 1\n{STIFF}\n[[load]]\nkind = 'tip'\n[solve]\ntol = 0.5\n")
+    with pytest.raises(CaseError, match=r"case\.toml: solve\.tol: must be .*\[1e-13, 0\.1\], "
+                                        r"got 0\.5"):
+        load_case(path)

@@ -33,6 +33,7 @@ import numpy as np
 from .equilibrium import Equilibrium
 from .loads import DistributedForce, Gravity, PointLoad, TipLoad, as_loads
 from .model import Arm, Circle, Material, Rectangle, Rigidities, Section, SegmentedArm, Tube
+from .statics.solver import check_tol
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -75,7 +76,8 @@ class SolveOptions:
     stations : int
         Number of uniformly spaced output stations on [0, L], >= 2.
     tol : float
-        Residual tolerance of the numerical solver (N and N m).
+        Tolerance of the numerical solver: tip-position error relative to the arm length, in
+        [1e-13, 0.1] (see ``softarm.solve``).
     """
 
     method: str = "auto"
@@ -446,8 +448,12 @@ def _solve_options(table: _Table) -> SolveOptions:
     options = SolveOptions(
         method=table.string("method", _METHODS, default="auto"),
         stations=table.integer("stations", default=101, minimum=2),
-        tol=table.number("tol", "N and N m", required=False, default=1e-8),
+        tol=table.number("tol", "units of the arm length", required=False, default=1e-8),
     )
+    try:
+        check_tol(options.tol)  # the solver's own rule, reported with the key path
+    except ValueError as error:
+        raise table.error("tol", str(error).removeprefix("tol ")) from None
     table.done()
     return options
 
@@ -647,28 +653,21 @@ def loads_to_dict(loads) -> list[dict]:
 def _solver():
     """``softarm.solve`` that warm-starts each call from the previous one (sweep chunks).
 
-    Where an exact closed form applies (``method="auto"``) it is used as by ``softarm.solve``;
-    otherwise one prepared :class:`softarm.statics.Solver` per (arm, stations, tol) serves every
-    call, so each chunk of a sweep starts from the last solution of the previous chunk instead
-    of from the unloaded arm.
+    One prepared :class:`softarm.statics.Solver` per (arm, stations, tol) serves every call
+    through :func:`softarm.dispatch.solve_prepared`: the same routes and checks as
+    ``softarm.solve``, but each chunk of a sweep starts from the last solution of the previous
+    chunk instead of from the unloaded arm.
     """
     from . import dispatch  # the solver is imported when first needed
-    from .analytic import exact_closed_form
     from .statics import Solver
 
     prepared = {}
 
     def solve(arm, loads, *, method="auto", s=None, tol=1e-8):
-        if method == "auto":
-            closed = exact_closed_form(arm, loads, s=s)
-            if closed is not None:
-                return closed
-        elif method != "numeric":
-            return dispatch.solve(arm, loads, method=method, s=s, tol=tol)
         key = (arm, s, tol)
         if key not in prepared:
             prepared[key] = Solver(arm, s=s, tol=tol)
-        return prepared[key].solve(loads)
+        return dispatch.solve_prepared(prepared[key], loads, method)
 
     return solve
 
@@ -691,7 +690,8 @@ def solve_case(case: Case, *, method: str | None = None, stations: int | None = 
     progress : callable, optional
         Called as ``progress(steps_done, steps_total)`` after each chunk of a long sweep.
     solve : callable, optional
-        The solver, ``softarm.solve`` by default.
+        The solver, with the signature of ``softarm.solve``; by default ``softarm.solve``
+        warm-started from one call to the next (:func:`_solver`).
 
     Returns
     -------

@@ -11,13 +11,11 @@ import dataclasses
 import numpy as np
 
 from . import analytic
-from ._validate import stations
 from .equilibrium import Equilibrium
 from .loads import DistributedForce, Gravity, PointLoad, TipLoad, as_loads, batch_shape
-from .statics import solve_numeric
-from .statics.solver import check_base, check_tol
+from .statics import Solver
 
-__all__ = ["METHODS", "solve"]
+__all__ = ["METHODS", "solve", "solve_prepared"]
 
 #: Accepted values of ``method``.
 METHODS = ("auto", "numeric", "analytic")
@@ -44,17 +42,16 @@ def _in_base_frame(loads, R: np.ndarray) -> tuple:
 
 
 def _closed_form(arm, loads, s, H0) -> Equilibrium | None:
-    """An exact closed form for these loads, or None (also while softarm.analytic has none)."""
-    exact_closed_form = getattr(analytic, "exact_closed_form", None)
-    if exact_closed_form is None:
-        return None
+    """An exact closed form for these loads on the arm clamped at H0, or None."""
     identity = np.array_equal(H0, np.eye(4))
-    result = exact_closed_form(arm, loads if identity else _in_base_frame(loads, H0[:3, :3]),
-                               s=s)
+    result = analytic.exact_closed_form(
+        arm, loads if identity else _in_base_frame(loads, H0[:3, :3]), s=s)
     if result is None or identity:
         return result
     # the same arm clamped at H0: rigidly move the solution; material strains are unchanged
-    return dataclasses.replace(result, poses=H0 @ result.poses, loads=loads)
+    poses = H0 @ result.poses
+    poses.setflags(write=False)  # fresh: Equilibrium takes it without a copy
+    return dataclasses.replace(result, poses=poses, loads=loads)
 
 
 def solve(arm, loads, *, method="auto", s=None, tol=1e-8, base=None, **options) -> Equilibrium:
@@ -81,7 +78,7 @@ def solve(arm, loads, *, method="auto", s=None, tol=1e-8, base=None, **options) 
         Pose of the clamped base in the spatial frame (default identity).
     **options
         Passed to :class:`softarm.statics.Solver` (``max_iterations``, ``continuation``,
-        ``max_step``).
+        ``max_step``, ``steps``, ``max_steps``, ``max_shootings``); checked on every route.
 
     Returns
     -------
@@ -104,21 +101,31 @@ def solve(arm, loads, *, method="auto", s=None, tol=1e-8, base=None, **options) 
     >>> eq.method, round(float(eq.tip_position[2]), 6)  # Mattiasson (1981): w/L = 0.71379
     ('numeric.shooting', 0.713792)
     """
+    _check_method(method)
+    return solve_prepared(Solver(arm, s=s, tol=tol, base=base, **options), loads, method)
+
+
+def _check_method(method) -> None:
     if method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}, got {method!r}")
-    if method == "numeric":  # the solver validates everything itself, once
-        return solve_numeric(arm, loads, s=s, tol=tol, base=base, **options)
-    loads = as_loads(loads)
-    batch_shape(loads)
-    H0 = check_base(base)
-    check_tol(tol)
-    stations(s, float(arm.length))  # validate before any route
-    result = _closed_form(arm, loads, s, H0)
-    if result is not None:
-        return result
-    if method == "analytic":
-        raise ValueError(
-            "method='analytic' but no exact closed form applies to this arm and these "
-            "loads; use method='auto' or 'numeric'"
-        )
-    return solve_numeric(arm, loads, s=s, tol=tol, base=base, **options)
+
+
+def solve_prepared(solver: Solver, loads, method="auto") -> Equilibrium:
+    """:func:`solve` with a prepared :class:`softarm.statics.Solver` (arm, stations, tol, base).
+
+    The same routes as :func:`solve`; the numerical one reuses ``solver``, so consecutive calls
+    warm-start from each other (the chunks of a sweep, a control loop).
+    """
+    _check_method(method)
+    if method != "numeric":  # the solver validates the loads itself
+        loads = as_loads(loads)
+        batch_shape(loads)
+        result = _closed_form(solver.arm, loads, solver.s, solver.base)
+        if result is not None:
+            return result
+        if method == "analytic":
+            raise ValueError(
+                "method='analytic' but no exact closed form applies to this arm and these "
+                "loads; use method='auto' or 'numeric'"
+            )
+    return solver.solve(loads)
