@@ -745,12 +745,17 @@ def _concatenate(parts: list[Equilibrium], loads: tuple) -> Equilibrium:
         return np.concatenate([np.broadcast_to(np.asarray(getattr(p, name), dtype=float),
                                                p.batch_shape) for p in parts])
 
+    def fields(name):  # fresh and read-only: Equilibrium takes it without a copy
+        array = np.concatenate([getattr(p, name) for p in parts])
+        array.setflags(write=False)
+        return array
+
     methods = sorted({p.method for p in parts})
     return Equilibrium(
         s=first.s,
-        poses=np.concatenate([p.poses for p in parts]),
-        strains=np.concatenate([p.strains for p in parts]),
-        stresses=np.concatenate([p.stresses for p in parts]),
+        poses=fields("poses"),
+        strains=fields("strains"),
+        stresses=fields("stresses"),
         arm=first.arm, loads=loads, method="+".join(methods),
         exact=all(bool(p.exact) for p in parts),
         residual=cat("residual"), error_estimate=cat("error_estimate"))

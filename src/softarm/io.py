@@ -23,7 +23,7 @@ import numpy as np
 from . import __version__
 from .case import Case, CaseError, _parse, arm_to_dict, loads_to_dict
 from .equilibrium import Equilibrium
-from .lie import so3
+from .lie import se3, so3
 
 __all__ = [
     "COLUMNS",
@@ -338,10 +338,7 @@ def _read_csv(path: Path):
     columns = {c: table[:, header.index(c)].reshape(shape) for c in COLUMNS}
     positions = _stack(columns, ("x_m", "y_m", "z_m"))
     quat = _stack(columns, ("quat_w", "quat_x", "quat_y", "quat_z"))
-    poses = np.zeros((*shape, 4, 4))
-    poses[..., :3, :3] = so3.from_quaternion(quat)
-    poses[..., :3, 3] = positions
-    poses[..., 3, 3] = 1.0
+    poses = se3.from_rotation_translation(so3.from_quaternion(quat), positions)
     sweep = None
     if batch and meta.get("sweep_column") in header:
         sweep = table[:, header.index(meta["sweep_column"])].reshape(shape)[..., 0]

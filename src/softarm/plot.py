@@ -100,7 +100,7 @@ def _radii(arm, s: np.ndarray):
     radii = [a.radius for a in segments]
     if any(r is None for r in radii):
         return None
-    bounds = np.cumsum([a.length for a in segments])[:-1]
+    bounds = np.asarray(arm.boundaries[1:-1])
     return np.asarray(radii, dtype=float)[np.searchsorted(bounds, s, side="right")]
 
 
@@ -309,17 +309,11 @@ def plot_result_file(source, path: str | os.PathLike | None = None, *, fig=None)
     from .io import SavedResult, load_saved
 
     saved = source if isinstance(source, SavedResult) else load_saved(source)
-    case = saved.case
-    name = case.name if case is not None else Path(saved.path).stem
+    name = saved.case.name  # every saved result carries its case
     result = saved.result
     if result.batch_shape:
-        sweep = case.sweep if case is not None else None
-        values = saved.sweep_values
-        if values is None and len(result.batch_shape) == 1:
-            values = np.arange(result.batch_shape[0], dtype=float)
-        flat = result
         if len(result.batch_shape) > 1:
             raise ValueError(f"{saved.path}: cannot plot a batch of shape {result.batch_shape}")
-        return plot_sweep(flat, values, label=saved.sweep_label, sweep=sweep, fig=fig,
-                          path=path, name=name)
+        return plot_sweep(result, saved.sweep_values, label=saved.sweep_label,
+                          sweep=saved.case.sweep, fig=fig, path=path, name=name)
     return plot_equilibrium(result, fig=fig, path=path, name=name)

@@ -39,7 +39,7 @@ BATCH_SHAPES = [(), (1,), (3, 1, 2)]
 def test_every_public_function_is_covered():
     public = {f"{module.__name__.rsplit('.', 1)[-1]}.{name}"
               for module in (lie.so3, lie.se3) for name in module.__all__}
-    assert public == set(FUNCTIONS)
+    assert public == set(FUNCTIONS) | {"se3.from_rotation_translation"}  # two inputs: below
     assert set(lie.__all__) == {"so3", "se3"}
 
 
@@ -112,3 +112,17 @@ def test_non_numeric_input_names_parameter(name):
     function, parameter, _, _, _ = FUNCTIONS[name]
     with pytest.raises(TypeError, match=rf"^{parameter} must be numeric"):
         function("not an array")
+
+
+@pytest.mark.parametrize("batch", BATCH_SHAPES, ids=str)
+def test_from_rotation_translation_batched_equals_looped(batch, rng):
+    h = make_input("h", rng, batch)
+    H = se3.exp(h)  # an independent pose: its blocks must come back as they are
+    out = se3.from_rotation_translation(H[..., :3, :3], H[..., :3, 3])
+    assert out.shape == (*batch, 4, 4)
+    assert_array_equal(out, H)
+    for index in np.ndindex(*batch):
+        assert_array_equal(out[index], se3.from_rotation_translation(H[index][:3, :3],
+                                                                     H[index][:3, 3]))
+    with pytest.raises(ValueError, match=r"p must have shape \(\.\.\., 3\), got shape \(2,\)"):
+        se3.from_rotation_translation(np.eye(3), [1.0, 2.0])

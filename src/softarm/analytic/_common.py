@@ -24,7 +24,6 @@ __all__ = [
     "constant_strain_poses",
     "moment_is_principal",
     "negligible",
-    "pose",
     "rotational_stiffness",
     "screw_poses",
     "vectors",
@@ -259,6 +258,7 @@ def build(arm: Arm, s: np.ndarray, poses, strains, loads, method: str, exact: bo
     :class:`~softarm.Equilibrium` documents.
     """
     n = s.shape[0]
+    s = _owned(s)
     poses = _owned(poses)
     strains = _owned(strains)
     stresses = _owned(strains * np.diagonal(arm.stiffness) if stresses is None else stresses)
@@ -271,13 +271,3 @@ def build(arm: Arm, s: np.ndarray, poses, strains, loads, method: str, exact: bo
     return Equilibrium(s=s, poses=poses, strains=strains, stresses=stresses, arm=arm,
                        loads=tuple(loads), method=method, exact=bool(exact), residual=0.0,
                        error_estimate=error_estimate)
-
-
-def pose(R: np.ndarray, p: np.ndarray) -> np.ndarray:
-    """[[R, p], [0, 1]] from R (..., 3, 3) and p (..., 3), broadcast."""
-    batch = np.broadcast_shapes(R.shape[:-2], p.shape[:-1])
-    H = np.zeros((*batch, 4, 4))
-    H[..., :3, :3] = R
-    H[..., :3, 3] = p
-    H[..., 3, 3] = 1.0
-    return H

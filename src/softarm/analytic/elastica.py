@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 
 from .._validate import stations
-from ..lie import so3
+from ..lie import se3, so3
 from ..loads import TipLoad
-from ._common import E1, build, check_arm, negligible, pose, vectors
+from ._common import E1, build, check_arm, negligible, vectors
 from ._elastica_math import K_MAX, planar_elastica
 
 __all__ = ["elastica", "elastica_plane"]
@@ -152,5 +152,6 @@ def elastica(arm, force, s=None, *, extensible=True):
         n = np.einsum("...ji,...j->...i", R, force[..., None, :])
         stresses = np.concatenate([n, kappa * np.diagonal(arm.stiffness)[3:]], axis=-1)
     strains = np.concatenate([gamma, kappa], axis=-1)
-    return build(arm, s, pose(R, p), strains, (TipLoad(force=force),), "analytic.elastica",
+    poses = se3.from_rotation_translation(R, p)
+    return build(arm, s, poses, strains, (TipLoad(force=force),), "analytic.elastica",
                  bool(extensible), stresses=stresses)

@@ -37,7 +37,7 @@ def exact_closed_form(arm, loads, s=None):
       :func:`axial_force` (the straight state, exact though unstable beyond the Euler load);
     * dead tip force only, on a straight arm, in a principal plane (any plane if EIy = EIz and
       GAy = GAz): the extensible, shearable :func:`elastica`;
-    * no load: the undeformed arm.
+    * a zero tip wrench: the undeformed arm (an empty list of loads gives None).
 
     Several TipLoads in the same frame are summed; any other load (Gravity, DistributedForce,
     PointLoad), mixed dead/follower tip loads, a force together with a moment, a follower

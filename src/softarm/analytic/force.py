@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 
 from .._validate import stations
-from ..lie import so3
+from ..lie import se3, so3
 from ..loads import TipLoad
-from ._common import build, check_arm, constant_strain_poses, negligible, pose, vectors
+from ._common import build, check_arm, constant_strain_poses, negligible, vectors
 
 __all__ = ["axial_force", "shear_force"]
 
@@ -84,6 +84,7 @@ def axial_force(arm, force, s=None):
     strain = np.zeros((*force.shape[:-1], 6))
     strain[..., 0] = force[..., 0] / arm.rigidities.EA
     poses = constant_strain_poses(arm.reference_strain + strain, s)
+    strain.setflags(write=False)  # fresh: its broadcast view goes to the result uncopied
     strains = np.broadcast_to(strain[..., None, :], (*strain.shape[:-1], s.size, 6))
     return build(arm, s, poses, strains, (TipLoad(force=force),), "analytic.axial_force", True)
 
@@ -165,7 +166,7 @@ def shear_force(arm, force, s=None):
     exact = bool(np.all(force[..., 1:] == 0.0))
     # Leading neglected effect: the shortening ½ ∫ |θ|² ds = (L⁵/15)((Fz/EIy)² + (Fy/EIz)²).
     shortening = L**5 / 15 * ((force[..., 2] / r.EIy) ** 2 + (force[..., 1] / r.EIz) ** 2)
-    poses = pose(so3.exp(theta), p)
+    poses = se3.from_rotation_translation(so3.exp(theta), p)
     load = (TipLoad(force=force),)
     return build(arm, s, poses, strains, load, "analytic.shear_force", exact,
                  error_estimate=shortening)

@@ -22,6 +22,7 @@ __all__ = [
     "ad",
     "adjoint",
     "exp",
+    "from_rotation_translation",
     "hat",
     "inverse",
     "jac_right",
@@ -39,11 +40,29 @@ def _blocks(top_left, top_right, bottom_right):
 
 
 def _pose(R: np.ndarray, p: np.ndarray) -> np.ndarray:
-    R, p = np.broadcast_arrays(R, p[..., None])
-    top = np.concatenate([R, p[..., :1]], axis=-1)
-    bottom = np.zeros((*top.shape[:-2], 1, 4))
-    bottom[..., 0, 3] = 1.0
-    return np.concatenate([top, bottom], axis=-2)
+    batch = np.broadcast_shapes(R.shape[:-2], p.shape[:-1])
+    H = np.zeros((*batch, 4, 4))
+    H[..., :3, :3] = R
+    H[..., :3, 3] = p
+    H[..., 3, 3] = 1.0
+    return H
+
+
+def from_rotation_translation(R, p):
+    """The pose [[R, p], [0, 1]] from rotations (..., 3, 3) and translations (..., 3), broadcast.
+
+    Parameters
+    ----------
+    R : array_like, shape (..., 3, 3)
+        Rotation matrices (orthonormality is assumed, not checked).
+    p : array_like, shape (..., 3)
+        Translations in m.
+
+    Returns
+    -------
+    ndarray, shape (..., 4, 4)
+    """
+    return _pose(as_matrices(R, "R", 3), as_vectors(p, "p", 3))
 
 
 def hat(h):

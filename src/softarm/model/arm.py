@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -88,9 +89,9 @@ class Arm:
         return cls(length, Rigidities(EA, GAy, GAz, GJ, EIy, EIz), None, curvature,
                    mass_per_length)
 
-    @property
+    @functools.cached_property
     def rigidities(self) -> Rigidities:
-        """The six stiffnesses EA, GAy, GAz, GJ, EIy, EIz."""
+        """The six stiffnesses EA, GAy, GAz, GJ, EIy, EIz (computed once per arm)."""
         if isinstance(self.section, Rigidities):
             return self.section
         return self.section.rigidities(self.material)
@@ -125,6 +126,11 @@ class Arm:
     def segments(self) -> tuple[Arm, ...]:
         """``(self,)``: an Arm is a segmented arm with one segment."""
         return (self,)
+
+    @property
+    def boundaries(self) -> tuple[float, ...]:
+        """``(0, L)``: the base and the tip (as :attr:`SegmentedArm.boundaries`), in m."""
+        return (0.0, float(self.length))
 
 
 @dataclass(frozen=True)
@@ -168,5 +174,6 @@ class SegmentedArm:
     @property
     def boundaries(self) -> tuple[float, ...]:
         """Arc length of each joint, base (0) and tip (L) included, in m."""
-        return tuple(float(b) for b in np.concatenate([[0.0], np.cumsum(
-            [a.length for a in self.segments])]))
+        bounds = np.concatenate([[0.0], np.cumsum([a.length for a in self.segments])])
+        bounds[-1] = self.length  # the same float as ``length``
+        return tuple(float(b) for b in bounds)

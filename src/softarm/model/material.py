@@ -49,6 +49,10 @@ class Material:
             )
         if self.shear_modulus is not None:
             positive(self.shear_modulus, "Material.shear_modulus", "Pa")
+        if self.poisson_ratio is not None and (
+            isinstance(self.poisson_ratio, bool) or not isinstance(self.poisson_ratio, (int, float))
+        ):
+            raise TypeError(f"Material.poisson_ratio must be a number, got {self.poisson_ratio!r}")
         nu = self.nu
         if not (math.isfinite(nu) and -1.0 < nu <= 0.5):
             what = (
@@ -76,11 +80,5 @@ class Material:
     def nu(self) -> float:
         """Poisson's ratio (given, or E/2G - 1)."""
         if self.poisson_ratio is not None:
-            if isinstance(self.poisson_ratio, bool) or not isinstance(
-                self.poisson_ratio, (int, float)
-            ):
-                raise TypeError(
-                    f"Material.poisson_ratio must be a number, got {self.poisson_ratio!r}"
-                )
             return float(self.poisson_ratio)
         return self.E / (2.0 * self.shear_modulus) - 1.0

@@ -81,8 +81,7 @@ class _ArmData:
     def __init__(self, arm):
         segments = arm.segments
         self.length = float(arm.length)
-        self.bounds = np.concatenate([[0.0], np.cumsum([seg.length for seg in segments])])
-        self.bounds[-1] = self.length
+        self.bounds = np.array(arm.boundaries)
         self.K = np.array([seg.stiffness for seg in segments], dtype=np.float64)
         self.C = np.linalg.inv(self.K)
         self.f0 = np.array([seg.reference_strain for seg in segments], dtype=np.float64)
