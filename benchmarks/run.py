@@ -361,15 +361,18 @@ def parse_table(text: str) -> list[dict]:
     return out
 
 
-def verdicts(rows, closed, batch, quick: bool) -> list[str]:
+def verdicts(rows, closed, closed_serial, batch) -> list[str]:
     out = []
     r = closed
     met = r["ratio_poses"] <= 3.0
     out.append(
         f"closed forms: {'met' if met else 'NOT met'}: tip_moment on {r['n_arms']:.0e} arms × "
-        f"{r['n_stations']} stations took {r['tip_moment_s']:.2f} s = {r['ratio_poses']:.1f}× "
-        f"numpy writing the poses once ({r['write_poses_s']:.2f} s; target ≤ 3×); "
-        f"{r['ratio_all']:.1f}× numpy writing all its outputs (poses, strains, stresses) once"
+        f"{r['n_stations']} stations took {r['tip_moment_s']:.2f} s on {r['threads']} "
+        f"thread(s) = {r['ratio_poses']:.1f}× numpy writing the poses once "
+        f"({r['write_poses_s']:.2f} s, one thread; target ≤ 3×); {r['ratio_all']:.1f}× numpy "
+        f"writing all its outputs (poses, strains, stresses) once; on one thread "
+        f"({closed_serial['n_arms']:.0e} arms) {closed_serial['ratio_poses']:.1f}× and "
+        f"{closed_serial['ratio_all']:.1f}×"
     )
     small, big = batch
     overhead = [b["rss_peak_bytes"] - b["rss_before_bytes"] - b["output_bytes"]
@@ -404,7 +407,7 @@ def verdicts(rows, closed, batch, quick: bool) -> list[str]:
     return out
 
 
-def report(env, comp, rows, ref_notes, pyel_note, closed, closed_principal, batch, verdict,
+def report(env, comp, rows, ref_notes, pyel_note, closed_runs, batch, verdict,
            quick: bool, elapsed: float) -> str:
     cold = comp["cold_first_call_s"]
     big = batch[-1]
@@ -460,12 +463,11 @@ def report(env, comp, rows, ref_notes, pyel_note, closed, closed_principal, batc
         "### Closed forms: `softarm.analytic.tip_moment`",
         "",
     ]
-    for r in (closed, closed_principal):
-        if r is None:
-            continue
+    for r in closed_runs:
         lines.append(
-            f"- {r['route']} route: {r['n_arms']:,} moments × {r['n_stations']} stations in "
-            f"chunks of {r['chunk']:,}: {r['tip_moment_s']:.2f} s (CPU "
+            f"- {r['route']} route, {r['threads']} thread(s): {r['n_arms']:,} moments × "
+            f"{r['n_stations']} stations in chunks of {r['chunk']:,}: "
+            f"{r['tip_moment_s']:.2f} s (CPU "
             f"{r['tip_moment_cpu_s']:.2f} s); numpy writing the same poses once "
             f"(`np.empty((chunk, {r['n_stations']}, 4, 4)).fill`) {r['write_poses_s']:.2f} s "
             f"→ **{r['ratio_poses']:.1f}×**; writing poses + strains + stresses once "
@@ -478,7 +480,9 @@ def report(env, comp, rows, ref_notes, pyel_note, closed, closed_principal, batc
         "The helix route is what the pure-bending arm (EIy = EIz) takes for any moment "
         "direction; the principal route (EIy ≠ EIz, moment about +y) is the paper's "
         "eqs. 30-34. The full (10^6, 100, 4, 4) pose array is 12.8 GB, hence the chunks; "
-        "both sides are timed per chunk and summed.",
+        "both sides are timed per chunk and summed. softarm's pose kernel splits a large batch "
+        "over the available cores (at most `$SOFTARM_NUM_THREADS`); the one-thread row "
+        "shows the same work with `SOFTARM_NUM_THREADS=1`. numpy's `fill` uses one thread.",
         "",
         "### Exact solver: one batched call",
         "",
@@ -545,16 +549,19 @@ def main(argv=None) -> int:
     closed_principal = throughput.closed_form_throughput(max(chunk, n_arms // 10), chunk,
                                                          principal=True)
     print(f"  {json.dumps(closed_principal)}", flush=True)
+    closed_serial = throughput.closed_form_throughput(max(chunk, n_arms // 10), chunk,
+                                                      threads=1)
+    print(f"  {json.dumps(closed_serial)}", flush=True)
     print("batched exact solver:", flush=True)
     batch = []
     for n in (max(1, n_cases // 10), n_cases):
         batch.append(throughput.batch_solver(n))
         print(f"  {json.dumps(batch[-1])}", flush=True)
 
-    verdict = verdicts(rows, closed, batch, quick)
+    verdict = verdicts(rows, closed, closed_serial, batch)
     elapsed = time.perf_counter() - t_start
-    text = report(env, comp, rows, ref_notes, pyel_note, closed, closed_principal, batch,
-                  verdict, quick, elapsed)
+    text = report(env, comp, rows, ref_notes, pyel_note, (closed, closed_principal, closed_serial),
+                  batch, verdict, quick, elapsed)
     print()
     print(table(rows))
     print()

@@ -17,6 +17,7 @@ from __future__ import annotations
 import argparse
 import gc
 import json
+import os
 import resource
 import subprocess
 import sys
@@ -141,7 +142,8 @@ def batch_solver(n_cases: int, tol: float = 1e-6, n_stations: int = 101) -> dict
 
 
 def closed_form_throughput(n_arms: int, chunk: int, n_stations: int = 100,
-                           principal: bool = False, seed: int = 3) -> dict:
+                           principal: bool = False, seed: int = 3,
+                           threads: int | None = None) -> dict:
     """``softarm.analytic.tip_moment`` on ``n_arms`` moments, in chunks, vs numpy writes.
 
     For each chunk of ``chunk`` arms: time one ``tip_moment(arm, moments, s=n_stations)``
@@ -154,13 +156,33 @@ def closed_form_throughput(n_arms: int, chunk: int, n_stations: int = 100,
     ``principal=False``: the arm of the pure-bending case (EIy = EIz, so the helix route,
     exact for any moment direction) with random moment directions. ``principal=True``: an
     arm with EIy != EIz and moments about +y (the constant-strain route, eqs. 30-34).
+
+    ``threads``: cap the pose kernel's threads (``$SOFTARM_NUM_THREADS``) for this
+    measurement; None keeps softarm's default (the CPUs available). numpy's writes are
+    single-threaded either way.
     """
     import softarm
-    from softarm.analytic import tip_moment
+    from softarm.analytic import _common, tip_moment
 
+    saved = os.environ.get(_common.THREADS_VARIABLE)
+    if threads is not None:
+        os.environ[_common.THREADS_VARIABLE] = str(threads)
+    try:
+        result = _closed_form_chunks(tip_moment, softarm.Arm, n_arms, chunk, n_stations,
+                                     principal, seed)
+        result["threads"] = _common.thread_count(min(chunk, n_arms) * n_stations)
+    finally:
+        if saved is None:
+            os.environ.pop(_common.THREADS_VARIABLE, None)
+        else:
+            os.environ[_common.THREADS_VARIABLE] = saved
+    return result
+
+
+def _closed_form_chunks(tip_moment, Arm, n_arms, chunk, n_stations, principal, seed) -> dict:
+    """The timed loop of :func:`closed_form_throughput`."""
     EIz = 2.0 if principal else 1.0
-    arm = softarm.Arm.from_stiffness(1.0, EA=1e9, GAy=1e9, GAz=1e9, GJ=1.0 / 1.5, EIy=1.0,
-                                     EIz=EIz)
+    arm = Arm.from_stiffness(1.0, EA=1e9, GAy=1e9, GAz=1e9, GJ=1.0 / 1.5, EIy=1.0, EIz=EIz)
     rng = np.random.default_rng(seed)
     tip_moment(arm, [0.0, 1.0, 0.0], s=n_stations)  # first-call imports, not timed
     t_tip = c_tip = t_poses = t_all = 0.0

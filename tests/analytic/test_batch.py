@@ -59,3 +59,33 @@ def test_no_nan_for_extreme_finite_input():
             assert np.all(np.isfinite(eq.poses)) and np.all(np.isfinite(eq.strains))
     assert np.all(np.isfinite(tip_moment(ARM, [1e6, -1e6, 3e5]).poses))
     assert np.all(np.isfinite(elastica(ARM, [0.0, 0.0, 5e4], extensible=False).poses))
+
+
+@pytest.mark.parametrize("threads", ["2", "3"])
+@pytest.mark.parametrize("name", ["tip_moment helix dead", "tip_moment helix follower",
+                                  "axial_force"])
+def test_threaded_split_equals_one_thread(name, threads, rng, monkeypatch):
+    # The pose kernel splits large batches over threads; with the per-thread minimum lowered,
+    # a batch of 7 is split (unevenly for 3 threads, and a lone arm leaves empty ranges).
+    # Every arm must come out bit for bit as in one thread and as when solved alone.
+    from softarm.analytic import _common
+
+    solve = CASES[name]
+    values = rng.normal(scale=0.8, size=(7, 3))
+    monkeypatch.setenv(_common.THREADS_VARIABLE, "1")
+    serial = solve(values)
+    monkeypatch.setattr(_common, "_PER_THREAD", 1)
+    monkeypatch.setenv(_common.THREADS_VARIABLE, threads)
+    assert _common.thread_count(7 * serial.s.size) == int(threads)
+    split = solve(values)
+    for field in ("poses", "strains", "stresses"):
+        np.testing.assert_array_equal(getattr(split, field), getattr(serial, field))
+    for index in range(values.shape[0]):
+        np.testing.assert_array_equal(solve(values[index]).poses, serial.poses[index])
+
+
+@pytest.mark.parametrize("setting", ["0", "-2", "two", "1.5"])
+def test_bad_thread_setting_names_the_variable(setting, monkeypatch):
+    monkeypatch.setenv("SOFTARM_NUM_THREADS", setting)
+    with pytest.raises(ValueError, match=rf"SOFTARM_NUM_THREADS.*positive integer.*{setting}"):
+        tip_moment(ARM, [0.0, 1.0, 0.0])

@@ -10,6 +10,9 @@ H(s) = exp_SE3(s (u; ω)) · exp_SE3(s (0; τ e1)) (NOTES.md note 4, eq. 32 for 
 
 from __future__ import annotations
 
+import os
+from concurrent.futures import ThreadPoolExecutor
+
 import numpy as np
 
 from .._validate import as_vectors
@@ -100,7 +103,55 @@ def constant_strain_poses(f: np.ndarray, s: np.ndarray) -> np.ndarray:
 #: of this many floats, 640 KiB) and the block of output it expands to stay in the L2 cache.
 _BLOCK = 8192
 
+#: Arm × station elements each thread of :func:`screw_poses` gets at least (about 5 ms of
+#: work), so that starting a thread never costs more than a small fraction of what it saves.
+_PER_THREAD = 64 * _BLOCK
+
+#: Environment variable capping the threads of :func:`screw_poses` (default: the CPUs this
+#: process may run on).
+THREADS_VARIABLE = "SOFTARM_NUM_THREADS"
+
 _EYE3 = np.eye(3)
+
+
+def thread_count(elements: int) -> int:
+    """Threads for a kernel writing ``elements`` (arm, station) pairs: 1 for small work.
+
+    At most ``$SOFTARM_NUM_THREADS`` (a positive integer) or, unset, the CPUs available to the
+    process; at least ``_PER_THREAD`` elements per thread.
+    """
+    setting = os.environ.get(THREADS_VARIABLE, "").strip()
+    if setting:
+        try:
+            limit = int(setting)
+        except ValueError:
+            limit = 0
+        if limit < 1:
+            raise ValueError(
+                f"environment variable {THREADS_VARIABLE} must be a positive integer (the "
+                f"most threads the closed forms may use), got {setting!r}"
+            )
+    else:
+        limit = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else \
+            (os.cpu_count() or 1)
+    return max(1, min(limit, elements // _PER_THREAD))
+
+
+def in_threads(work, size: int, threads: int) -> None:
+    """``work(first, last)`` over ``range(size)`` split into ``threads`` contiguous ranges.
+
+    The ranges run concurrently (numpy releases the GIL in its loops); each element is
+    computed the same way whatever the split, so the result does not depend on ``threads``.
+    """
+    if threads == 1:
+        work(0, size)
+        return
+    edges = [size * i // threads for i in range(threads + 1)]
+    with ThreadPoolExecutor(threads - 1) as pool:
+        others = [pool.submit(work, edges[i], edges[i + 1]) for i in range(1, threads)]
+        work(edges[0], edges[1])
+        for other in others:
+            other.result()
 
 
 def _broadcast(array: np.ndarray, shape: tuple) -> np.ndarray:
@@ -146,6 +197,9 @@ def screw_poses(u, omega, s, twist=None, fields=None):
     one small matrix product, (N, k) @ (k, 16 + C), straight into the output buffer: the
     output is written once, contiguously, with no (..., N, 3, 3) temporaries. Blocks of about
     ``_BLOCK`` (arm, station) elements keep b and K in cache (a loop over blocks, not arms).
+    Large batches are split into contiguous ranges of arms filled by concurrent threads
+    (:func:`thread_count`, at most ``$SOFTARM_NUM_THREADS``); every arm is computed the same
+    way in any split, so the result does not depend on the number of threads.
 
     Parameters
     ----------
@@ -197,43 +251,48 @@ def screw_poses(u, omega, s, twist=None, fields=None):
     if fields is not None:
         fields = _broadcast(fields, (*batch, 3, columns - 16)).reshape(size, 3, -1)
 
-    # Scratch reused by every block, constant rows written once. Basis rows: 1, s, then
-    # (1 - cos, sin) of φ [and ψ] at rows 2 (4) and 3 (5), then the products 1 - cos φ and
-    # sin φ times 1 - cos ψ and sin ψ at rows 6-9.
-    block = max(1, min(size, _BLOCK // max(n, 1)))
-    basis = np.empty((block, k, n))
-    basis[:, 0] = 1.0
-    basis[:, 1] = s
-    t, q = np.empty((2, block, r, n))
-    K = np.zeros((block, k, columns))
-    pose = K[..., :16].reshape(block, k, 4, 4)
-    pose[:, 0, :3, :3] = _EYE3
-    pose[:, 0, 3, 3] = 1.0
-    rotation = pose[..., :3, :3]
-    if twisted:  # exp(ψ e1~) = I + (1 - cos ψ) (e1 e1ᵀ - I) + sin ψ e1~
-        rotation[:, 4, 1, 1] = rotation[:, 4, 2, 2] = -1.0
-        rotation[:, 5, 2, 1], rotation[:, 5, 1, 2] = 1.0, -1.0
-    for start in range(0, size, block):
-        stop = min(start + block, size)
-        m = stop - start
-        b, R, ab = basis[:m], rotation[:m], a[start:stop]
-        np.multiply(ab[:, :, None], ab[:, None, :], out=R[:, 2])      # a aᵀ - I
-        R[:, 2] -= _EYE3
-        # a~ = [[0, -a₃, a₂], [a₃, 0, -a₁], [-a₂, a₁, 0]], by flat index 4 i + j of the pose
-        K[:m, 3, [9, 2, 4]] = ab
-        K[:m, 3, [6, 8, 1]] = -ab
-        if twisted:  # P Q for Q = e1 e1ᵀ - I: (0, -P₂, -P₃); Q = e1~: (0, P₃, -P₂) by columns
-            products = R[:, 6:10].reshape(m, 2, 2, 3, 3)
-            np.negative(R[:, 2:4, :, 1:], out=products[:, :, 0, :, 1:])
-            products[:, :, 1, :, 1] = R[:, 2:4, :, 2]
-            np.negative(R[:, 2:4, :, 1], out=products[:, :, 1, :, 2])
-        pose[:m, 1:4, :3, 3] = position[start:stop]
-        if fields is not None:
-            K[:m, (0, 4, 5), 16:] = fields[start:stop]
-        _half_angle(rates[start:stop], s, t[:m], q[:m], b[:, 2:2 + 2 * r:2], b[:, 3:3 + 2 * r:2])
-        if twisted:
-            np.multiply(b[:, 2:4, None], b[:, None, 4:6], out=b[:, 6:10].reshape(m, 2, 2, n))
-        np.matmul(b.transpose(0, 2, 1), K[:m], out=flat[start:stop])
+    def fill(first: int, last: int) -> None:
+        """Write arms first..last-1, block by block, with scratch of its own."""
+        # Scratch reused by every block, constant rows written once. Basis rows: 1, s, then
+        # (1 - cos, sin) of φ [and ψ] at rows 2 (4) and 3 (5), then the products 1 - cos φ and
+        # sin φ times 1 - cos ψ and sin ψ at rows 6-9.
+        block = max(1, min(last - first, _BLOCK // max(n, 1)))
+        basis = np.empty((block, k, n))
+        basis[:, 0] = 1.0
+        basis[:, 1] = s
+        t, q = np.empty((2, block, r, n))
+        K = np.zeros((block, k, columns))
+        pose = K[..., :16].reshape(block, k, 4, 4)
+        pose[:, 0, :3, :3] = _EYE3
+        pose[:, 0, 3, 3] = 1.0
+        rotation = pose[..., :3, :3]
+        if twisted:  # exp(ψ e1~) = I + (1 - cos ψ) (e1 e1ᵀ - I) + sin ψ e1~
+            rotation[:, 4, 1, 1] = rotation[:, 4, 2, 2] = -1.0
+            rotation[:, 5, 2, 1], rotation[:, 5, 1, 2] = 1.0, -1.0
+        for start in range(first, last, block):
+            stop = min(start + block, last)
+            m = stop - start
+            b, R, ab = basis[:m], rotation[:m], a[start:stop]
+            np.multiply(ab[:, :, None], ab[:, None, :], out=R[:, 2])      # a aᵀ - I
+            R[:, 2] -= _EYE3
+            # a~ = [[0, -a₃, a₂], [a₃, 0, -a₁], [-a₂, a₁, 0]], by flat index 4 i + j of the pose
+            K[:m, 3, [9, 2, 4]] = ab
+            K[:m, 3, [6, 8, 1]] = -ab
+            if twisted:  # P Q, Q = e1 e1ᵀ - I: (0, -P₂, -P₃); Q = e1~: (0, P₃, -P₂) by column
+                products = R[:, 6:10].reshape(m, 2, 2, 3, 3)
+                np.negative(R[:, 2:4, :, 1:], out=products[:, :, 0, :, 1:])
+                products[:, :, 1, :, 1] = R[:, 2:4, :, 2]
+                np.negative(R[:, 2:4, :, 1], out=products[:, :, 1, :, 2])
+            pose[:m, 1:4, :3, 3] = position[start:stop]
+            if fields is not None:
+                K[:m, (0, 4, 5), 16:] = fields[start:stop]
+            _half_angle(rates[start:stop], s, t[:m], q[:m],
+                        b[:, 2:2 + 2 * r:2], b[:, 3:3 + 2 * r:2])
+            if twisted:
+                np.multiply(b[:, 2:4, None], b[:, None, 4:6], out=b[:, 6:10].reshape(m, 2, 2, n))
+            np.matmul(b.transpose(0, 2, 1), K[:m], out=flat[start:stop])
+
+    in_threads(fill, size, thread_count(size * n))
     buffer.setflags(write=False)
     poses = buffer[..., :16].reshape(*batch, n, 4, 4)
     return poses, (None if fields is None else buffer[..., 16:])
