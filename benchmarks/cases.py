@@ -23,25 +23,15 @@ from pathlib import Path
 
 import numpy as np
 
-try:  # imported as part of a package (``benchmarks.cases``)
-    from .peers import (
-        RodProblem,
-        pyelastica_problem,
-        pyelastica_static,
-        pyelastica_warmup,
-        shooting_cosserat,
-        solve_bvp_cosserat,
-    )
-except ImportError:  # run as a script, or benchmarks/ itself on sys.path
-    sys.path.insert(0, str(Path(__file__).resolve().parent))
-    from peers import (
-        RodProblem,
-        pyelastica_problem,
-        pyelastica_static,
-        pyelastica_warmup,
-        shooting_cosserat,
-        solve_bvp_cosserat,
-    )
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from peers import (  # benchmarks/ is not a package (as in run.py and throughput.py)
+    RodProblem,
+    pyelastica_problem,
+    pyelastica_static,
+    pyelastica_warmup,
+    shooting_cosserat,
+    solve_bvp_cosserat,
+)
 
 __all__ = ["Case", "cases", "mattiasson_table"]
 
