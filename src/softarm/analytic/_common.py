@@ -107,7 +107,7 @@ _BLOCK = 8192
 
 #: Arm × station elements each thread of :func:`screw_poses` gets at least: 1-3 ms of work,
 #: against about 0.1 ms to start a thread (a batch of 1000 helices × 101 stations already runs
-#: 1.3× faster on two threads).
+#: 1.3-1.7× faster on two threads).
 _PER_THREAD = 4 * _BLOCK
 
 #: Environment variable capping the threads of :func:`screw_poses` (default: the CPUs this
