@@ -15,6 +15,7 @@ it otherwise).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import gc
 import json
 import os
@@ -161,26 +162,34 @@ def closed_form_throughput(n_arms: int, chunk: int, n_stations: int = 100,
     measurement; None keeps softarm's default (the CPUs available). numpy's writes are
     single-threaded either way.
     """
-    import softarm
-    from softarm.analytic import _common, tip_moment
+    from softarm.analytic import _common
 
-    saved = os.environ.get(_common.THREADS_VARIABLE)
-    if threads is not None:
-        os.environ[_common.THREADS_VARIABLE] = str(threads)
-    try:
-        result = _closed_form_chunks(tip_moment, softarm.Arm, n_arms, chunk, n_stations,
-                                     principal, seed)
+    with _thread_cap(_common.THREADS_VARIABLE, threads):
+        result = _closed_form_chunks(n_arms, chunk, n_stations, principal, seed)
         result["threads"] = _common.thread_count(min(chunk, n_arms) * n_stations)
-    finally:
-        if saved is None:
-            os.environ.pop(_common.THREADS_VARIABLE, None)
-        else:
-            os.environ[_common.THREADS_VARIABLE] = saved
     return result
 
 
-def _closed_form_chunks(tip_moment, Arm, n_arms, chunk, n_stations, principal, seed) -> dict:
+@contextlib.contextmanager
+def _thread_cap(variable: str, threads: int | None):
+    """The environment variable set to ``threads`` inside the block (None: left as it is)."""
+    saved = os.environ.get(variable)
+    if threads is not None:
+        os.environ[variable] = str(threads)
+    try:
+        yield
+    finally:
+        if saved is None:
+            os.environ.pop(variable, None)
+        else:
+            os.environ[variable] = saved
+
+
+def _closed_form_chunks(n_arms, chunk, n_stations, principal, seed) -> dict:
     """The timed loop of :func:`closed_form_throughput`."""
+    from softarm import Arm
+    from softarm.analytic import tip_moment
+
     EIz = 2.0 if principal else 1.0
     arm = Arm.from_stiffness(1.0, EA=1e9, GAy=1e9, GAz=1e9, GJ=1.0 / 1.5, EIy=1.0, EIz=EIz)
     rng = np.random.default_rng(seed)
