@@ -12,7 +12,7 @@ import numpy as np
 
 from . import analytic
 from .equilibrium import Equilibrium
-from .loads import DistributedForce, Gravity, PointLoad, TipLoad, as_loads, batch_shape
+from .loads import as_loads, batch_shape
 from .statics import Solver
 
 __all__ = ["METHODS", "solve", "solve_prepared"]
@@ -22,23 +22,8 @@ METHODS = ("auto", "numeric", "analytic")
 
 
 def _in_base_frame(loads, R: np.ndarray) -> tuple:
-    """The dead (spatial) loads with components in the base frame (follower loads unchanged)."""
-
-    def rotate(v):
-        return np.einsum("ji,...j->...i", R, v)  # Rᵀ v
-
-    out = []
-    for load in loads:
-        if isinstance(load, TipLoad):
-            out.append(load if load.follower else TipLoad(rotate(load.force),
-                                                          rotate(load.moment)))
-        elif isinstance(load, Gravity):
-            out.append(Gravity(rotate(load.acceleration)))
-        elif isinstance(load, DistributedForce):
-            out.append(DistributedForce(rotate(load.force)))
-        elif isinstance(load, PointLoad):
-            out.append(PointLoad(load.s, rotate(load.force), rotate(load.moment)))
-    return tuple(out)
+    """The loads with dead (spatial) components in the base frame (follower ones unchanged)."""
+    return tuple(load.in_base_frame(R) for load in loads)
 
 
 def _closed_form(arm, loads, s, H0) -> Equilibrium | None:
@@ -54,8 +39,15 @@ def _closed_form(arm, loads, s, H0) -> Equilibrium | None:
     return dataclasses.replace(result, poses=poses, loads=loads)
 
 
-def solve(arm, loads, *, method="auto", s=None, tol=1e-8, base=None, **options) -> Equilibrium:
+def solve(arm, loads, *, method="auto", s=None, tol=1e-8, base=None, jacobians=False,
+          **options) -> Equilibrium:
     """Static equilibrium of a clamped arm under any combination of loads.
+
+    The answer is defined: the equilibrium connected to the unloaded arm along the
+    proportional loading path λ·loads, λ from 0 to 1, followed continuously. Every case of a
+    batch is solved on its own path, so it does not depend on the batch order, on its
+    neighbours or on ``tol`` (beyond tol itself). If the path meets a fold before λ = 1 (the
+    arm would snap), a ConvergenceError names the load factor of the fold.
 
     Parameters
     ----------
@@ -76,9 +68,14 @@ def solve(arm, loads, *, method="auto", s=None, tol=1e-8, base=None, **options) 
         is raised until the step-doubling error estimate is ≤ tol·L).
     base : array_like, shape (4, 4), optional
         Pose of the clamped base in the spatial frame (default identity).
+    jacobians : bool
+        If True, also return the exact tip compliance ``tip_compliance`` (B..., 6, 6) and the
+        station compliances ``compliance`` (B..., N, 6, 6): (δp; δθ), spatial, per unit extra
+        dead tip wrench (δF; δM), spatial (δR = δθ~ R), from the variational equations and
+        the implicit function theorem. Forces the numerical route.
     **options
-        Passed to :class:`softarm.statics.Solver` (``max_iterations``, ``continuation``,
-        ``max_step``, ``steps``, ``max_steps``, ``max_shootings``); checked on every route.
+        Passed to :class:`softarm.statics.Solver` (``max_iterations``, ``max_load_step``,
+        ``steps``, ``max_steps``, ``max_shootings``); checked on every route.
 
     Returns
     -------
@@ -102,7 +99,15 @@ def solve(arm, loads, *, method="auto", s=None, tol=1e-8, base=None, **options) 
     ('numeric.shooting', 0.713792)
     """
     _check_method(method)
-    return solve_prepared(Solver(arm, s=s, tol=tol, base=base, **options), loads, method)
+    solver = Solver(arm, s=s, tol=tol, base=base, **options)
+    if not isinstance(jacobians, (bool, np.bool_)):
+        raise TypeError(f"jacobians must be True or False, got {jacobians!r}")
+    if jacobians:
+        if method == "analytic":
+            raise ValueError("jacobians=True needs the numerical route; use method='auto' or "
+                             "'numeric'")
+        return solver.solve_from_unloaded(loads, jacobians=True)
+    return solve_prepared(solver, loads, method)
 
 
 def _check_method(method) -> None:
@@ -113,8 +118,8 @@ def _check_method(method) -> None:
 def solve_prepared(solver: Solver, loads, method="auto") -> Equilibrium:
     """:func:`solve` with a prepared :class:`softarm.statics.Solver` (arm, stations, tol, base).
 
-    The same routes as :func:`solve`; the numerical one reuses ``solver``, so consecutive calls
-    warm-start from each other (the chunks of a sweep, a control loop).
+    The same routes and the same answers as :func:`solve` (every case from the unloaded arm);
+    the numerical one reuses ``solver``'s preparation of the arm.
     """
     _check_method(method)
     if method != "numeric":  # the solver validates the loads itself
@@ -128,4 +133,4 @@ def solve_prepared(solver: Solver, loads, method="auto") -> Equilibrium:
                 "method='analytic' but no exact closed form applies to this arm and these "
                 "loads; use method='auto' or 'numeric'"
             )
-    return solver.solve(loads)
+    return solver.solve_from_unloaded(loads)

@@ -76,6 +76,12 @@ class Equilibrium:
     error_estimate : float or ndarray, shape (B...)
         Estimated position error at the tip in m (0 for exact closed forms, NaN where the
         closed form is an approximation of unknown error).
+    tip_compliance : ndarray, shape (B..., 6, 6), or None
+        With ``solve(..., jacobians=True)``: the tip's (δp; δθ) per unit extra *dead* tip
+        wrench (δF; δM), all spatial components, δR(L) = δθ~ R(L) (m/N, m/(N m), 1/N,
+        1/(N m)). None otherwise.
+    compliance : ndarray, shape (B..., N, 6, 6), or None
+        The same map to every station's (δp(s); δθ(s)), spatial components.
     """
 
     s: np.ndarray
@@ -88,6 +94,8 @@ class Equilibrium:
     exact: bool
     residual: float | np.ndarray = 0.0
     error_estimate: float | np.ndarray = 0.0
+    tip_compliance: np.ndarray | None = None
+    compliance: np.ndarray | None = None
 
     def __post_init__(self):
         for name in ("s", "poses", "strains", "stresses"):

@@ -15,11 +15,16 @@ class ConvergenceError(RuntimeError):
         the tip wrench (N and N m).
     tried : str
         What the solver tried before giving up (iterations, load steps).
+    load_factor : float or None
+        The load factor λ (the loads scaled by λ) up to which the loading path was followed,
+        when the failure is tied to one (a fold where the arm would snap); else None.
     """
 
-    def __init__(self, message: str, residual: float, tried: str = ""):
+    def __init__(self, message: str, residual: float, tried: str = "", *,
+                 load_factor: float | None = None):
         self.residual = float(residual)
         self.tried = tried
+        self.load_factor = load_factor
         text = f"{message} (residual {self.residual:.3e}"
         text += f"; tried {tried})" if tried else ")"
         super().__init__(text)

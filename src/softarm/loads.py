@@ -1,14 +1,22 @@
-"""External loads on an arm, each stating its frame.
+"""External loads on an arm, each stating its frame, behind one interface: :class:`Load`.
 
 *Dead* loads keep their components in the fixed (spatial, base) frame whatever the arm does;
 *follower* loads keep their components in the material frame of the cross-section they act on.
 Force and moment arrays may carry leading batch axes, (..., 3): a batch of load cases solved
 together, the batch axes reappearing on every output array.
+
+Every load kind declares, once, in its own class: its batch shape, its components in another
+base frame, the stations where it cuts the arm, what it adds to the solver's load channels
+(:meth:`Load.apply` on a :class:`LoadTarget`), a one-line description and its case-file row.
+The solvers and tools never branch on load kinds: a new kind is a new class here.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import abc
+import dataclasses
+from dataclasses import dataclass, field
+from typing import ClassVar, Protocol
 
 import numpy as np
 
@@ -16,8 +24,10 @@ from ._validate import as_array, as_vectors
 
 __all__ = [
     "DistributedForce",
+    "DistributedMoment",
     "Gravity",
     "Load",
+    "LoadTarget",
     "PointLoad",
     "TipLoad",
     "as_loads",
@@ -34,22 +44,124 @@ def _vector(obj, name: str) -> np.ndarray:
     return array
 
 
-def _force_and_moment(obj) -> None:
-    """Check that ``force`` and ``moment`` have batch shapes that broadcast together."""
-    _vector(obj, "force")
-    _vector(obj, "moment")
+def _broadcast(obj, *names: str) -> tuple[int, ...]:
+    """The batch shape of the named (..., 3) fields, ValueError if they do not broadcast."""
+    shapes = [getattr(obj, name).shape[:-1] for name in names]
     try:
-        np.broadcast_shapes(obj.force.shape[:-1], obj.moment.shape[:-1])
+        return np.broadcast_shapes(*shapes)
     except ValueError:
-        name = type(obj).__name__
+        kind = type(obj).__name__
+        fields_ = " and ".join(f"{kind}.{name}" for name in names)
         raise ValueError(
-            f"{name}.force and {name}.moment must have batch shapes that broadcast, got shapes "
-            f"{obj.force.shape} and {obj.moment.shape}"
+            f"{fields_} must have batch shapes that broadcast, got shapes "
+            f"{[getattr(obj, name).shape for name in names]}"
         ) from None
 
 
+def _check_follower(obj) -> None:
+    if not isinstance(obj.follower, (bool, np.bool_)):
+        raise TypeError(
+            f"{type(obj).__name__}.follower must be True or False, got {obj.follower!r}")
+    object.__setattr__(obj, "follower", bool(obj.follower))
+
+
+def _rotated(R: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Rᵀ v: spatial components re-expressed in a base frame with rotation R."""
+    return np.einsum("ji,...j->...i", R, v)
+
+
+def _fmt(vector: np.ndarray, unit: str) -> str:
+    if vector.ndim > 1:
+        return f"batch {vector.shape[:-1]} in {unit}"
+    return "(" + ", ".join(f"{x:.4g}" for x in vector) + f") {unit}"
+
+
+class LoadTarget(Protocol):
+    """What a load writes into: the load channels of a solver (see :meth:`Load.apply`).
+
+    Every vector broadcasts against the batch shape of the loads being solved. Components
+    are spatial for dead loads and material for follower loads.
+    """
+
+    arm: object  #: the Arm or SegmentedArm being solved
+    length: float  #: its length in m
+
+    def distributed(self, *, force=None, moment=None, follower: bool = False,
+                    span: tuple[float, float] | None = None, per_mass: bool = False) -> None:
+        """A uniform force (N/m) and moment (N m/m) per unit length on ``span`` (m; None: the
+        whole arm); ``per_mass``: the force is an acceleration times the linear density."""
+
+    def point(self, s: float, *, force=None, moment=None) -> None:
+        """A dead point wrench (N, N m) at arc length s (s = L: the tip)."""
+
+    def tip(self, *, force=None, moment=None, follower: bool = False) -> None:
+        """A wrench at the tip, dead or follower."""
+
+
+class Load(abc.ABC):
+    """Base of every load kind.
+
+    A load states its frame (dead: spatial components; follower: material components) and
+    carries batch axes on its arrays. Subclasses define:
+
+    - ``kind``: the case-file name of the kind (``[[load]] kind = ...``);
+    - ``batch_shape``: the broadcast batch shape of its arrays;
+    - :meth:`apply`: what it adds to a solver's load channels (:class:`LoadTarget`);
+    - :meth:`in_base_frame`: the same load with its dead components in another base frame;
+    - :meth:`describe`: a one-line description.
+
+    :meth:`cuts` (stations where the arm must be cut: point loads, span ends) and
+    :meth:`check` (a check against the arm) have defaults.
+    """
+
+    kind: ClassVar[str]
+    #: The vector fields of the load: (name, unit), in the order of the case file.
+    vectors: ClassVar[tuple[tuple[str, str], ...]]
+
+    @property
+    @abc.abstractmethod
+    def batch_shape(self) -> tuple[int, ...]:
+        """The broadcast batch shape of the load's arrays."""
+
+    @abc.abstractmethod
+    def apply(self, target: LoadTarget) -> None:
+        """Add this load to ``target``'s load channels."""
+
+    @abc.abstractmethod
+    def in_base_frame(self, R: np.ndarray) -> Load:
+        """The same load for an arm clamped with base rotation R: dead (spatial) components
+        re-expressed in the base frame (Rᵀ v), follower components unchanged."""
+
+    @abc.abstractmethod
+    def describe(self) -> str:
+        """One line saying what the load is, with its frame and units."""
+
+    def cuts(self, arm) -> tuple[float, ...]:
+        """Arc lengths (m) where the arm must be cut for this load (default: none)."""
+        return ()
+
+    def check(self, arm) -> None:  # noqa: B027 (a default that does nothing on purpose)
+        """ValueError if the load does not fit ``arm`` (default: every load fits)."""
+
+    def scaled(self, factor) -> Load:
+        """The same load with every vector field multiplied by ``factor`` (broadcast)."""
+        factor = np.asarray(factor, dtype=np.float64)[..., None]
+        return self.replace(**{name: getattr(self, name) * factor for name, _ in self.vectors})
+
+    def replace(self, **changes) -> Load:
+        """A copy with some fields changed (validated like a new load)."""
+        return dataclasses.replace(self, **changes)
+
+    def take(self, index) -> Load:
+        """The load of one case (or a sub-batch) of a batch: ``index`` into the batch axes."""
+        shape = self.batch_shape
+        return self.replace(**{
+            name: np.broadcast_to(getattr(self, name), (*shape, 3))[index]
+            for name, _ in self.vectors})
+
+
 @dataclass(frozen=True, eq=False)
-class TipLoad:
+class TipLoad(Load):
     """Force and moment applied at the free end (s = L).
 
     Parameters
@@ -58,7 +170,7 @@ class TipLoad:
         N. Spatial components for a dead load, tip material components for a follower load.
     moment : array_like, shape (..., 3)
         N m, in the same frame as ``force``.
-    follower : bool
+    follower : bool, keyword-only
         False (dead: fixed in space) or True (follower: fixed in the tip's material frame).
 
     Examples
@@ -67,22 +179,39 @@ class TipLoad:
     array([ 0.,  0., -1.])
     """
 
+    kind: ClassVar[str] = "tip"
+    vectors: ClassVar = (("force", "N"), ("moment", "N m"))
+
     force: np.ndarray = (0.0, 0.0, 0.0)
     moment: np.ndarray = (0.0, 0.0, 0.0)
-    follower: bool = False
+    follower: bool = field(default=False, kw_only=True)
 
     def __post_init__(self):
-        _force_and_moment(self)
-        if not isinstance(self.follower, (bool, np.bool_)):
-            raise TypeError(f"TipLoad.follower must be True or False, got {self.follower!r}")
+        _vector(self, "force")
+        _vector(self, "moment")
+        _broadcast(self, "force", "moment")
+        _check_follower(self)
 
     @property
     def batch_shape(self) -> tuple[int, ...]:
-        return np.broadcast_shapes(self.force.shape[:-1], self.moment.shape[:-1])
+        return _broadcast(self, "force", "moment")
+
+    def apply(self, target: LoadTarget) -> None:
+        target.tip(force=self.force, moment=self.moment, follower=self.follower)
+
+    def in_base_frame(self, R) -> TipLoad:
+        if self.follower:
+            return self
+        return TipLoad(_rotated(R, self.force), _rotated(R, self.moment))
+
+    def describe(self) -> str:
+        frame = "follower (tip material frame)" if self.follower else "dead (spatial)"
+        return (f"tip load, {frame}: force {_fmt(self.force, 'N')}, "
+                f"moment {_fmt(self.moment, 'N m')}")
 
 
 @dataclass(frozen=True, eq=False)
-class Gravity:
+class Gravity(Load):
     """Weight of the arm: a dead distributed force μ g per unit length, μ the mass per length.
 
     Parameters
@@ -90,6 +219,9 @@ class Gravity:
     acceleration : array_like, shape (..., 3)
         g in m/s², spatial frame. Default (0, 0, -9.81).
     """
+
+    kind: ClassVar[str] = "gravity"
+    vectors: ClassVar = (("acceleration", "m/s²"),)
 
     acceleration: np.ndarray = (0.0, 0.0, -9.81)
 
@@ -100,29 +232,153 @@ class Gravity:
     def batch_shape(self) -> tuple[int, ...]:
         return self.acceleration.shape[:-1]
 
+    def check(self, arm) -> None:
+        if any(seg.linear_density is None for seg in arm.segments):
+            raise ValueError(
+                "Gravity needs the arm's mass: give the material a density or the arm "
+                "a mass_per_length (Arm.linear_density is None)"
+            )
+
+    def apply(self, target: LoadTarget) -> None:
+        target.distributed(force=self.acceleration, per_mass=True)
+
+    def in_base_frame(self, R) -> Gravity:
+        return Gravity(_rotated(R, self.acceleration))
+
+    def describe(self) -> str:
+        return f"gravity {_fmt(self.acceleration, 'm/s²')}"
+
+
+def _check_span(obj) -> None:
+    """``span`` = (s0, s1) with 0 <= s0 < s1, or None; ``segment`` a segment index or None."""
+    name = type(obj).__name__
+    if obj.span is not None and obj.segment is not None:
+        raise ValueError(f"{name}: give span or segment, not both "
+                         f"(got span={obj.span!r}, segment={obj.segment!r})")
+    if obj.segment is not None:
+        if isinstance(obj.segment, bool) or not isinstance(obj.segment, (int, np.integer)) \
+                or obj.segment < 0:
+            raise ValueError(f"{name}.segment must be a segment index >= 0, got "
+                             f"{obj.segment!r}")
+        object.__setattr__(obj, "segment", int(obj.segment))
+    if obj.span is not None:
+        span = as_array(obj.span, f"{name}.span")
+        if span.shape != (2,) or not 0.0 <= span[0] < span[1]:
+            raise ValueError(f"{name}.span must be (s0, s1) in m with 0 <= s0 < s1, got "
+                             f"{obj.span!r}")
+        object.__setattr__(obj, "span", (float(span[0]), float(span[1])))
+
+
+def _resolved_span(obj, arm) -> tuple[float, float] | None:
+    """The span of a distributed load on ``arm`` in m (None: the whole arm)."""
+    name = type(obj).__name__
+    if obj.segment is not None:
+        bounds = arm.boundaries
+        if obj.segment >= len(bounds) - 1:
+            raise ValueError(f"{name}.segment must be a segment index in [0, "
+                             f"{len(bounds) - 2}] for this arm, got {obj.segment}")
+        return (float(bounds[obj.segment]), float(bounds[obj.segment + 1]))
+    if obj.span is not None and obj.span[1] > arm.length * (1 + 8 * np.finfo(float).eps):
+        raise ValueError(f"{name}.span must lie on the arm, in [0, L] = [0, {arm.length!r}] "
+                         f"m, got {obj.span!r}")
+    return None if obj.span is None else (obj.span[0], min(obj.span[1], arm.length))
+
+
+def _span_text(obj) -> str:
+    if obj.segment is not None:
+        return f" on segment {obj.segment}"
+    if obj.span is not None:
+        return f" on [{obj.span[0]:.4g}, {obj.span[1]:.4g}] m"
+    return ""
+
 
 @dataclass(frozen=True, eq=False)
-class DistributedForce:
-    """A uniform dead force per unit length along the whole arm.
+class _Distributed(Load):
+    """Shared by the uniform distributed loads: frame, span and segment."""
+
+    follower: bool = field(default=False, kw_only=True)
+    span: tuple[float, float] | None = field(default=None, kw_only=True)
+    segment: int | None = field(default=None, kw_only=True)
+
+    def __post_init__(self):
+        name, _ = self.vectors[0]
+        _vector(self, name)
+        _check_follower(self)
+        _check_span(self)
+
+    @property
+    def batch_shape(self) -> tuple[int, ...]:
+        return getattr(self, self.vectors[0][0]).shape[:-1]
+
+    def cuts(self, arm) -> tuple[float, ...]:
+        span = _resolved_span(self, arm)
+        return () if span is None else span
+
+    def check(self, arm) -> None:
+        _resolved_span(self, arm)
+
+    def apply(self, target: LoadTarget) -> None:
+        name, _ = self.vectors[0]
+        target.distributed(**{name: getattr(self, name)}, follower=self.follower,
+                           span=_resolved_span(self, target.arm))
+
+    def in_base_frame(self, R):
+        if self.follower:
+            return self
+        name, _ = self.vectors[0]
+        return self.replace(**{name: _rotated(R, getattr(self, name))})
+
+    def describe(self) -> str:
+        name, unit = self.vectors[0]
+        frame = "follower (material)" if self.follower else "dead (spatial)"
+        what = "force" if name == "force" else "moment"
+        return (f"distributed {what}, {frame}: {_fmt(getattr(self, name), unit)}"
+                + _span_text(self))
+
+
+@dataclass(frozen=True, eq=False)
+class DistributedForce(_Distributed):
+    """A uniform force per unit length, on the whole arm, a span or a segment.
 
     Parameters
     ----------
     force : array_like, shape (..., 3)
-        N/m, spatial frame.
+        N/m. Spatial components (dead, default) or material components of the section it
+        acts on (``follower=True``: it turns with the section).
+    follower : bool, keyword-only
+    span : (s0, s1), keyword-only, optional
+        Arc lengths in m: the load acts on [s0, s1] only.
+    segment : int, keyword-only, optional
+        Index of the segment of a :class:`~softarm.SegmentedArm` the load acts on.
     """
 
-    force: np.ndarray
+    kind: ClassVar[str] = "distributed"
+    vectors: ClassVar = (("force", "N/m"),)
 
-    def __post_init__(self):
-        _vector(self, "force")
-
-    @property
-    def batch_shape(self) -> tuple[int, ...]:
-        return self.force.shape[:-1]
+    force: np.ndarray = (0.0, 0.0, 0.0)
 
 
 @dataclass(frozen=True, eq=False)
-class PointLoad:
+class DistributedMoment(_Distributed):
+    """A uniform moment per unit length (a couple density), on the whole arm, a span or a
+    segment.
+
+    Parameters
+    ----------
+    moment : array_like, shape (..., 3)
+        N m/m. Spatial components (dead, default) or material components (``follower=True``).
+    follower, span, segment
+        As for :class:`DistributedForce`.
+    """
+
+    kind: ClassVar[str] = "distributed_moment"
+    vectors: ClassVar = (("moment", "N m/m"),)
+
+    moment: np.ndarray = (0.0, 0.0, 0.0)
+
+
+@dataclass(frozen=True, eq=False)
+class PointLoad(Load):
     """A dead force and moment applied at an interior station s.
 
     Parameters
@@ -135,6 +391,9 @@ class PointLoad:
         N m, spatial frame.
     """
 
+    kind: ClassVar[str] = "point"
+    vectors: ClassVar = (("force", "N"), ("moment", "N m"))
+
     s: float
     force: np.ndarray = (0.0, 0.0, 0.0)
     moment: np.ndarray = (0.0, 0.0, 0.0)
@@ -144,30 +403,51 @@ class PointLoad:
         if s.ndim != 0:
             raise ValueError(f"PointLoad.s must be a single arc length in m, got {self.s!r}")
         object.__setattr__(self, "s", float(s))
-        _force_and_moment(self)
+        _vector(self, "force")
+        _vector(self, "moment")
+        _broadcast(self, "force", "moment")
 
     @property
     def batch_shape(self) -> tuple[int, ...]:
-        return np.broadcast_shapes(self.force.shape[:-1], self.moment.shape[:-1])
+        return _broadcast(self, "force", "moment")
+
+    def check(self, arm) -> None:
+        if not 0.0 <= self.s <= arm.length:
+            raise ValueError(
+                f"PointLoad.s must lie on the arm, in [0, L] = [0, {arm.length!r}] m, "
+                f"got {self.s!r}"
+            )
+
+    def cuts(self, arm) -> tuple[float, ...]:
+        return (self.s,)
+
+    def apply(self, target: LoadTarget) -> None:
+        target.point(self.s, force=self.force, moment=self.moment)
+
+    def in_base_frame(self, R) -> PointLoad:
+        return PointLoad(self.s, _rotated(R, self.force), _rotated(R, self.moment))
+
+    def describe(self) -> str:
+        return (f"point load at s = {self.s:.4g} m, dead (spatial): force "
+                f"{_fmt(self.force, 'N')}, moment {_fmt(self.moment, 'N m')}")
 
 
-Load = TipLoad | Gravity | DistributedForce | PointLoad
-_LOAD_KINDS = (TipLoad, Gravity, DistributedForce, PointLoad)
-
-
-def as_loads(loads) -> tuple:
+def as_loads(loads) -> tuple[Load, ...]:
     """A single load or a sequence of loads as a tuple, TypeError for anything else."""
-    if isinstance(loads, _LOAD_KINDS):
+    if isinstance(loads, Load):
         return (loads,)
     try:
         items = tuple(loads)
     except TypeError:
         items = None
-    if items is None or not all(isinstance(item, _LOAD_KINDS) for item in items):
-        raise TypeError(
-            "loads must be a TipLoad, Gravity, DistributedForce or PointLoad, or a list of "
-            f"them, got {loads!r}"
-        )
+    if items is None:
+        raise TypeError(f"loads must be a softarm.Load or a list of them, got {loads!r}")
+    for item in items:
+        if not isinstance(item, Load):
+            raise TypeError(
+                f"loads must be softarm.Load instances (TipLoad, Gravity, DistributedForce, "
+                f"DistributedMoment, PointLoad, ...), got {item!r} of type "
+                f"{type(item).__name__}")
     return items
 
 
@@ -178,3 +458,4 @@ def batch_shape(loads) -> tuple[int, ...]:
         return np.broadcast_shapes(*shapes) if shapes else ()
     except ValueError as error:
         raise ValueError(f"loads have batch shapes {shapes} that do not broadcast") from error
+

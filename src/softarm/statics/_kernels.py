@@ -1,88 +1,157 @@
 """Compiled kernels of the shooting solver (numba, the only compiled module of softarm).
 
+Design notes (layouts, the stage machine, why this file is whole): ``README.md`` beside it.
+
 State along the arm, from the clamped base to the tip: centreline p (3), material frame R
 (3×3, row-major), internal force n and moment m in *spatial* components (3 + 3):
 
-    p' = R v,   R' = R û,   n' = -f,   m' = -p' × n,   (v; u) = f⁰ + K⁻¹ (Rᵀn; Rᵀm),
+    p' = R v,   R' = R û,   n' = -(f_d + R f_f),   m' = -p' × n - (l_d + R l_f),
+    (v; u) = strain(Rᵀn, Rᵀm)   (today f⁰ + K⁻¹ (Rᵀn; Rᵀm), the linear law),
 
-the static Cosserat (Simo–Reissner) rod with the linear law σ = K ε (Grazioso et al. 2018,
-eq. 20 written in spatial components of the stress resultant). Point loads make n and m jump.
+the static Cosserat (Simo–Reissner) rod (Grazioso et al. 2018, eq. 20, with the stress
+resultant in spatial components), under distributed forces and moments that are dead (d,
+spatial components) or follower (f, material components). Point wrenches make n and m jump.
 The unknowns are the base reaction x = (n(0); m(0)); the tip boundary condition is
 
-    r(x) = (n(L) - F_dead - R(L) F_follower;  m(L) - M_dead - R(L) M_follower) = 0.
+    r(x, λ) = (n(L) - F_d - R(L) F_f;  m(L) - M_d - R(L) M_f) = 0.
 
-Integration: classical RK4 on (p, R, n, m) with R projected back onto SO(3) after every step
-(one Newton–Schulz / Björck step, R ← R (3I - RᵀR)/2, Hairer–Lubich–Wanner, *Geometric
-Numerical Integration*, §IV.4: projection keeps the order 4). The Jacobian ∂r/∂x comes from the
-variational equations integrated with the same RK4 stages, with the rotation perturbation
-δR = R δθ~ (δθ in material components):
+Every load is affine in the load factor λ: load(λ) = start + λ (end - start), the homotopy that
+the continuation follows (start = 0: the unloaded arm; start = the previous case: a slowly
+driven arm).
 
-    δθ' = -u × δθ + δu,   δp' = R (δθ × v + δv),   δm' = -δp' × n - p' × δn,   δn' = 0,
-    (δv; δu) = K⁻¹ (Rᵀn × δθ + Rᵀδn;  Rᵀm × δθ + Rᵀδm).
+Integration: classical RK4 with R projected back onto SO(3) after every step (one Björck step,
+R ← R (3I - RᵀR)/2, Hairer–Lubich–Wanner, *Geometric Numerical Integration*, §IV.4). The
+tangents (δp, δθ, δn, δm), δR = R δθ~ with δθ in material components, are integrated with the
+same stages:
 
-Everything per load case (Newton, load stepping, step doubling, output) runs here, so a batch
-of cases is one call with no Python in the loop.
+    δθ' = -u × δθ + δu,   δp' = R (δθ × v + δv),
+    δn' = -R (δθ × f_f) - ∂_λ(f_d + R f_f),
+    δm' = -δp' × n - p' × δn - R (δθ × l_f) - ∂_λ(l_d + R l_f),
+    (δv; δu) = dstrain(Rᵀδn + σ_n × δθ;  Rᵀδm + σ_m × δθ),
+
+where the ∂_λ terms belong to the load-factor column only. Columns 0-5 are the derivatives
+with respect to x (δn(0), δm(0) = e_d), column 6 the one with respect to λ.
 """
 
 from __future__ import annotations
 
 import math
+import os
+import warnings
 
 import numpy as np
 from numba import njit
 
-__all__ = ["MEMORY", "PIECE_MEMORY", "solve_cases"]
+__all__ = ["MEMORY", "OPTIONS", "PIECE_LOADS", "TIP_LOADS", "shoot", "solve_cases"]
+
+
+def _jit(function):
+    """``njit(cache=True)``, or without the cache where numba has nowhere to write it.
+
+    Numba stores its cache beside the source file or in a user cache directory; with a
+    read-only package and no writable cache directory (a service user, a container) it raises
+    at decoration time. softarm then compiles in memory on first use and says so once.
+    """
+    try:
+        return njit(cache=True)(function)
+    except RuntimeError as error:
+        if "cannot cache" not in str(error):
+            raise
+        global _CACHE_WARNED
+        if not _CACHE_WARNED:
+            _CACHE_WARNED = True
+            warnings.warn(
+                "softarm: numba cannot cache the compiled solver here (read-only package and "
+                "no writable cache directory); it compiles on first use in every process. Set "
+                "NUMBA_CACHE_DIR to a writable directory to cache it"
+                + (f" (now {os.environ['NUMBA_CACHE_DIR']!r})"
+                   if "NUMBA_CACHE_DIR" in os.environ else ""),
+                RuntimeWarning, stacklevel=2)
+        return njit(cache=False)(function)
+
+
+_CACHE_WARNED = False
 
 # Status codes returned per load case.
 OK = 0
-NEWTON_FAILED = 1  # Newton and load stepping did not converge
+NEWTON_FAILED = 1  # the corrector did not converge at the final load (refinement)
 TOO_MANY_STEPS = 2  # the error estimate stayed above tol up to the largest step count
+PATH_FAILED = 3  # the loading path could not be followed past a load factor (a fold)
+BUDGET = 4  # the shooting budget ran out
+NOT_FINITE = 5  # the state became non-finite at an accepted point
 
-# Layout of the flat state y (18) and of each tangent row (9).
+# Layout of the state y (18) and of each tangent row (12).
 _P, _R, _N, _M = 0, 3, 12, 15
+_TP, _TT, _TN, _TM = 0, 3, 6, 9
+NT = 12
+LAM = 6  # the tangent column of the load factor
 
-# What a solved case leaves for the next one (the warm start and its first-order predictor):
-# ``memory`` holds the base wrench x (6), the Jacobian ∂r/∂x (36, row-major), the dead and
-# follower tip wrenches (6 + 6), the tip rotation R(L) (9, row-major) and position p(L) (3);
-# ``piece_memory`` (one row per piece) the distributed force (3), the point wrench at the
-# piece start (6), p at the piece start (3) and ∫ p ds over the piece (3).
-_MX, _MJ, _MTD, _MTF, _MRL, _MPL = 0, 6, 42, 48, 54, 63
-MEMORY = 66
-PIECE_MEMORY = 15
-# ``memory_level``: 0 nothing, 1 the base wrench only, 2 everything (predictor usable).
+# Per-piece load channels (PIECE_LOADS = 24): distributed dead force (spatial), follower
+# force (material), dead moment, follower moment, each per unit length; the point wrench at
+# the piece start, dead (spatial) and follower (material).
+FD, FF, LD, LF, JD, JF = _FD, _FF, _LD, _LF, _JD, _JF = 0, 3, 6, 9, 12, 18
+PIECE_LOADS = 24
+# Tip channels (TIP_LOADS = 12): the dead tip wrench (spatial), the follower one (material).
+TD, TF = _TD, _TF = 0, 6
+TIP_LOADS = 12
+
+# Solver options, one float array (OPTIONS long): see solve_cases.
+(_O_TOL, _O_ITER, _O_LOADSTEP, _O_NFIXED, _O_NMAX, _O_BUDGET, _O_CHAINED,
+ _O_JACOBIANS) = range(8)
+OPTIONS = 8
+
+# The memory of a chained (quasi-static) solve, in and out (MEMORY long): x at the coarse
+# step count N (6), x at 2N (6), N, valid (1 if the memory holds a solved case).
+_MXC, _MXF, _MN, _MVALID = 0, 6, 12, 13
+MEMORY = 14
+
+# Continuation: largest first-corrector distance accepted, the distance aimed at by the step
+# control, largest contraction of successive corrector steps, smallest load-factor step.
+_DIST_MAX = 0.25
+_DIST_AIM = 0.1
+_CONTRACTION_MAX = 0.5
+_DLAM_MIN = 1e-5
+# Corrector steps no larger than this end a corrector on the way (not at λ = 1), and the
+# first load step predicts a tip motion of about _FIRST_MOTION (L or rad).
+_LOOSE = 1e-2
+_FIRST_MOTION = 0.3
+# Refinement of a solution under a change of step count: distances are of the order of the
+# discretisation error, far below this.
+_REFINE_MAX = 0.05
 
 
-@njit(cache=True)
-def _cmul(piece_C, j, diag, a0, a1, a2, a3, a4, a5):
-    """C a for the compliance C = K⁻¹ of piece j (6 products if ``diag``, else 36)."""
+@_jit
+def _strain(C, f0, j, diag, s0, s1, s2, s3, s4, s5):
+    """The constitutive step of piece j: strains (v; u) = f⁰ + C σ from the stress σ in
+    material components. With ``f0`` zero rows it is the linear map of the tangents
+    (dstrain); every future law (tendon coupling) replaces this one function."""
     if diag:
-        return (piece_C[j, 0, 0] * a0, piece_C[j, 1, 1] * a1, piece_C[j, 2, 2] * a2,
-                piece_C[j, 3, 3] * a3, piece_C[j, 4, 4] * a4, piece_C[j, 5, 5] * a5)
-    C = piece_C
-    return (C[j, 0, 0] * a0 + C[j, 0, 1] * a1 + C[j, 0, 2] * a2 + C[j, 0, 3] * a3
-            + C[j, 0, 4] * a4 + C[j, 0, 5] * a5,
-            C[j, 1, 0] * a0 + C[j, 1, 1] * a1 + C[j, 1, 2] * a2 + C[j, 1, 3] * a3
-            + C[j, 1, 4] * a4 + C[j, 1, 5] * a5,
-            C[j, 2, 0] * a0 + C[j, 2, 1] * a1 + C[j, 2, 2] * a2 + C[j, 2, 3] * a3
-            + C[j, 2, 4] * a4 + C[j, 2, 5] * a5,
-            C[j, 3, 0] * a0 + C[j, 3, 1] * a1 + C[j, 3, 2] * a2 + C[j, 3, 3] * a3
-            + C[j, 3, 4] * a4 + C[j, 3, 5] * a5,
-            C[j, 4, 0] * a0 + C[j, 4, 1] * a1 + C[j, 4, 2] * a2 + C[j, 4, 3] * a3
-            + C[j, 4, 4] * a4 + C[j, 4, 5] * a5,
-            C[j, 5, 0] * a0 + C[j, 5, 1] * a1 + C[j, 5, 2] * a2 + C[j, 5, 3] * a3
-            + C[j, 5, 4] * a4 + C[j, 5, 5] * a5)
+        return (f0[j, 0] + C[j, 0, 0] * s0, f0[j, 1] + C[j, 1, 1] * s1,
+                f0[j, 2] + C[j, 2, 2] * s2, f0[j, 3] + C[j, 3, 3] * s3,
+                f0[j, 4] + C[j, 4, 4] * s4, f0[j, 5] + C[j, 5, 5] * s5)
+    return (f0[j, 0] + C[j, 0, 0] * s0 + C[j, 0, 1] * s1 + C[j, 0, 2] * s2 + C[j, 0, 3] * s3
+            + C[j, 0, 4] * s4 + C[j, 0, 5] * s5,
+            f0[j, 1] + C[j, 1, 0] * s0 + C[j, 1, 1] * s1 + C[j, 1, 2] * s2 + C[j, 1, 3] * s3
+            + C[j, 1, 4] * s4 + C[j, 1, 5] * s5,
+            f0[j, 2] + C[j, 2, 0] * s0 + C[j, 2, 1] * s1 + C[j, 2, 2] * s2 + C[j, 2, 3] * s3
+            + C[j, 2, 4] * s4 + C[j, 2, 5] * s5,
+            f0[j, 3] + C[j, 3, 0] * s0 + C[j, 3, 1] * s1 + C[j, 3, 2] * s2 + C[j, 3, 3] * s3
+            + C[j, 3, 4] * s4 + C[j, 3, 5] * s5,
+            f0[j, 4] + C[j, 4, 0] * s0 + C[j, 4, 1] * s1 + C[j, 4, 2] * s2 + C[j, 4, 3] * s3
+            + C[j, 4, 4] * s4 + C[j, 4, 5] * s5,
+            f0[j, 5] + C[j, 5, 0] * s0 + C[j, 5, 1] * s1 + C[j, 5, 2] * s2 + C[j, 5, 3] * s3
+            + C[j, 5, 4] * s4 + C[j, 5, 5] * s5)
 
 
-@njit(cache=True)
-def _deriv(work, twork, nt, stage, piece_C, piece_f0, piece_fd, j, diag, lam):
-    """F(y) and the variational right-hand side of the first nt tangent rows, on piece j.
+@_jit
+def _deriv(work, twork, nt, stage, arm, j, now, rate):
+    """F(y) and the right-hand side of the first nt tangent columns, on piece j.
 
-    Reads the state y from ``work[4]`` and the tangents from ``twork[4]``; writes F(y) into
+    Reads the state from ``work[4]`` and the tangents from ``twork[4]``; writes F(y) into
     ``work[stage]`` and the tangent derivatives into ``twork[stage]``. Scalars throughout:
-    no array views (each costs reference counting in the innermost loop), no scratch array
-    (stores into it would alias the state and stop the compiler keeping values in
-    registers), no allocation.
+    no array views (each costs reference counting in the innermost loop), no allocation.
     """
+    C, f0, zero, diag = arm[2], arm[3], arm[4], arm[5]
     Y = 4
     R00, R01, R02 = work[Y, _R], work[Y, _R + 1], work[Y, _R + 2]
     R10, R11, R12 = work[Y, _R + 3], work[Y, _R + 4], work[Y, _R + 5]
@@ -96,93 +165,118 @@ def _deriv(work, twork, nt, stage, piece_C, piece_f0, piece_fd, j, diag, lam):
     s3 = R00 * mx + R10 * my + R20 * mz
     s4 = R01 * mx + R11 * my + R21 * mz
     s5 = R02 * mx + R12 * my + R22 * mz
-    c0, c1, c2, c3, c4, c5 = _cmul(piece_C, j, diag, s0, s1, s2, s3, s4, s5)
-    v0, v1, v2 = piece_f0[j, 0] + c0, piece_f0[j, 1] + c1, piece_f0[j, 2] + c2
-    u0, u1, u2 = piece_f0[j, 3] + c3, piece_f0[j, 4] + c4, piece_f0[j, 5] + c5
-    # p' = R v, R' = R û, n' = -f, m' = -p' × n
+    v0, v1, v2, u0, u1, u2 = _strain(C, f0, j, diag, s0, s1, s2, s3, s4, s5)
+    # follower loads in spatial components: R f_f, R l_f
+    ff0, ff1, ff2 = now[j, _FF], now[j, _FF + 1], now[j, _FF + 2]
+    lf0, lf1, lf2 = now[j, _LF], now[j, _LF + 1], now[j, _LF + 2]
     px = R00 * v0 + R01 * v1 + R02 * v2
     py = R10 * v0 + R11 * v1 + R12 * v2
     pz = R20 * v0 + R21 * v1 + R22 * v2
-    work[stage, _P] = px
-    work[stage, _P + 1] = py
-    work[stage, _P + 2] = pz
-    work[stage, _R] = R01 * u2 - R02 * u1
-    work[stage, _R + 1] = -R00 * u2 + R02 * u0
-    work[stage, _R + 2] = R00 * u1 - R01 * u0
-    work[stage, _R + 3] = R11 * u2 - R12 * u1
-    work[stage, _R + 4] = -R10 * u2 + R12 * u0
-    work[stage, _R + 5] = R10 * u1 - R11 * u0
-    work[stage, _R + 6] = R21 * u2 - R22 * u1
-    work[stage, _R + 7] = -R20 * u2 + R22 * u0
-    work[stage, _R + 8] = R20 * u1 - R21 * u0
-    work[stage, _N] = -lam * piece_fd[j, 0]
-    work[stage, _N + 1] = -lam * piece_fd[j, 1]
-    work[stage, _N + 2] = -lam * piece_fd[j, 2]
-    work[stage, _M] = -(py * nz - pz * ny)
-    work[stage, _M + 1] = -(pz * nx - px * nz)
-    work[stage, _M + 2] = -(px * ny - py * nx)
+    w = work[stage]
+    w[_P] = px
+    w[_P + 1] = py
+    w[_P + 2] = pz
+    w[_R] = R01 * u2 - R02 * u1
+    w[_R + 1] = -R00 * u2 + R02 * u0
+    w[_R + 2] = R00 * u1 - R01 * u0
+    w[_R + 3] = R11 * u2 - R12 * u1
+    w[_R + 4] = -R10 * u2 + R12 * u0
+    w[_R + 5] = R10 * u1 - R11 * u0
+    w[_R + 6] = R21 * u2 - R22 * u1
+    w[_R + 7] = -R20 * u2 + R22 * u0
+    w[_R + 8] = R20 * u1 - R21 * u0
+    w[_N] = -(now[j, _FD] + R00 * ff0 + R01 * ff1 + R02 * ff2)
+    w[_N + 1] = -(now[j, _FD + 1] + R10 * ff0 + R11 * ff1 + R12 * ff2)
+    w[_N + 2] = -(now[j, _FD + 2] + R20 * ff0 + R21 * ff1 + R22 * ff2)
+    w[_M] = -(py * nz - pz * ny) - (now[j, _LD] + R00 * lf0 + R01 * lf1 + R02 * lf2)
+    w[_M + 1] = -(pz * nx - px * nz) - (now[j, _LD + 1] + R10 * lf0 + R11 * lf1 + R12 * lf2)
+    w[_M + 2] = -(px * ny - py * nx) - (now[j, _LD + 2] + R20 * lf0 + R21 * lf1 + R22 * lf2)
     for d in range(nt):
-        th0, th1, th2 = twork[Y, d, 3], twork[Y, d, 4], twork[Y, d, 5]
-        dm0, dm1, dm2 = twork[Y, d, 6], twork[Y, d, 7], twork[Y, d, 8]
-        # δσ = (Rᵀδn + σ_n × δθ; Rᵀδm + σ_m × δθ), δn = e_d for d < 3, else 0
-        e0 = (R00 if d == 0 else (R10 if d == 1 else R20)) if d < 3 else 0.0
-        e1 = (R01 if d == 0 else (R11 if d == 1 else R21)) if d < 3 else 0.0
-        e2 = (R02 if d == 0 else (R12 if d == 1 else R22)) if d < 3 else 0.0
-        c0, c1, c2, c3, c4, c5 = _cmul(
-            piece_C, j, diag,
-            e0 + s1 * th2 - s2 * th1,
-            e1 + s2 * th0 - s0 * th2,
-            e2 + s0 * th1 - s1 * th0,
+        t = twork[Y, d]
+        th0, th1, th2 = t[_TT], t[_TT + 1], t[_TT + 2]
+        dn0, dn1, dn2 = t[_TN], t[_TN + 1], t[_TN + 2]
+        dm0, dm1, dm2 = t[_TM], t[_TM + 1], t[_TM + 2]
+        # δσ = (Rᵀδn + σ_n × δθ; Rᵀδm + σ_m × δθ); δ(v; u) by the constitutive step
+        c0, c1, c2, c3, c4, c5 = _strain(
+            C, zero, j, diag,
+            R00 * dn0 + R10 * dn1 + R20 * dn2 + s1 * th2 - s2 * th1,
+            R01 * dn0 + R11 * dn1 + R21 * dn2 + s2 * th0 - s0 * th2,
+            R02 * dn0 + R12 * dn1 + R22 * dn2 + s0 * th1 - s1 * th0,
             R00 * dm0 + R10 * dm1 + R20 * dm2 + s4 * th2 - s5 * th1,
             R01 * dm0 + R11 * dm1 + R21 * dm2 + s5 * th0 - s3 * th2,
             R02 * dm0 + R12 * dm1 + R22 * dm2 + s3 * th1 - s4 * th0)
-        # δθ × v + δv, rotated to spatial
+        # δp' = R (δθ × v + δv)
         a0 = th1 * v2 - th2 * v1 + c0
         a1 = th2 * v0 - th0 * v2 + c1
         a2 = th0 * v1 - th1 * v0 + c2
         q0 = R00 * a0 + R01 * a1 + R02 * a2
         q1 = R10 * a0 + R11 * a1 + R12 * a2
         q2 = R20 * a0 + R21 * a1 + R22 * a2
-        twork[stage, d, 0] = q0
-        twork[stage, d, 1] = q1
-        twork[stage, d, 2] = q2
-        twork[stage, d, 3] = -(u1 * th2 - u2 * th1) + c3
-        twork[stage, d, 4] = -(u2 * th0 - u0 * th2) + c4
-        twork[stage, d, 5] = -(u0 * th1 - u1 * th0) + c5
-        # δm' = -δp' × n - p' × δn
-        twork[stage, d, 6] = -(q1 * nz - q2 * ny) - (py if d == 2 else 0.0) + (
-            pz if d == 1 else 0.0)
-        twork[stage, d, 7] = -(q2 * nx - q0 * nz) - (pz if d == 0 else 0.0) + (
-            px if d == 2 else 0.0)
-        twork[stage, d, 8] = -(q0 * ny - q1 * nx) - (px if d == 1 else 0.0) + (
-            py if d == 0 else 0.0)
+        # -R (δθ × f_f) and -R (δθ × l_f), material cross products rotated to spatial
+        b0 = -(th1 * ff2 - th2 * ff1)
+        b1 = -(th2 * ff0 - th0 * ff2)
+        b2 = -(th0 * ff1 - th1 * ff0)
+        e0 = -(th1 * lf2 - th2 * lf1)
+        e1 = -(th2 * lf0 - th0 * lf2)
+        e2 = -(th0 * lf1 - th1 * lf0)
+        if d == LAM:  # the loads' own change with λ
+            b0 -= rate[j, _FF]
+            b1 -= rate[j, _FF + 1]
+            b2 -= rate[j, _FF + 2]
+            e0 -= rate[j, _LF]
+            e1 -= rate[j, _LF + 1]
+            e2 -= rate[j, _LF + 2]
+        g0 = R00 * b0 + R01 * b1 + R02 * b2
+        g1 = R10 * b0 + R11 * b1 + R12 * b2
+        g2 = R20 * b0 + R21 * b1 + R22 * b2
+        k0 = R00 * e0 + R01 * e1 + R02 * e2
+        k1 = R10 * e0 + R11 * e1 + R12 * e2
+        k2 = R20 * e0 + R21 * e1 + R22 * e2
+        if d == LAM:
+            g0 -= rate[j, _FD]
+            g1 -= rate[j, _FD + 1]
+            g2 -= rate[j, _FD + 2]
+            k0 -= rate[j, _LD]
+            k1 -= rate[j, _LD + 1]
+            k2 -= rate[j, _LD + 2]
+        o = twork[stage, d]
+        o[_TP] = q0
+        o[_TP + 1] = q1
+        o[_TP + 2] = q2
+        o[_TT] = -(u1 * th2 - u2 * th1) + c3
+        o[_TT + 1] = -(u2 * th0 - u0 * th2) + c4
+        o[_TT + 2] = -(u0 * th1 - u1 * th0) + c5
+        o[_TN] = g0
+        o[_TN + 1] = g1
+        o[_TN + 2] = g2
+        # δm' = -δp' × n - p' × δn - R (δθ × l_f) - ∂_λ l
+        o[_TM] = -(q1 * nz - q2 * ny) - (py * dn2 - pz * dn1) + k0
+        o[_TM + 1] = -(q2 * nx - q0 * nz) - (pz * dn0 - px * dn2) + k1
+        o[_TM + 2] = -(q0 * ny - q1 * nx) - (px * dn1 - py * dn0) + k2
 
 
-@njit(cache=True)
-def _rk4(y, T, h, piece_C, piece_f0, piece_fd, j, diag, lam, work, twork):
-    """One RK4 step of length h on piece j in place (state, and the tangents T (6 or 0
-    rows)), then R ← R (3I - RᵀR)/2: one Björck step towards the nearest rotation.
+@_jit
+def _rk4(y, T, nt, h, arm, j, now, rate, work, twork):
+    """One RK4 step of length h on piece j in place (the state and the first nt tangent
+    columns of T), then R ← R (3I - RᵀR)/2: one Björck step towards the nearest rotation.
 
-    All loops are written out (no slice assignment, no array expression): numba compiles
-    those with shape checks whose error messages pull in its string machinery. No literal
-    argument either (the tangent count is T's row count): numba compiles a callee once per
-    distinct literal it is called with.
+    Loops are written out (no slice assignment, no array expression): numba compiles those
+    with shape checks whose error messages pull in its string machinery.
     """
-    nt = T.shape[0]
     for stage in range(4):  # work rows 0-3: the stage derivatives; row 4: the stage state
         a = 0.0 if stage == 0 else (h if stage == 3 else 0.5 * h)
         prev = max(stage - 1, 0)
         for i in range(18):
             work[4, i] = y[i] + a * work[prev, i] if stage else y[i]
         for d in range(nt):
-            for i in range(9):
+            for i in range(NT):
                 twork[4, d, i] = T[d, i] + a * twork[prev, d, i] if stage else T[d, i]
-        _deriv(work, twork, nt, stage, piece_C, piece_f0, piece_fd, j, diag, lam)
+        _deriv(work, twork, nt, stage, arm, j, now, rate)
     w = h / 6.0
     for i in range(18):
         y[i] += w * (work[0, i] + 2.0 * work[1, i] + 2.0 * work[2, i] + work[3, i])
     for d in range(nt):
-        for i in range(9):
+        for i in range(NT):
             T[d, i] += w * (twork[0, d, i] + 2.0 * twork[1, d, i] + 2.0 * twork[2, d, i]
                             + twork[3, d, i])
     g00 = 1.5 - 0.5 * (y[3] * y[3] + y[6] * y[6] + y[9] * y[9])
@@ -198,82 +292,112 @@ def _rk4(y, T, h, piece_C, piece_f0, piece_fd, j, diag, lam, work, twork):
         y[_R + 3 * i + 2] = a * g02 + b * g12 + c * g22
 
 
-@njit(cache=True)
-def _fill_steps(length, piece_len, N, factor, out):
-    """Steps per piece for a nominal N steps over the whole arm (at least one per piece),
-    times ``factor`` (2 for the fine solution)."""
-    for j in range(piece_len.size):
-        out[j] = factor * max(1, math.ceil(N * piece_len[j] / length - 1e-9))
+@_jit
+def _jump(y, T, nt, now, rate, j):
+    """The point wrench at the start of piece j: n and m drop by W_d + R W_f (and their
+    tangents by R (δθ × W_f), plus ∂_λ W in the load-factor column)."""
+    for half in range(2):
+        at = 3 * half
+        W0, W1, W2 = now[j, _JF + at], now[j, _JF + at + 1], now[j, _JF + at + 2]
+        for i in range(3):
+            y[_N + at + i] -= now[j, _JD + at + i] + (
+                y[_R + 3 * i] * W0 + y[_R + 3 * i + 1] * W1 + y[_R + 3 * i + 2] * W2)
+        for d in range(nt):
+            th0, th1, th2 = T[d, _TT], T[d, _TT + 1], T[d, _TT + 2]
+            c0 = th1 * W2 - th2 * W1
+            c1 = th2 * W0 - th0 * W2
+            c2 = th0 * W1 - th1 * W0
+            if d == LAM:
+                c0 += rate[j, _JF + at]
+                c1 += rate[j, _JF + at + 1]
+                c2 += rate[j, _JF + at + 2]
+            for i in range(3):
+                T[d, _TN + at + i] -= (y[_R + 3 * i] * c0 + y[_R + 3 * i + 1] * c1
+                                       + y[_R + 3 * i + 2] * c2)
+                if d == LAM:
+                    T[d, _TN + at + i] -= rate[j, _JD + at + i]
 
 
-@njit(cache=True)
-def _start(y, base, x):
+@_jit
+def _start(y, T, nt, base, x):
+    """The state at the clamp from the base reaction x, and the tangents' initial values."""
     for i in range(3):
         y[_P + i] = base[i, 3]
-        for j in range(3):
-            y[_R + 3 * i + j] = base[i, j]
+        for k in range(3):
+            y[_R + 3 * i + k] = base[i, k]
         y[_N + i] = x[i]
         y[_M + i] = x[3 + i]
-
-
-@njit(cache=True)
-def _tip_residual(y, lam, tip_dead, tip_fol, r, tip):
-    """The tip position and the boundary residual r of the state y at the tip."""
-    for i in range(3):
-        tip[i] = y[_P + i]
-        R0, R1, R2 = y[_R + 3 * i], y[_R + 3 * i + 1], y[_R + 3 * i + 2]
-        rf = R0 * tip_fol[0] + R1 * tip_fol[1] + R2 * tip_fol[2]
-        rm = R0 * tip_fol[3] + R1 * tip_fol[4] + R2 * tip_fol[5]
-        r[i] = y[_N + i] - lam * (tip_dead[i] + rf)
-        r[3 + i] = y[_M + i] - lam * (tip_dead[3 + i] + rm)
-
-
-@njit(cache=True)
-def _shoot(x, lam, steps, base, pieces, loads, r, J, tip, y, T, work, twork):
-    """Integrate base → tip from the base reaction x: residual r (6) and, if T has 6 rows,
-    the Jacobian J (6×6); with 0 rows the state alone (about half the cost)."""
-    nt = T.shape[0]
-    piece_len, piece_C, diag, piece_f0, piece_fd = pieces
-    jumps, tip_dead, tip_fol = loads
     for d in range(nt):
-        for i in range(9):
+        for i in range(NT):
             T[d, i] = 0.0
-    for d in range(nt // 2):
-        T[3 + d, 6 + d] = 1.0  # δm(0) = e_d; δn = e_d is implicit (constant)
-    _start(y, base, x)
+        if d < 6:
+            T[d, _TN + d] = 1.0  # δ(n(0); m(0)) = e_d
+
+
+@_jit
+def _tip_residual(y, T, nt, tip_now, tip_rate, r, J):
+    """The boundary residual r at the tip and its Jacobian columns J[:, :nt]."""
+    for half in range(2):
+        at = 3 * half
+        F0, F1, F2 = tip_now[_TF + at], tip_now[_TF + at + 1], tip_now[_TF + at + 2]
+        for i in range(3):
+            r[at + i] = y[_N + at + i] - tip_now[_TD + at + i] - (
+                y[_R + 3 * i] * F0 + y[_R + 3 * i + 1] * F1 + y[_R + 3 * i + 2] * F2)
+        for d in range(nt):
+            th0, th1, th2 = T[d, _TT], T[d, _TT + 1], T[d, _TT + 2]
+            c0 = th1 * F2 - th2 * F1
+            c1 = th2 * F0 - th0 * F2
+            c2 = th0 * F1 - th1 * F0
+            if d == LAM:
+                c0 += tip_rate[_TF + at]
+                c1 += tip_rate[_TF + at + 1]
+                c2 += tip_rate[_TF + at + 2]
+            for i in range(3):
+                J[at + i, d] = T[d, _TN + at + i] - (
+                    y[_R + 3 * i] * c0 + y[_R + 3 * i + 1] * c1 + y[_R + 3 * i + 2] * c2)
+                if d == LAM:
+                    J[at + i, d] -= tip_rate[_TD + at + i]
+
+
+@_jit
+def _set_loads(lam, case, now, tip_now):
+    """The loads at load factor λ: start + λ (end - start), per piece and at the tip."""
+    start, rate, tip_start, tip_rate = case
+    for j in range(start.shape[0]):
+        for i in range(PIECE_LOADS):
+            now[j, i] = start[j, i] + lam * rate[j, i]
+    for i in range(TIP_LOADS):
+        tip_now[i] = tip_start[i] + lam * tip_rate[i]
+
+
+@_jit
+def _integrate(x, lam, nt, steps, base, arm, case, scratch, r, J):
+    """Integrate base → tip from the base reaction x at load factor λ: the residual r (6) and
+    the first nt Jacobian columns J[:, :nt] (6 by x, the 7th by λ). The tip state is left in
+    scratch's y and its tangents in T (for the tip motion per unit x)."""
+    y, T, work, twork, now, tip_now = scratch[0], scratch[1], scratch[2], scratch[3], \
+        scratch[4], scratch[5]
+    rate, tip_rate = case[1], case[3]
+    _set_loads(lam, case, now, tip_now)
+    piece_len = arm[1]
+    _start(y, T, nt, base, x)
     for j in range(piece_len.size):
-        for i in range(6):
-            y[_N + i] -= lam * jumps[j, i]
+        _jump(y, T, nt, now, rate, j)
         h = piece_len[j] / steps[j]
         for _ in range(steps[j]):
-            _rk4(y, T, h, piece_C, piece_f0, piece_fd, j, diag, lam, work, twork)
-    _tip_residual(y, lam, tip_dead, tip_fol, r, tip)
-    for d in range(nt):
-        th0, th1, th2 = T[d, 3], T[d, 4], T[d, 5]
-        for half in range(2):
-            F0, F1, F2 = (lam * tip_fol[3 * half], lam * tip_fol[3 * half + 1],
-                          lam * tip_fol[3 * half + 2])
-            # R (F × δθ)
-            c0 = F1 * th2 - F2 * th1
-            c1 = F2 * th0 - F0 * th2
-            c2 = F0 * th1 - F1 * th0
-            for i in range(3):
-                J[3 * half + i, d] = (y[_R + 3 * i] * c0 + y[_R + 3 * i + 1] * c1
-                                      + y[_R + 3 * i + 2] * c2)
-        for i in range(3):
-            J[i, d] += 1.0 if d == i else 0.0
-            J[3 + i, d] += T[d, 6 + i]
+            _rk4(y, T, nt, h, arm, j, now, rate, work, twork)
+    _tip_residual(y, T, nt, tip_now, tip_rate, r, J)
 
 
-@njit(cache=True)
-def _newton_step(A, r, out):
-    """out = -A⁻¹ r by Gaussian elimination with partial pivoting; False if singular."""
-    M = np.empty((6, 6))
-    v = np.empty(6)
+@_jit
+def _linear_solve(A, b, out, cols):
+    """out = A[:, :6]⁻¹ b by Gaussian elimination with partial pivoting; False if singular
+    or not finite. ``cols`` > 0 also solves for the columns A[:, 6:6+cols] into out[:, 1:]."""
+    M = np.empty((6, 7))
     for i in range(6):
-        v[i] = -r[i]
         for k in range(6):
             M[i, k] = A[i, k]
+        M[i, 6] = b[i]
     for c in range(6):
         p = c
         best = abs(M[c, c])
@@ -284,16 +408,14 @@ def _newton_step(A, r, out):
         if not best > 0.0:
             return False
         if p != c:
-            for k in range(6):
+            for k in range(7):
                 M[c, k], M[p, k] = M[p, k], M[c, k]
-            v[c], v[p] = v[p], v[c]
         for i in range(c + 1, 6):
             g = M[i, c] / M[c, c]
-            for k in range(c, 6):
+            for k in range(c, 7):
                 M[i, k] -= g * M[c, k]
-            v[i] -= g * v[c]
     for c in range(5, -1, -1):
-        acc = v[c]
+        acc = M[c, 6]
         for k in range(c + 1, 6):
             acc -= M[c, k] * out[k]
         out[c] = acc / M[c, c]
@@ -303,7 +425,16 @@ def _newton_step(A, r, out):
     return True
 
 
-@njit(cache=True)
+@_jit
+def _newton_step(J, r, dx):
+    """dx = -J_x⁻¹ r."""
+    neg = np.empty(6)
+    for i in range(6):
+        neg[i] = -r[i]
+    return _linear_solve(J, neg, dx, 0)
+
+
+@_jit
 def _norm_scaled(r, scale):
     out = 0.0
     for i in range(6):
@@ -313,270 +444,175 @@ def _norm_scaled(r, scale):
     return out
 
 
-@njit(cache=True)
-def _solve_load(x, x_warm, warm, steps, base, pieces, loads, scale, threshold,
-                max_iterations, continuation, max_step, max_shootings, extrapolate, r, J,
-                tip, dtip, y, T, T0, work, twork, counter):
-    """Full-load Newton from x_warm; failing that, load stepping from the unloaded arm.
+@_jit
+def _distance(dx, T, scale, length):
+    """The size of a change dx of the base reaction, nondimensional: the largest of the tip
+    displacement / L and tip rotation (rad) it causes (to first order, from the tip tangents
+    T[:6]) and of its components in units of ``scale`` (the bending scale times the case's
+    load size, so that a given relative change of the reaction counts alike at any load)."""
+    out = 0.0
+    for i in range(6):
+        out = max(out, abs(dx[i]) / scale[i])
+    for row in range(6):
+        acc = 0.0
+        for d in range(6):
+            acc += T[d, row] * dx[d]
+        out = max(out, abs(acc) / (length if row < 3 else 1.0))
+    if not math.isfinite(out):
+        return np.inf
+    return out
 
-    Newton: each step is limited to ``max_step`` in scaled units (a trust region that keeps
-    load stepping on the branch it started from) and halved until the residual decreases.
-    When the last two full steps show quadratic convergence that predicts the next residual
-    below the threshold, the trial is integrated without tangents (about half the cost) and
-    only re-integrated with them if it did not converge after all; with ``extrapolate`` (at
-    full load) it is not integrated at all: x takes the step and the tip position its
-    linearisation tip + (∂p/∂x) dx (an error of order dx², far below the threshold), which
-    is all the coarse solution of the step doubling is used for. Load stepping: λ from 0
-    (the unloaded arm, x = 0, exact) to 1, secant predictor, the step doubled after a success
-    and halved after a failure, down to 1e-5. True when converged; x, r, J, tip in place.
+
+@_jit
+def _corrector(x, lam, nt, steps, base, arm, case, scratch, scale, dscale, length, threshold,
+               max_iterations, first_limit, loose, r, J, tip, counter):
+    """Newton at fixed λ from the prediction x, accepted only if it stays near it.
+
+    The first step must be no larger than ``first_limit`` (nondimensional, see _distance) and
+    every later step at most half the one before (contraction): a corrector that wanders or
+    stalls is rejected instead of accepted at whatever root it reaches. Converged when the
+    residual is below ``threshold``, or when a step is no larger than ``loose``: that step is
+    taken without integrating again (its error is of the order of its square), the tip
+    position ``tip`` is moved by its linearisation and J is the one of the point before.
+    True when converged; x, r, J (nt columns) and tip hold the solution; x changes even on
+    failure.
     """
-    dx = np.zeros(6)
-    trial = np.empty(6)
-    r_trial = np.empty(6)
-    J_trial = np.empty((6, 6))
-    tip_trial = np.empty(3)
-    x_c = np.zeros(6)
-    x_p = np.zeros(6)
-    lam_c, lam_p = 0.0, 0.0
-    have_prev = False
-    dl = 1.0
-    direct = warm
-    for _ in range(400):
-        if direct:
-            lam = 1.0
-            for i in range(6):
-                x[i] = x_warm[i]
-        else:
-            lam = min(1.0, lam_c + dl)
-            for i in range(6):
-                if have_prev:
-                    x[i] = x_c[i] + (lam - lam_c) * (x_c[i] - x_p[i]) / (lam_c - lam_p)
-                else:
-                    x[i] = x_c[i]
-        # a load step with a good predictor converges fast or not at all: fail it early
-        budget = max_iterations if direct else min(max_iterations, 8)
-        # --- damped Newton at load factor lam, from x ---
-        ok = False
-        res = np.inf
-        res_old = np.inf
-        alpha = 0.0
-        full = False
-        light = False
-        iterations = 0
-        halvings = 0
-        for i in range(6):
-            trial[i] = x[i]
-        while True:
-            _shoot(trial, lam, steps, base, pieces, loads, r_trial, J_trial, tip_trial, y,
-                   T0 if light else T, work, twork)
-            counter[0] += 1
-            res_trial = _norm_scaled(r_trial, scale)
-            if res_trial < res or res_trial <= threshold or (iterations == 0 and halvings == 0):
-                if light and res_trial > threshold:
-                    light = False  # accepted but not converged: its Jacobian is needed
-                    continue
-                for i in range(6):
-                    x[i] = trial[i]
-                    r[i] = r_trial[i]
-                    if not light:
-                        for k in range(6):
-                            J[i, k] = J_trial[i, k]
-                        for k in range(3):
-                            dtip[k, i] = T[i, k]  # ∂p(L)/∂x_i
-                for i in range(3):
-                    tip[i] = tip_trial[i]
-                res_old = res
-                res = res_trial
-                halvings = 0
-                if res <= threshold:
-                    ok = True
-                    break
-                if not math.isfinite(res) or iterations >= budget:
-                    break
-                if not _newton_step(J, r, dx):
-                    break
-                size = 0.0
-                for i in range(6):
-                    size = max(size, abs(dx[i]) / scale[i])
-                alpha = 1.0 if size <= max_step else max_step / size
-                # e_k+1 ≈ e_k³ / e_k-1² after two full steps (quadratic convergence)
-                predicted = res**3 / res_old**2 if full and alpha == 1.0 else np.inf
-                light = predicted <= 0.01 * threshold
-                if predicted <= threshold and extrapolate and lam >= 1.0:
-                    for i in range(6):
-                        x[i] += dx[i]
-                    for k in range(3):
-                        for i in range(6):
-                            tip[k] += dtip[k, i] * dx[i]
-                    ok = True
-                    break
-                full = alpha == 1.0
-                iterations += 1
-            else:
-                halvings += 1
-                if halvings > 5:
-                    break
-                alpha *= 0.5
-                light = False
-                full = False
-            for i in range(6):
-                trial[i] = x[i] + alpha * dx[i]
-        # --- load stepping ---
-        if ok and lam >= 1.0:
+    dx = np.empty(6)
+    previous = np.inf
+    y, T = scratch[0], scratch[1]
+    for k in range(max_iterations + 1):
+        _integrate(x, lam, nt, steps, base, arm, case, scratch, r, J)
+        counter[0] += 1
+        for i in range(3):
+            tip[i] = y[_P + i]
+        res = _norm_scaled(r, scale)
+        if res <= threshold:
             return True
-        if direct:
-            direct = False
-            if not continuation:
+        if k == max_iterations or not math.isfinite(res) or not _newton_step(J, r, dx):
+            return False
+        size = _distance(dx, T, dscale, length)
+        if k == 0:
+            if size > first_limit:
                 return False
-        elif ok:
-            for i in range(6):
-                x_p[i] = x_c[i]
-                x_c[i] = x[i]
-            lam_p = lam_c
-            lam_c = lam
-            have_prev = True
-            dl = min(2.0 * dl, 1.0 - lam_c)
-        else:
-            if not continuation:
-                return False
-            dl *= 0.5
-            if dl < 1e-5 or counter[0] > max_shootings:
-                return False
+        elif size > _CONTRACTION_MAX * previous:
+            # a step at round-off level cannot contract further: accept a tiny residual
+            return res <= 1e3 * threshold
+        previous = size
+        for i in range(6):
+            x[i] += dx[i]
+        if size <= loose:
+            for i in range(3):
+                for d in range(6):
+                    tip[i] += T[d, _TP + i] * dx[d]
+            return True
     return False
 
 
-@njit(cache=True)
-def _predict(x, memory, piece_memory, pieces, loads, scale, max_step, dx):
-    """x ← x_prev - J⁻¹ Δr: the first-order change of the base wrench for the change of the
-    loads since the previous case, with Δr the change of the tip residual along the previous
-    trajectory (tip loads, point loads and distributed forces; exact to first order for tip
-    loads), limited to the trust radius ``max_step``."""
-    piece_len, _, _, _, piece_fd = pieces
-    jumps, tip_dead, tip_fol = loads
-    dr = np.zeros(6)
-    for half in range(2):
-        for i in range(3):
-            k = 3 * half + i
-            acc = memory[_MTD + k] - tip_dead[k]
-            for j in range(3):
-                acc -= memory[_MRL + 3 * i + j] * (tip_fol[3 * half + j]
-                                                   - memory[_MTF + 3 * half + j])
-            dr[k] = acc
-    # A: the force removed from n so far (n(s) = n_prev(s) - A(s)); m' = -p' × n
-    A0, A1, A2 = 0.0, 0.0, 0.0
-    npieces = piece_len.size
-    for j in range(npieces):
-        A0 += jumps[j, 0] - piece_memory[j, 3]
-        A1 += jumps[j, 1] - piece_memory[j, 4]
-        A2 += jumps[j, 2] - piece_memory[j, 5]
-        for i in range(3):
-            dr[3 + i] -= jumps[j, 3 + i] - piece_memory[j, 6 + i]
-        last = j == npieces - 1
-        s0 = (memory[_MPL] if last else piece_memory[j + 1, 9]) - piece_memory[j, 9]
-        s1 = (memory[_MPL + 1] if last else piece_memory[j + 1, 10]) - piece_memory[j, 10]
-        s2 = (memory[_MPL + 2] if last else piece_memory[j + 1, 11]) - piece_memory[j, 11]
-        # ∫ (s - s_j) p' ds over the piece = l p(s_j+1) - ∫ p ds
-        length = piece_len[j]
-        w0 = length * (s0 + piece_memory[j, 9]) - piece_memory[j, 12]
-        w1 = length * (s1 + piece_memory[j, 10]) - piece_memory[j, 13]
-        w2 = length * (s2 + piece_memory[j, 11]) - piece_memory[j, 14]
-        f0 = piece_fd[j, 0] - piece_memory[j, 0]
-        f1 = piece_fd[j, 1] - piece_memory[j, 1]
-        f2 = piece_fd[j, 2] - piece_memory[j, 2]
-        dr[3] += s1 * A2 - s2 * A1 + w1 * f2 - w2 * f1
-        dr[4] += s2 * A0 - s0 * A2 + w2 * f0 - w0 * f2
-        dr[5] += s0 * A1 - s1 * A0 + w0 * f1 - w1 * f0
-        A0 += length * f0
-        A1 += length * f1
-        A2 += length * f2
-    dr[0] -= A0
-    dr[1] -= A1
-    dr[2] -= A2
-    J = np.empty((6, 6))
+@_jit
+def _tangent(J, t):
+    """The path tangent dx/dλ = -J_x⁻¹ J_λ."""
+    rhs = np.empty(6)
     for i in range(6):
-        x[i] = memory[_MX + i]
-        for k in range(6):
-            J[i, k] = memory[_MJ + 6 * i + k]
-    if not _newton_step(J, dr, dx):
-        return
-    size = 0.0
-    for i in range(6):
-        size = max(size, abs(dx[i]) / scale[i])
-    alpha = 1.0 if size <= max_step else max_step / size
-    for i in range(6):
-        x[i] += alpha * dx[i]
+        rhs[i] = -J[i, LAM]
+    return _linear_solve(J, rhs, t, 0)
 
 
-@njit(cache=True)
-def _record(x, steps, base, pieces, loads, s_out, poses, strains, stresses, r, tip, y, ys,
-            T0, work, twork, memory, piece_memory):
-    """Integrate the solution x once more, write every station's outputs, and the tip
-    residual r and position (the same steps as :func:`_shoot`, so the same numbers: this
-    pass doubles as the check of the last chord iteration).
+@_jit
+def _follow(x, steps, base, arm, case, scratch, scale, dscale, length, threshold,
+            max_iterations, max_load_step, max_shootings, r, J, tip, counter, reached):
+    """Follow the equilibrium path from λ = 0 (x: the solution there, exact or close) to
+    λ = 1 by predictor–corrector continuation. True on success, with x, r, J (7 columns) and
+    the tip position at λ = 1 (converged to ``_LOOSE``: the caller refines it); otherwise
+    ``reached[0]`` is the last load factor reached (a fold, or a point the path cannot be
+    followed past).
 
-    A station inside a step is reached by its own RK4 step from the start of that step, so
-    the stations never change the steps of the solution itself. Also leaves the trajectory
-    data of the predictor in ``memory`` and ``piece_memory``.
+    Predictor: the tangent dx/dλ = -J_x⁻¹ J_λ from the variational equations for the first
+    step, then the cubic Hermite extrapolation of the last two points and their tangents.
+    Corrector: :func:`_corrector` (distance and contraction tests). Step control: the first
+    Δλ makes the predicted motion ``_FIRST_MOTION``; then Δλ ← Δλ (aim/δ)^(1/3) within
+    [Δλ/2, 2Δλ], δ the corrector's distance from the predictor; Δλ × 0.4 after a failure; a
+    step that would leave less than half a step to λ = 1 is stretched to reach it.
     """
-    piece_len, piece_C, diag, piece_f0, piece_fd = pieces
-    jumps, tip_dead, tip_fol = loads
-    _start(y, base, x)
-    k = 0
-    ns = s_out.size
-    start = 0.0
-    npieces = piece_len.size
-    for j in range(npieces):
+    reached[0] = 0.0
+    nt = J.shape[1]  # all 7 columns (a variable, not a literal: one compiled version)
+    if not _corrector(x, 0.0, nt, steps, base, arm, case, scratch, scale, dscale, length,
+                      threshold, max_iterations, _REFINE_MAX, _LOOSE, r, J, tip, counter):
+        return False
+    t = np.empty(6)
+    t_new = np.empty(6)
+    x0 = np.empty(6)
+    xp = np.empty(6)  # the point before (λp), and its tangent
+    tp = np.empty(6)
+    dx = np.empty(6)
+    if not _tangent(J, t):
+        return False
+    lam = 0.0
+    lam_p = -1.0  # no point before yet
+    motion = _distance(t, scratch[1], dscale, length)
+    dl = max_load_step if motion <= 0.0 else min(max_load_step, _FIRST_MOTION / motion)
+    while lam < 1.0:
+        if counter[0] > max_shootings:
+            return False
+        if lam + 1.5 * dl >= 1.0:
+            dl = 1.0 - lam
+        target = lam + dl
+        if target >= 1.0 - 1e-12:
+            target = 1.0
         for i in range(6):
-            y[_N + i] -= jumps[j, i]
-        for i in range(3):
-            piece_memory[j, 9 + i] = y[_P + i]
-            piece_memory[j, 12 + i] = 0.0
-        h = piece_len[j] / steps[j]
-        end = start + piece_len[j]
-        last_piece = j == npieces - 1
-        for i in range(steps[j]):
-            t0 = start + i * h
-            t1 = end if i == steps[j] - 1 else start + (i + 1) * h
-            last = last_piece and i == steps[j] - 1
-            while True:
-                station = k < ns and (s_out[k] < t1 or (last and s_out[k] <= t1))
-                for a in range(18):
-                    ys[a] = y[a]
-                _rk4(ys, T0, s_out[k] - t0 if station else h, piece_C, piece_f0,
-                     piece_fd, j, diag, 1.0, work, twork)
-                if not station:
-                    for a in range(3):  # trapezoidal ∫ p ds
-                        piece_memory[j, 12 + a] += 0.5 * h * (y[_P + a] + ys[_P + a])
-                    for a in range(18):
-                        y[a] = ys[a]
-                    break
-                _write(ys, piece_C[j], poses[k], strains[k], stresses[k])
-                k += 1
-        start = end
-    for i in range(k, ns):  # only reached through rounding at s = L
-        for a in range(4):
-            for b in range(4):
-                poses[i, a, b] = poses[k - 1, a, b]
-        for a in range(6):
-            strains[i, a] = strains[k - 1, a]
-            stresses[i, a] = stresses[k - 1, a]
-    for i in range(9):
-        memory[_MRL + i] = y[_R + i]
-    for i in range(3):
-        memory[_MPL + i] = y[_P + i]
-    _tip_residual(y, 1.0, tip_dead, tip_fol, r, tip)
+            x0[i] = x[i]
+        h = lam - lam_p
+        tau = (target - lam_p) / h
+        if lam_p >= 0.0 and tau <= 3.0:
+            # cubic Hermite through (λp, xp, tp) and (λ, x, t), evaluated at the target
+            t2, t3 = tau * tau, tau * tau * tau
+            h00, h10 = 2 * t3 - 3 * t2 + 1.0, t3 - 2 * t2 + tau
+            h01, h11 = -2 * t3 + 3 * t2, t3 - t2
+            for i in range(6):
+                x[i] = h00 * xp[i] + h10 * h * tp[i] + h01 * x0[i] + h11 * h * t[i]
+        else:
+            for i in range(6):
+                x[i] = x0[i] + (target - lam) * t[i]
+        for i in range(6):
+            dx[i] = x[i]  # the prediction
+        ok = _corrector(x, target, nt, steps, base, arm, case, scratch, scale, dscale, length,
+                        threshold, max_iterations, _DIST_MAX, _LOOSE, r, J, tip, counter)
+        if ok:
+            for i in range(6):
+                dx[i] = x[i] - dx[i]  # the corrector's distance from the prediction
+                t_new[i] = t[i]
+            ok = _tangent(J, t_new)
+        if ok:
+            for i in range(6):
+                xp[i] = x0[i]
+                tp[i] = t[i]
+                t[i] = t_new[i]
+            lam_p = lam
+            lam = target
+            reached[0] = lam
+            moved = _distance(dx, scratch[1], dscale, length)
+            grow = 2.0 if moved <= 0.0 else min(2.0, max(0.5, (_DIST_AIM / moved) ** (1 / 3)))
+            dl = min(max_load_step, dl * grow)
+        else:
+            for i in range(6):
+                x[i] = x0[i]
+            dl *= 0.4
+            if dl < _DLAM_MIN:
+                return False
+    return True
 
 
-@njit(cache=True)
-def _write(y, C, pose, strain, stress):
+@_jit
+def _write(y, T, nt, C, pose, strain, stress, E):
+    """One station's outputs: pose, material strain and stress, and (nt = 6) the station's
+    motion per unit base reaction, E = ∂(δp; δθ)/∂x with both rows in spatial components."""
     for i in range(4):
-        for j in range(4):
-            pose[i, j] = 0.0
+        for k in range(4):
+            pose[i, k] = 0.0
     pose[3, 3] = 1.0
     for i in range(3):
         pose[i, 3] = y[_P + i]
-        for j in range(3):
-            pose[i, j] = y[_R + 3 * i + j]
+        for k in range(3):
+            pose[i, k] = y[_R + 3 * i + k]
     for i in range(3):
         stress[i] = y[_R + i] * y[_N] + y[_R + 3 + i] * y[_N + 1] + y[_R + 6 + i] * y[_N + 2]
         stress[3 + i] = (y[_R + i] * y[_M] + y[_R + 3 + i] * y[_M + 1]
@@ -586,186 +622,344 @@ def _write(y, C, pose, strain, stress):
         for k in range(6):
             acc += C[i, k] * stress[k]
         strain[i] = acc
-
-
-@njit(cache=True)
-def _first_guess(length, tol, scale, piece_len, piece_f0, piece_mu, gravity, dist_force,
-                 jumps, tip_dead, tip_fol):
-    """(load scale, first step count) of a batch.
-
-    The load scale (≥ 1) is the largest load in units of the bending scale; the step count
-    comes from an estimate of the total turning of the arm: 0.1 (1 + turning) tol^-1/4.
-    """
-    fs, ms = scale[0], scale[3]
-    tip_f, tip_m, tip_fn, tip_mn, jump, g, gn, dist, distn = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, \
-        0.0, 0.0, 0.0
-    for b in range(tip_dead.shape[0]):
-        fn, mn, gb, db = 0.0, 0.0, 0.0, 0.0
+    for d in range(min(nt, 6)):
         for i in range(3):
-            tip_f = max(tip_f, abs(tip_dead[b, i]) + abs(tip_fol[b, i]))
-            tip_m = max(tip_m, abs(tip_dead[b, 3 + i]) + abs(tip_fol[b, 3 + i]))
-            fn += (tip_dead[b, i] + tip_fol[b, i]) ** 2
-            mn += (tip_dead[b, 3 + i] + tip_fol[b, 3 + i]) ** 2
-            g = max(g, abs(gravity[b, i]))
-            dist = max(dist, abs(dist_force[b, i]))
-            gb += gravity[b, i] ** 2
-            db += dist_force[b, i] ** 2
-        tip_fn = max(tip_fn, math.sqrt(fn))
-        tip_mn = max(tip_mn, math.sqrt(mn))
-        gn = max(gn, math.sqrt(gb))
-        distn = max(distn, math.sqrt(db))
-        for j in range(jumps.shape[1]):
-            for i in range(6):
-                jump = max(jump, abs(jumps[b, j, i]))
-    mu, kappa0 = 0.0, 0.0
+            E[i, d] = T[d, _TP + i]
+            E[3 + i, d] = (y[_R + 3 * i] * T[d, _TT] + y[_R + 3 * i + 1] * T[d, _TT + 1]
+                           + y[_R + 3 * i + 2] * T[d, _TT + 2])
+
+
+@_jit
+def _record(x, nt, steps, base, arm, case, scratch, s_out, out, b, r, J):
+    """Integrate the solution x at λ = 1 once more and write every station's outputs (the
+    same steps as :func:`_integrate`, so the same numbers), the tip residual r and, with
+    nt = 6, the Jacobian J and the station tangents.
+
+    A station inside a step is reached by its own RK4 step from the start of that step, so
+    the stations never change the steps of the solution. A station at a piece start gets the
+    state after the point wrench there (the tip side). The station s = L (and any station
+    past the last step's start) is written from the tip state itself.
+    """
+    y, T, work, twork, now, tip_now, ys, Ts = scratch
+    poses, strains, stresses = out[0][b], out[1][b], out[2][b]
+    E = out[6][b if nt > 0 else 0]  # a (1, S, 6, 6) placeholder without tangents
+    rate, tip_rate = case[1], case[3]
+    piece_start, piece_len, C = arm[0], arm[1], arm[2]
+    _set_loads(1.0, case, now, tip_now)
+    _start(y, T, nt, base, x)
+    k = 0
+    ns = s_out.size
+    npieces = piece_len.size
+    for j in range(npieces):
+        _jump(y, T, nt, now, rate, j)
+        h = piece_len[j] / steps[j]
+        for i in range(steps[j]):
+            t0 = piece_start[j] + i * h
+            last = j == npieces - 1 and i == steps[j] - 1
+            t1 = piece_start[j] + (i + 1) * h if i < steps[j] - 1 else (
+                piece_start[j + 1] if j < npieces - 1 else np.inf)
+            while k < ns and s_out[k] < t1:  # stations inside this step: own steps
+                if last and s_out[k] >= arm[6]:
+                    break  # the tip station: the tip state itself, below
+                for a in range(18):
+                    ys[a] = y[a]
+                for d in range(nt):
+                    for a in range(NT):
+                        Ts[d, a] = T[d, a]
+                _rk4(ys, Ts, nt, s_out[k] - t0, arm, j, now, rate, work, twork)
+                _write(ys, Ts, nt, C[j], poses[k], strains[k], stresses[k], E[k])
+                k += 1
+            _rk4(y, T, nt, h, arm, j, now, rate, work, twork)
+    for i in range(k, ns):
+        _write(y, T, nt, C[npieces - 1], poses[i], strains[i], stresses[i], E[i])
+    _tip_residual(y, T, nt, tip_now, tip_rate, r, J)
+
+
+@_jit
+def _fill_steps(length, piece_len, N, factor, out):
+    """Steps per piece for a nominal N steps over the whole arm (at least one per piece,
+    rounded to the nearest whole number), times ``factor`` (2 for the fine solution)."""
     for j in range(piece_len.size):
-        mu = max(mu, piece_mu[j])
-        kappa0 += piece_len[j] * math.sqrt(piece_f0[j, 3] ** 2 + piece_f0[j, 4] ** 2
-                                           + piece_f0[j, 5] ** 2)
-    load_scale = max(tip_f / fs, tip_m / ms, jump / fs, (g * mu + dist) * length / fs, 1.0)
-    fd = gn * mu + distn
-    wrench = (tip_fn * length**2 / 2 + tip_mn * length + jump * length**2
-              + fd * length**3 / 6) / (fs * length**2)
-    n = math.ceil(0.1 * (1.0 + kappa0 + wrench) * (tol / length) ** -0.25)
-    return load_scale, min(256, max(2, n))
+        out[j] = factor * max(1, math.floor(N * piece_len[j] / length + 0.5))
 
 
-@njit(cache=True)
-def solve_cases(base, length, piece_len, piece_C, piece_f0, piece_mu, gravity,
-                dist_force, jumps, tip_dead, tip_fol, s_out, scale, tol, max_iterations,
-                continuation, max_step, n_initial, n_max, max_shootings, memory,
-                piece_memory, memory_level, poses, strains, stresses, residual,
-                error_estimate, status, work_done):
-    """Solve every load case of a flattened batch, each warm-started from the previous one.
+@_jit
+def _load_size(arm, scale, start, end, tip_start, tip_end):
+    """(w, turning): the case's largest load in units of the bending scale (EI/L² for
+    forces, EI/L for moments; distributed loads times the piece length, at either end of
+    the homotopy) and an estimate of the total turning of the arm (rad) for the first
+    step count."""
+    piece_len = arm[1]
+    L = arm[6]
+    fs, ms = scale[0], scale[3]
+    w = 0.0
+    turning = 0.0
+    for which in range(2):
+        loads = start if which == 0 else end
+        tip = tip_start if which == 0 else tip_end
+        f_tip, m_tip = 0.0, 0.0
+        for i in range(3):
+            f_tip += abs(tip[_TD + i]) + abs(tip[_TF + i])
+            m_tip += abs(tip[_TD + 3 + i]) + abs(tip[_TF + 3 + i])
+        w = max(w, f_tip / fs, m_tip / ms)
+        bend = f_tip * L / ms + m_tip / ms
+        f_along = 0.0
+        for j in range(piece_len.size):
+            f, m, jf, jm = 0.0, 0.0, 0.0, 0.0
+            for i in range(3):
+                f += abs(loads[j, _FD + i]) + abs(loads[j, _FF + i])
+                m += abs(loads[j, _LD + i]) + abs(loads[j, _LF + i])
+                jf += abs(loads[j, _JD + i]) + abs(loads[j, _JF + i])
+                jm += abs(loads[j, _JD + 3 + i]) + abs(loads[j, _JF + 3 + i])
+            f_along += f * piece_len[j] + jf
+            w = max(w, f_along / fs, m * piece_len[j] / ms, jm / ms)
+            bend += (f * piece_len[j] * 0.5 * L + jf * L + m * piece_len[j] + jm) / ms
+        w = max(w, f_along / fs)
+        turning = max(turning, bend)
+    return w, turning
 
-    For each case: a first-order prediction of the base wrench from the previous case
-    (its solution and Jacobian, and the change of the loads); Newton (with load stepping if
-    needed) with N steps; then the 2N-step solution by chord iterations with the N-step
-    Jacobian, from the N-step solution, without tangents (full Newton only if they stall).
-    The tip positions give the Richardson estimate of the error of the 2N solution,
-    |p_2N - p_N| / (2⁴ - 1). N grows (order-4 model) until the estimate is ≤ tol; the 2N
-    solution is the result.
+
+@_jit
+def _first_steps(arm, tol, turning):
+    """The first coarse step count: 0.1 (1 + turning) (tol/L)^-1/4, in [2, 256]."""
+    kappa0 = 0.0
+    for j in range(arm[1].size):
+        kappa0 += arm[1][j] * math.sqrt(arm[3][j, 3] ** 2 + arm[3][j, 4] ** 2
+                                        + arm[3][j, 5] ** 2)
+    rel = tol / arm[6] if math.isfinite(tol) else 1e-8
+    n = math.ceil(0.1 * (1.0 + kappa0 + turning) * rel ** -0.25)
+    return min(256, max(2, n))
+
+
+@_jit
+def _chord(x, J_c, steps, base, arm, case, scratch, scale, threshold, max_iterations, r,
+           J, tip, counter):
+    """The solution at λ = 1 with another step count by chord iterations from x (a solution
+    with a nearby step count) with that solution's Jacobian J_c, state only (no tangents).
+
+    The first step may change x only by a discretisation-sized amount (``_REFINE_MAX``) and
+    each iteration must at least halve the residual. Returns 0 (failed), 1 (converged: r and
+    tip are x's) or 2 (the last step was taken without integrating it, because the observed
+    contraction predicts a residual below the threshold: the output pass checks it, and
+    ``tip`` is the position before that step, an error of the order of the step).
+    """
+    dx = np.empty(6)
+    previous = np.inf
+    none = J.shape[1] - 7  # no tangents (a variable, not a literal: one compiled version)
+    for _ in range(max_iterations):
+        _integrate(x, 1.0, none, steps, base, arm, case, scratch, r, J)
+        counter[0] += 1
+        for i in range(3):
+            tip[i] = scratch[0][_P + i]
+        res = _norm_scaled(r, scale)
+        if res <= threshold:
+            return 1
+        if not res < 0.5 * previous or not _newton_step(J_c, r, dx):
+            return 0
+        if not math.isfinite(previous):  # the first step: a change of discretisation only
+            size = 0.0
+            for i in range(6):
+                size = max(size, abs(dx[i]) / scale[i])
+            if not size <= _REFINE_MAX:
+                return 0
+        # the chord contraction: observed, or at first ~ 0.1 res (the Jacobians of N and 2N
+        # steps differ by the discretisation error, as r does)
+        rate = res / previous if math.isfinite(previous) else 0.1 * res
+        previous = res
+        for i in range(6):
+            x[i] += dx[i]
+        if rate * res <= threshold:
+            return 2
+    return 0
+
+
+@_jit
+def _scratch(npieces):
+    """Work arrays of one integration (state, tangents, RK4 stages, loads at λ, a station's
+    own state and tangents)."""
+    return (np.empty(18), np.empty((7, NT)), np.empty((6, 24)), np.empty((5, 7, NT)),
+            np.empty((npieces, PIECE_LOADS)), np.empty(TIP_LOADS), np.empty(18),
+            np.empty((7, NT)))
+
+
+@_jit
+def _copy(src, dst):
+    for i in range(src.size):
+        dst.flat[i] = src.flat[i]
+
+
+@_jit
+def solve_cases(base, arm, loads, first, options, s_out, memory, out):
+    """Solve every load case of a flattened batch.
+
+    Each case follows its own homotopy from λ = 0 to 1 (see the module docstring): from the
+    unloaded arm (start loads 0, x = 0) unless ``options[_O_CHAINED]``, where case b starts
+    from case b - 1's loads and solution (case 0 from ``first`` and ``memory``): a slowly
+    driven arm. Per case, the stage machine of README.md: the path at N steps (continuation),
+    the solution at 2N (chord iterations, else a checked Newton, else the path at 2N), the
+    Richardson estimate |p_2N - p_N| / 15 against tol, N grown by the order-4 model (a
+    checked Newton from the 2N solution, else the path again) until it is met, then the
+    output pass.
 
     Parameters (B cases, P pieces, S stations)
     ----------
-    base : (4, 4) base pose.  piece_* : (P, ...) the arm cut at joints and point loads.
-    gravity, dist_force : (B, 3); jumps : (B, P, 6) point wrenches at piece starts (spatial);
-    tip_dead : (B, 6) spatial; tip_fol : (B, 6) tip material components.
-    scale : (6,) residual scale (the bending scale of forces and moments); tol : tip position
-    tolerance in m (inf with a fixed step count). n_initial : first N (0: estimate it).
-    Outputs are written into poses (B, S, 4, 4), strains and stresses (B, S, 6), residual,
-    error_estimate (B,), status (B,) and work_done (B, 2) (trajectory integrations, final N).
-    memory (MEMORY,), piece_memory (P, PIECE_MEMORY), memory_level (1,): the warm start,
-    read at the start and overwritten with the last solved case.
+    base : (4, 4) base pose.
+    arm : (piece_start (P,), piece_len (P,), C (P, 6, 6) compliance, f0 (P, 6) reference
+        strain, zero (P, 6), diag (bool: every C diagonal), length, scale (6,) residual scale)
+    loads : (piece (B, P, PIECE_LOADS), tip (B, TIP_LOADS)): each case's loads at λ = 1.
+    first : (piece (P, PIECE_LOADS), tip (TIP_LOADS,)): case 0's start loads when chained.
+    options : (OPTIONS,) tol (m; inf with a fixed step count), max_iterations, max_load_step,
+        fixed step count (0: from tol), largest step count, shootings budget, chained (0/1),
+        jacobians (0/1).
+    memory : (MEMORY,) the chained start (x at N, x at 2N, N, valid), read and rewritten.
+    out : (poses (B, S, 4, 4), strains (B, S, 6), stresses (B, S, 6), info (B, 5) [residual,
+        error estimate, load factor reached, shootings, N], status (B,), J (B, 6, 6) at the
+        solution (jacobians), E (B, S, 6, 6) station motion per unit x (jacobians)).
     """
-    nb = tip_dead.shape[0]
-    npieces = piece_len.size
-    work = np.empty((6, 24))  # RK4 stages, stage state, scratch
-    twork = np.empty((5, 6, 9))
-    y = np.empty(18)
-    ys = np.empty(18)
-    T = np.empty((6, 9))
-    T0 = np.empty((0, 9))  # no tangents
+    piece_loads, tip_loads = loads
+    nb = piece_loads.shape[0]
+    npieces = arm[1].size
+    scale = arm[7]
+    length = arm[6]
+    tol = options[_O_TOL]
+    max_iterations = int(options[_O_ITER])
+    max_load_step = options[_O_LOADSTEP]
+    n_fixed = int(options[_O_NFIXED])
+    n_max = int(options[_O_NMAX])
+    budget = int(options[_O_BUDGET])
+    chained = options[_O_CHAINED] > 0.0
+    nt_out = 6 if options[_O_JACOBIANS] > 0.0 else 0
+    info, status, jac = out[3], out[4], out[5]
+    scratch = _scratch(npieces)
+    start = np.zeros((npieces, PIECE_LOADS))
+    rate = np.empty((npieces, PIECE_LOADS))
+    tip_start = np.zeros(TIP_LOADS)
+    tip_rate = np.empty(TIP_LOADS)
+    case = (start, rate, tip_start, tip_rate)
     r = np.empty(6)
-    J = np.empty((6, 6))
-    J_c = np.empty((6, 6))
-    dx = np.empty(6)
-    tip = np.empty(3)
-    tip_c = np.empty(3)
-    dtip = np.empty((3, 6))
+    J = np.empty((6, 7))
+    J_c = np.empty((6, 7))
     x = np.zeros(6)
-    x_c = np.empty(6)
-    guess = np.zeros(6)
+    x_f = np.zeros(6)
+    tip_c = np.empty(3)
+    tip_f = np.empty(3)
+    dscale = np.empty(6)
+    six, seven = nt_out * 0 + 6, nt_out * 0 + 7  # not literals: one compiled version
+    # a Newton step of this size at N leaves an error of about its square: far below tol
+    final_step = min(1e-3, math.sqrt(0.01 * tol / length)) if math.isfinite(tol) else 1e-9
+    reached = np.zeros(1)
     steps = np.empty(npieces, dtype=np.int64)
-    piece_fd = np.empty((npieces, 3))
     counter = np.zeros(1, dtype=np.int64)
-    off_diagonal = 0.0
-    for j in range(npieces):
-        for i in range(6):
-            for k in range(6):
-                off_diagonal += abs(piece_C[j, i, k]) if i != k else 0.0
-    diag = off_diagonal == 0.0  # a computed bool: a literal True would type a second version
-    load_scale, n_guess = _first_guess(length, tol, scale, piece_len, piece_f0, piece_mu,
-                                       gravity, dist_force, jumps, tip_dead, tip_fol)
-    threshold = 1e-12 * load_scale
-    N = min(n_initial if n_initial > 0 else n_guess, n_max // 2)
-    level = memory_level[0]
-    if level > 0:
-        for i in range(6):
-            x[i] = memory[_MX + i]
     for b in range(nb):
         counter[0] = 0
+        # the homotopy of this case: start loads and their rate of change with λ
+        if chained:
+            for j in range(npieces):
+                for i in range(PIECE_LOADS):
+                    start[j, i] = first[0][j, i] if b == 0 else piece_loads[b - 1, j, i]
+            for i in range(TIP_LOADS):
+                tip_start[i] = first[1][i] if b == 0 else tip_loads[b - 1, i]
         for j in range(npieces):
-            for i in range(3):
-                piece_fd[j, i] = piece_mu[j] * gravity[b, i] + dist_force[b, i]
-        pieces = (piece_len, piece_C, diag, piece_f0, piece_fd)
-        loads = (jumps[b], tip_dead[b], tip_fol[b])
-        if level > 1:
-            _predict(guess, memory, piece_memory, pieces, loads, scale, max_step, dx)
+            for i in range(PIECE_LOADS):
+                rate[j, i] = piece_loads[b, j, i] - start[j, i]
+        for i in range(TIP_LOADS):
+            tip_rate[i] = tip_loads[b, i] - tip_start[i]
+        w, turning = _load_size(arm, scale, start, piece_loads[b], tip_start, tip_loads[b])
+        threshold = 1e-12 * w + 1e-300
+        for i in range(6):
+            dscale[i] = scale[i] * (1.0 + w)
+        warm = chained and memory[_MVALID] > 0.0
+        if n_fixed > 0:
+            N = n_fixed // 2
+        elif warm:
+            N = int(memory[_MN])
         else:
-            for i in range(6):
-                guess[i] = x[i]
+            N = _first_steps(arm, tol, turning)
+        N = min(N, n_max // 2)
         status[b] = OK
         estimate = np.inf
-        stage = 0  # 0: Newton with N steps; 1: chord with 2N; 2: Newton with 2N (fallback)
-        recorded = False  # the outputs hold the final solution
+        path = True  # the coarse solution must come from the path
+        retried = False
+        fine_path = False
+        recorded = False
+        resume = False
         while True:
-            _fill_steps(length, piece_len, N, 1 if stage == 0 else 2, steps)
-            if stage == 1:
-                converged = False
-                res_prev = np.inf
-                recorded = False  # the first shot, from x_N, never converges
-                for _ in range(max_iterations):
-                    if recorded:
-                        _record(x, steps, base, pieces, loads, s_out, poses[b], strains[b],
-                                stresses[b], r, tip, y, ys, T0, work, twork, memory,
-                                piece_memory)
+            if path:
+                # the path on a coarse grid (a third of the steps) unless that failed
+                n_path = N if fine_path or N <= 6 else (N + 2) // 3
+                _fill_steps(length, arm[1], n_path, 1, steps)
+                for i in range(6):
+                    if not warm:
+                        x[i] = 0.0
+                    elif n_path == int(memory[_MN]):
+                        x[i] = memory[_MXC + i]  # exact at this step count
                     else:
-                        _shoot(x, 1.0, steps, base, pieces, loads, r, J, tip, y, T0, work,
-                               twork)
-                    counter[0] += 1
-                    res = _norm_scaled(r, scale)
-                    if res <= threshold:
-                        converged = True
+                        x[i] = memory[_MXF + i]  # close: corrected at λ = 0
+                if not _follow(x, steps, base, arm, case, scratch, scale, dscale, length,
+                               threshold, max_iterations, max_load_step, budget, r, J, tip_c,
+                               counter, reached):
+                    if counter[0] > budget:
+                        status[b] = BUDGET
                         break
-                    if not res < 0.5 * res_prev or not _newton_step(J_c, r, dx):
-                        break  # stalled (or NaN): full Newton instead
-                    # the chord contraction: observed, or at first ~ 0.1 res (the Jacobians
-                    # of N and 2N steps differ by the discretisation error, as r does)
-                    rate = res / res_prev if math.isfinite(res_prev) else 0.1 * res
-                    # the next pass records the outputs if it should be the last one
-                    recorded = rate * res <= threshold
-                    res_prev = res
-                    for i in range(6):
-                        x[i] += dx[i]
-                if not converged:
-                    for i in range(6):
-                        guess[i] = x_c[i]
-                    stage = 2
-                    recorded = False
-                    continue
-            else:
-                ok = _solve_load(x, guess, level > 0 or stage == 2, steps, base, pieces,
-                                 loads, scale, threshold, max_iterations, continuation,
-                                 max_step, max_shootings, stage == 0, r, J, tip, dtip, y, T,
-                                 T0, work, twork, counter)
-                if not ok:
+                    if n_path < N:
+                        fine_path = True
+                        continue
+                    if not retried and 2 * N <= n_max // 2 and n_fixed == 0:
+                        # a fold of the discrete path only? the same path, finer
+                        retried = True
+                        N = 2 * N
+                        continue
+                    status[b] = PATH_FAILED
+                    break
+                # the coarse solution at N, from the end of the path (a checked Newton)
+                _fill_steps(length, arm[1], N, 1, steps)
+                if not _corrector(x, 1.0, seven, steps, base, arm, case, scratch, scale,
+                                  dscale, length, threshold, max_iterations, _REFINE_MAX,
+                                  final_step, r, J, tip_c, counter):
+                    if n_path < N:
+                        fine_path = True
+                        continue
                     status[b] = NEWTON_FAILED
                     break
-                if stage == 0:
-                    for i in range(6):
-                        x_c[i] = x[i]
-                        for k in range(6):
-                            J_c[i, k] = J[i, k]
-                    for i in range(3):
-                        tip_c[i] = tip[i]
-                    stage = 1
+                _copy(J, J_c)
+            if counter[0] > budget:
+                status[b] = BUDGET
+                break
+            # the fine solution, 2N steps (from the coarse one, or where a check left it)
+            _fill_steps(length, arm[1], N, 2, steps)
+            if not resume:
+                _copy(x, x_f)
+            resume = False
+            fine = _chord(x_f, J_c, steps, base, arm, case, scratch, scale, threshold,
+                          max_iterations, r, J, tip_f, counter)
+            if fine == 0:
+                _copy(x, x_f)
+                fine = _corrector(x_f, 1.0, six, steps, base, arm, case, scratch, scale, dscale,
+                                  length, threshold, max_iterations, _REFINE_MAX, 1e-9, r, J,
+                                  tip_f, counter)
+                if not fine:
+                    if 4 * N > n_max or n_fixed > 0:
+                        status[b] = NEWTON_FAILED
+                        break
+                    N = 2 * N  # the fine solution is not near the coarse one: finer path
+                    path = True
                     continue
             d2 = 0.0
             for i in range(3):
-                d2 += (tip[i] - tip_c[i]) ** 2
+                d2 += (tip_f[i] - tip_c[i]) ** 2
             estimate = math.sqrt(d2) / 15.0
-            if estimate <= tol:
+            if estimate <= tol or n_fixed > 0:
+                if fine == 2:
+                    # the output pass integrates the last chord step: it must converge
+                    _record(x_f, nt_out, steps, base, arm, case, scratch, s_out, out, b, r,
+                            J)
+                    counter[0] += 1
+                    if _norm_scaled(r, scale) <= threshold:
+                        recorded = True
+                        break
+                    path = False
+                    resume = True
+                    continue  # not converged after all: chord again from here
                 break
             if 2 * N >= n_max:
                 status[b] = TOO_MANY_STEPS
@@ -773,38 +967,52 @@ def solve_cases(base, length, piece_len, piece_C, piece_f0, piece_mu, gravity,
             # order 4: the coarse N whose fine partner meets tol with a margin
             grow = (estimate / (0.3 * tol)) ** 0.25
             N = min(n_max // 2, max(N + 1, math.ceil(N * grow)))
-            for i in range(6):
-                guess[i] = x[i]
-            stage = 0
-            recorded = False
-            level = max(level, 1)
-        residual[b] = 0.0
-        for i in range(6):
-            if not abs(r[i]) <= residual[b]:  # NaN propagates
-                residual[b] = abs(r[i])
-        error_estimate[b] = estimate
-        work_done[b, 0] = counter[0]
-        work_done[b, 1] = N
+            _fill_steps(length, arm[1], N, 1, steps)
+            _copy(x_f, x)
+            path = not _corrector(x, 1.0, seven, steps, base, arm, case, scratch, scale, dscale,
+                                  length, threshold, max_iterations, _REFINE_MAX, final_step, r, J,
+                                  tip_c, counter)
+            if not path:
+                _copy(J, J_c)
+        info[b, 1] = estimate
+        info[b, 2] = reached[0] if status[b] == PATH_FAILED else 1.0
+        info[b, 4] = N
         if status[b] != OK:
-            level = 0
-            for i in range(6):
-                x[i] = 0.0
+            info[b, 0] = _norm_scaled(r, scale)
+            info[b, 3] = counter[0]
+            if chained:
+                memory[_MVALID] = 0.0
             continue
         if not recorded:
-            _record(x, steps, base, pieces, loads, s_out, poses[b], strains[b], stresses[b],
-                    r, tip, y, ys, T0, work, twork, memory, piece_memory)
+            _fill_steps(length, arm[1], N, 2, steps)
+            _record(x_f, nt_out, steps, base, arm, case, scratch, s_out, out, b, r, J)
+            counter[0] += 1
+        residual = 0.0
         for i in range(6):
-            memory[_MX + i] = x[i]
-            memory[_MTD + i] = tip_dead[b, i]
-            memory[_MTF + i] = tip_fol[b, i]
-            for k in range(6):
-                memory[_MJ + 6 * i + k] = J_c[i, k]
-        for j in range(npieces):
-            for i in range(3):
-                piece_memory[j, i] = piece_fd[j, i]
+            if not abs(r[i]) <= residual:  # NaN propagates
+                residual = abs(r[i])
+        info[b, 0] = residual
+        info[b, 3] = counter[0]
+        if not math.isfinite(residual):
+            status[b] = NOT_FINITE
+        for i in range(6):
+            for k in range(nt_out):
+                jac[b, i, k] = J[i, k]
+        if chained:
             for i in range(6):
-                piece_memory[j, 3 + i] = jumps[b, j, i]
-        level = 2
-        if math.isfinite(tol) and estimate < 0.01 * tol:  # next case: fewer steps may do
-            N = max(2, math.ceil(N * (estimate / (0.3 * tol)) ** 0.25))
-    memory_level[0] = level
+                memory[_MXC + i] = x[i]
+                memory[_MXF + i] = x_f[i]
+            memory[_MN] = N
+            memory[_MVALID] = 1.0 if status[b] == OK else 0.0
+
+
+@_jit
+def shoot(x, lam, steps, base, arm, case, r, J, tip_state, tip_tangents):
+    """The shooting primitive: integrate from the base reaction x (6) at load factor λ with
+    ``steps`` RK4 steps per piece; returns in place the residual r (6), its Jacobian J (6, 7)
+    (columns: ∂r/∂x, then ∂r/∂λ), the tip state (18: p, R row-major, n, m spatial) and the
+    tip tangents (7, 12) (per column: δp spatial, δθ material, δn, δm spatial)."""
+    scratch = _scratch(arm[1].size)
+    _integrate(x, lam, J.shape[1], steps, base, arm, case, scratch, r, J)
+    _copy(scratch[0], tip_state)
+    _copy(scratch[1], tip_tangents)

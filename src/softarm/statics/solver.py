@@ -1,25 +1,26 @@
-"""The geometrically exact static solver: shooting on the base wrench (see docs/solver.md).
+"""The geometrically exact static solver: shooting on the base wrench, with continuation along
+the loading path (see docs/solver.md and README.md beside this file).
 
-Python-side preparation (validation, cutting the arm into uniform pieces at segment joints and
-point-load stations, flattening the batch of loads) lives here; the numerical work, for the
-whole batch at once, is :func:`softarm.statics._kernels.solve_cases`.
+Python-side preparation (validation, cutting the arm into uniform pieces at segment joints,
+point loads and span ends, writing every load into the kernel's load channels) lives here;
+the numerical work, for the whole batch at once, is :func:`softarm.statics._kernels.solve_cases`.
 """
 
 from __future__ import annotations
 
 import functools
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
 from .._validate import as_matrices, stations
 from ..equilibrium import Equilibrium
 from ..errors import ConvergenceError
-from ..loads import DistributedForce, Gravity, PointLoad, TipLoad, as_loads, batch_shape
+from ..loads import as_loads, batch_shape
 from ..model import Arm, SegmentedArm
-from . import _kernels
 
-__all__ = ["METHOD", "Solver", "check_base", "check_tol", "solve_numeric"]
+__all__ = ["METHOD", "ShootResult", "Solver", "check_base", "check_tol", "solve_numeric"]
 
 #: Equilibrium.method of every result of this solver.
 METHOD = "numeric.shooting"
@@ -27,6 +28,18 @@ METHOD = "numeric.shooting"
 _N_MAX = 1 << 15  # largest step count of the fine solution is 2 * _N_MAX / 2
 _IDENTITY = np.eye(4)
 _IDENTITY.setflags(write=False)
+#: The largest load accepted, in units of the bending scale (EI/L², EI/L): beyond it the rod
+#: is a string whose shape double precision cannot follow.
+_LOAD_LIMIT = 1e12
+_BYTES_LIMIT = 1 << 34  # 16 GiB of outputs: refuse before allocating
+
+
+def _kernels():
+    """The compiled module, imported on first use: ``import softarm`` compiles nothing and
+    does not import numba."""
+    from . import _kernels
+
+    return _kernels
 
 
 def check_base(base) -> np.ndarray:
@@ -56,7 +69,7 @@ def _check_arm(arm):
 
 
 def check_tol(tol) -> float:
-    if isinstance(tol, bool) or not isinstance(tol, (int, float, np.floating)):
+    if isinstance(tol, bool) or not isinstance(tol, (int, float, np.floating, np.integer)):
         raise TypeError(f"tol must be a number (tip position tolerance / L), got {tol!r}")
     tol = float(tol)
     if not (math.isfinite(tol) and 1e-13 <= tol <= 1e-1):
@@ -72,6 +85,15 @@ def _check_count(value, name: str, low: int) -> int:
     return int(value)
 
 
+def _normal_positive(values, what: str) -> None:
+    """ValueError unless every value is finite and a positive normal float."""
+    values = np.asarray(values, dtype=np.float64)
+    bad = ~(np.isfinite(values) & (values >= np.finfo(np.float64).tiny))
+    if np.any(bad):
+        raise ValueError(f"{what} must be finite, positive and representable (normal floats), "
+                         f"got {values[bad][0]!r}")
+
+
 class _ArmData:
     """What the solver needs of an arm, computed once per arm (see :func:`_arm_data`).
 
@@ -80,34 +102,44 @@ class _ArmData:
 
     def __init__(self, arm):
         segments = arm.segments
+        self.arm = arm
         self.length = float(arm.length)
-        self.bounds = np.array(arm.boundaries)
+        self.bounds = np.array(arm.boundaries, dtype=np.float64)
         self.K = np.array([seg.stiffness for seg in segments], dtype=np.float64)
+        _normal_positive(np.diagonal(self.K, axis1=1, axis2=2),
+                         "the arm's stiffnesses (EA, GA, GJ, EI)")
         self.C = np.linalg.inv(self.K)
+        if not np.all(np.isfinite(self.C)):
+            raise ValueError("the arm's stiffness matrices must be invertible with a finite "
+                             "compliance")
         self.f0 = np.array([seg.reference_strain for seg in segments], dtype=np.float64)
+        if not np.all(np.isfinite(self.f0 * self.length)):
+            raise ValueError("the arm's reference strains (curvature) times its length must "
+                             "be finite")
         mu = [seg.linear_density for seg in segments]
-        self.massless = any(m is None for m in mu)
-        self.mu = np.array([0.0 if m is None else m for m in mu], dtype=np.float64)
+        self.mu = np.array([np.nan if m is None else m for m in mu], dtype=np.float64)
+        if not np.all(np.isnan(self.mu) | (np.isfinite(self.mu) & (self.mu >= 0.0))):
+            raise ValueError(f"the arm's linear densities must be finite and >= 0 kg/m, got "
+                             f"{self.mu.tolist()!r}")
         bending = float(np.max(self.K[:, [3, 4, 5], [3, 4, 5]]))
         self.force_scale = bending / self.length**2
+        _normal_positive([self.force_scale, bending / self.length],
+                         "the arm's bending scale EI/L² and EI/L")
         self.scale = np.array([self.force_scale] * 3 + [bending / self.length] * 3)
-        # the pieces without interior point loads: the segments themselves
-        self.pieces = self.cut(np.empty(0))
+        self.diag = bool(np.all(self.C[:, ~np.eye(6, dtype=bool)] == 0.0))
 
-    def cut(self, point_s):
-        """Cut the segments at interior point-load stations.
-
-        Returns (starts, lengths, C, f0, mu), one row per piece.
-        """
-        cuts = np.unique(np.concatenate([self.bounds, point_s]))
-        cuts = cuts[(cuts >= 0.0) & (cuts <= self.length)]
-        lengths = np.diff(cuts)
-        keep = lengths > 0.0
-        starts, lengths = cuts[:-1][keep], lengths[keep]
+    @functools.lru_cache(maxsize=16)  # noqa: B019 (per arm data, itself cached per arm)
+    def pieces(self, cuts: tuple[float, ...]) -> tuple:
+        """The kernel's arm tuple for the arm cut at the segment joints and at ``cuts``."""
+        starts = np.unique(np.concatenate([self.bounds, np.asarray(cuts, dtype=np.float64)]))
+        starts = starts[(starts >= 0.0) & (starts < self.length)]
+        ends = np.append(starts[1:], self.length)
+        lengths = ends - starts
         middle = starts + 0.5 * lengths
         segment = np.clip(np.searchsorted(self.bounds, middle) - 1, 0, len(self.K) - 1)
-        return (starts, lengths, np.ascontiguousarray(self.C[segment]),
-                np.ascontiguousarray(self.f0[segment]), self.mu[segment])
+        f0 = np.ascontiguousarray(self.f0[segment])
+        return (starts, lengths, np.ascontiguousarray(self.C[segment]), f0,
+                np.zeros_like(f0), self.diag, self.length, self.scale, self.mu[segment])
 
 
 @functools.lru_cache(maxsize=64)
@@ -132,13 +164,92 @@ def _uniform_stations(length: float, count: int):
     return public, s
 
 
+class _Channels:
+    """The kernel's load channels of a batch (a :class:`~softarm.loads.LoadTarget`): per
+    piece (B, P, PIECE_LOADS) and at the tip (B, TIP_LOADS), filled by each load's
+    :meth:`~softarm.Load.apply`. Views with the batch shape let loads broadcast into them
+    without broadcast copies."""
+
+    def __init__(self, data: _ArmData, pieces: tuple, shape: tuple, count: int):
+        k = _kernels()
+        self.k = k
+        self.arm = data.arm
+        self.length = data.length
+        self.starts, self.lengths, self.mu = pieces[0], pieces[1], pieces[8]
+        P = self.starts.size
+        self.piece = np.zeros((count, P, k.PIECE_LOADS))
+        self.tip_loads = np.zeros((count, k.TIP_LOADS))
+        self._piece = self.piece.reshape(*shape, P, k.PIECE_LOADS)
+        self._tip = self.tip_loads.reshape(*shape, k.TIP_LOADS)
+
+    def _rows(self, span):
+        if span is None:
+            return slice(None)
+        middle = self.starts + 0.5 * self.lengths
+        return np.flatnonzero((middle > span[0]) & (middle < span[1]))
+
+    def distributed(self, *, force=None, moment=None, follower=False, span=None,
+                    per_mass=False):
+        k, rows = self.k, self._rows(span)
+        weight = self.mu[rows][:, None] if per_mass else 1.0
+        if force is not None:
+            at = k.FF if follower else k.FD
+            self._piece[..., rows, at:at + 3] += np.asarray(force)[..., None, :] * weight
+        if moment is not None:
+            at = k.LF if follower else k.LD
+            self._piece[..., rows, at:at + 3] += np.asarray(moment)[..., None, :]
+
+    def point(self, s, *, force=None, moment=None):
+        k = self.k
+        if s >= self.length:
+            self.tip(force=force, moment=moment)
+            return
+        j = max(int(np.searchsorted(self.starts, s, side="right")) - 1, 0)
+        if force is not None:
+            self._piece[..., j, k.JD:k.JD + 3] += force
+        if moment is not None:
+            self._piece[..., j, k.JD + 3:k.JD + 6] += moment
+
+    def tip(self, *, force=None, moment=None, follower=False):
+        at = self.k.TF if follower else self.k.TD
+        if force is not None:
+            self._tip[..., at:at + 3] += force
+        if moment is not None:
+            self._tip[..., at + 3:at + 6] += moment
+
+
+@dataclass(frozen=True)
+class ShootResult:
+    """One integration of the arm from a base reaction (:meth:`Solver.shoot`).
+
+    Attributes
+    ----------
+    residual : ndarray, shape (6,)
+        r(x, λ) = (n(L) - F_d - R(L) F_f; m(L) - M_d - R(L) M_f), N and N m, spatial.
+    jacobian_x : ndarray, shape (6, 6)
+        ∂r/∂x, x = (n(0); m(0)) the base reaction in spatial components.
+    jacobian_load : ndarray, shape (6,)
+        ∂r/∂λ at fixed x.
+    tip_pose : ndarray, shape (4, 4)
+    tip_motion_x : ndarray, shape (6, 6)
+        ∂(δp(L); δθ(L))/∂x, both in spatial components (δR = δθ~ R).
+    """
+
+    residual: np.ndarray
+    jacobian_x: np.ndarray
+    jacobian_load: np.ndarray
+    tip_pose: np.ndarray
+    tip_motion_x: np.ndarray
+
+
 class Solver:
     """A prepared problem: an arm, output stations, a tolerance and a base pose.
 
-    Calling :meth:`solve` with a list of loads returns an :class:`~softarm.Equilibrium`. The
-    arm-side preparation is done once, and each call starts from the previous call's solution
-    and step count, corrected to first order for the change of the loads (the previous
-    Jacobian): the fast path for control loops that solve the same arm many times.
+    :meth:`solve` follows the arm *quasi-statically*, as a slowly driven arm moves: from its
+    previous equilibrium (at first the unloaded arm) continuously to the new loads, and through
+    a batch case after case in order, so hysteresis is possible; :meth:`reset` returns it to
+    the unloaded arm. :func:`softarm.solve` instead solves every case from the unloaded arm,
+    independently of the others. One Solver per thread or worker (it carries state).
 
     Parameters
     ----------
@@ -151,14 +262,10 @@ class Solver:
     base : array_like, shape (4, 4), optional
         Pose of the clamped base (default identity).
     max_iterations : int
-        Newton iterations per attempt (one attempt per load step).
-    continuation : bool
-        If True (default), a failed full-load Newton solve falls back to load stepping from
-        the unloaded arm with adaptive step halving.
-    max_step : float
-        Trust radius of a Newton step, in units of the bending scale (EI/L² for forces, EI/L
-        for moments). Small values keep the load stepping on the branch connected to the
-        unloaded arm.
+        Newton iterations per corrector.
+    max_load_step : float
+        Largest continuation step in the load factor λ, in (0, 1] (default 1: one step where
+        the path is straight enough). Smaller values only cost time; the answer is the same.
     steps : int, optional
         Fix the number of RK4 steps of the solution (an even number, spread over the pieces in
         proportion to their length) instead of choosing it from ``tol``; the error estimate
@@ -166,8 +273,7 @@ class Solver:
     max_steps : int
         Largest number of RK4 steps tried before giving up on ``tol`` (ConvergenceError).
     max_shootings : int
-        Budget of trajectory integrations per load case (Newton iterations, backtracking and
-        load steps together) before a ConvergenceError.
+        Budget of trajectory integrations per load case before a ConvergenceError.
 
     Examples
     --------
@@ -179,9 +285,8 @@ class Solver:
     0.30172
     """
 
-    def __init__(self, arm, *, s=None, tol=1e-8, base=None, max_iterations=30,
-                 continuation=True, max_step=4.0, steps=None, max_steps=_N_MAX,
-                 max_shootings=2000):
+    def __init__(self, arm, *, s=None, tol=1e-8, base=None, max_iterations=12,
+                 max_load_step=1.0, steps=None, max_steps=_N_MAX, max_shootings=3000):
         self.arm = _check_arm(arm)
         self._data = _arm_data(arm)
         self.length = self._data.length
@@ -196,137 +301,142 @@ class Solver:
         self.base = check_base(base)
         self._base_kernel = self.base.copy()  # private and writable (one kernel type)
         self.max_iterations = _check_count(max_iterations, "max_iterations", 1)
-        if not isinstance(continuation, (bool, np.bool_)):
-            raise TypeError(f"continuation must be True or False, got {continuation!r}")
-        self.continuation = bool(continuation)
-        if not (isinstance(max_step, (int, float)) and math.isfinite(max_step) and max_step > 0):
-            raise ValueError(f"max_step must be a positive number, got {max_step!r}")
-        self.max_step = float(max_step)
+        if isinstance(max_load_step, bool) or not isinstance(
+                max_load_step, (int, float, np.integer, np.floating)) \
+                or not 0.0 < float(max_load_step) <= 1.0:
+            raise ValueError(f"max_load_step must be a load-factor step in (0, 1], got "
+                             f"{max_load_step!r}")
+        self.max_load_step = float(max_load_step)
         if steps is not None and (_check_count(steps, "steps", 2) % 2 or steps > _N_MAX):
             raise ValueError(f"steps must be an even integer in [2, {_N_MAX}], got {steps!r}")
         self.steps = steps
         self.max_steps = _check_count(max_steps, "max_steps", 4)
         self.max_shootings = _check_count(max_shootings, "max_shootings", 1)
-        # warm start: step count, and what the last solved case left for the next one
-        self._n = None
-        self._memory = np.zeros(_kernels.MEMORY)
-        self._memory_level = np.zeros(1, dtype=np.int64)
-        self._piece_memory = None
-        self._piece_lengths = None
+        self.reset()
 
-    def _prepare(self, loads):
+    def reset(self) -> None:
+        """Return the quasi-static state to the unloaded arm."""
+        self._memory = np.zeros(14)  # _kernels.MEMORY, without importing the kernels
+        self._last = None  # (cut starts, piece loads, tip loads) of the last solved case
+
+    # ---------------------------------------------------------------- preparation
+
+    def _prepare(self, loads, extra_cuts=()):
+        """(loads, batch shape, count, the kernel's arm tuple, load channels)."""
         loads = as_loads(loads)
         shape = batch_shape(loads)
         count = math.prod(shape)
         data = self._data
-        tip_dead = np.zeros((count, 6))
-        tip_fol = np.zeros((count, 6))
-        gravity = np.zeros((count, 3))
-        dist = np.zeros((count, 3))
-        # views with the batch shape: the loads broadcast into them (no broadcast copies)
-        dead_b, fol_b = tip_dead.reshape(*shape, 6), tip_fol.reshape(*shape, 6)
-        points = []
         for load in loads:
-            if isinstance(load, TipLoad):
-                target = fol_b if load.follower else dead_b
-                target[..., :3] += load.force
-                target[..., 3:] += load.moment
-            elif isinstance(load, Gravity):
-                if data.massless:
-                    raise ValueError(
-                        "Gravity needs the arm's mass: give the material a density or the arm "
-                        "a mass_per_length (Arm.linear_density is None)"
-                    )
-                gravity.reshape(*shape, 3)[...] += load.acceleration
-            elif isinstance(load, DistributedForce):
-                dist.reshape(*shape, 3)[...] += load.force
-            elif isinstance(load, PointLoad):
-                if not 0.0 <= load.s <= self.length:
-                    raise ValueError(
-                        f"PointLoad.s must lie on the arm, in [0, L] = [0, {self.length!r}] m, "
-                        f"got {load.s!r}"
-                    )
-                points.append(load)
-        interior = [p.s for p in points if p.s < self.length]
-        pieces = data.cut(np.array(interior, dtype=np.float64)) if interior else data.pieces
-        starts = pieces[0]
-        jumps = np.zeros((count, starts.size, 6))
-        jumps_b = jumps.reshape(*shape, starts.size, 6)
-        for point in points:
-            if point.s >= self.length:
-                dead_b[..., :3] += point.force
-                dead_b[..., 3:] += point.moment
-            else:
-                j = max(int(np.searchsorted(starts, point.s, side="right") - 1), 0)
-                jumps_b[..., j, :3] += point.force
-                jumps_b[..., j, 3:] += point.moment
-        return loads, shape, count, pieces, (gravity, dist, jumps, tip_dead, tip_fol)
+            load.check(self.arm)
+        cuts = tuple(sorted({float(c) for load in loads for c in load.cuts(self.arm)}
+                            | {float(c) for c in extra_cuts}))
+        pieces = data.pieces(cuts)
+        S = self.s.size
+        need = count * (S * (16 + 12) * 8 + pieces[0].size * 24 * 8)
+        if need > _BYTES_LIMIT:
+            raise ValueError(
+                f"a batch of {count} load cases at {S} stations needs about "
+                f"{need / 2**30:.3g} GiB of outputs (limit {_BYTES_LIMIT / 2**30:.0f} GiB): "
+                "solve it in chunks or with fewer stations")
+        channels = _Channels(data, pieces, shape, count)
+        for load in loads:
+            load.apply(channels)
+        self._check_magnitudes(loads, channels)
+        return loads, shape, count, pieces, channels
 
-    def solve(self, loads) -> Equilibrium:
-        """The equilibrium under ``loads`` (a load or a list of loads, possibly batched).
+    def _check_magnitudes(self, loads, channels) -> None:
+        """ValueError naming the load whose size is not representable against the arm."""
+        k = self.length
+        fs, ms = self._data.scale[0], self._data.scale[3]
+        with np.errstate(over="ignore", invalid="ignore"):
+            piece = np.abs(channels.piece)
+            tip = np.abs(channels.tip_loads)
+            sizes = np.concatenate([
+                (piece[..., :3] + piece[..., 3:6]).sum(-1).ravel() * k / fs,
+                (piece[..., 6:9] + piece[..., 9:12]).sum(-1).ravel() * k / ms,
+                piece[..., 12:15].sum(-1).ravel() / fs, piece[..., 15:18].sum(-1).ravel() / ms,
+                tip[..., [0, 1, 2, 6, 7, 8]].sum(-1).ravel() / fs,
+                tip[..., [3, 4, 5, 9, 10, 11]].sum(-1).ravel() / ms])
+        if sizes.size and not np.max(sizes) <= _LOAD_LIMIT:
+            worst = max(loads, key=_largest)
+            raise ValueError(
+                f"{type(worst).__name__}: a load of {_largest(worst):.3g} (SI units) is not "
+                f"representable on this arm: it exceeds {_LOAD_LIMIT:.0e} times the bending "
+                f"scale (EI/L² = {fs:.3g} N, EI/L = {ms:.3g} N m), where double precision "
+                "cannot follow the shape")
+
+    def _options(self, chained: bool, jacobians: bool) -> np.ndarray:
+        n_fixed = self.steps if self.steps is not None else 0
+        n_max = max(self.max_steps, self.steps or 0)
+        tol = math.inf if self.steps is not None else self.tol * self.length
+        return np.array([tol, self.max_iterations, self.max_load_step, n_fixed, n_max,
+                         self.max_shootings, float(chained), float(jacobians)])
+
+    # ---------------------------------------------------------------- solving
+
+    def solve(self, loads, *, jacobians: bool = False) -> Equilibrium:
+        """The equilibrium reached by driving the arm slowly from its previous equilibrium
+        (the unloaded arm after construction or :meth:`reset`) to ``loads``; a batch is
+        followed case after case in order.
 
         Raises
         ------
         ConvergenceError
-            If Newton with load stepping fails, or the error estimate cannot reach tol.
+            If the loading path meets a fold (the arm would snap; ``load_factor`` says where),
+            Newton fails, or the error estimate cannot reach tol.
         ValueError
-            For loads that do not fit the arm (point load off the arm, gravity without mass).
+            For loads that do not fit the arm (point load off the arm, gravity without mass,
+            a load too large to represent).
         """
-        loads, shape, count, pieces, (gravity, dist, jumps, tip_dead, tip_fol) = \
-            self._prepare(loads)
-        _, lengths, piece_C, piece_f0, piece_mu = pieces
-        if self.steps is not None:
-            n_initial, tol = self.steps // 2, math.inf
-        else:  # 0: the kernel estimates it from the loads
-            n_initial = min(self._n, self.max_steps // 2) if self._n else 0
-            tol = self.tol * self.length
-        if self._piece_lengths is None or not np.array_equal(self._piece_lengths, lengths):
-            # a different cut of the arm (point loads moved): keep only the base wrench
-            self._piece_memory = np.zeros((lengths.size, _kernels.PIECE_MEMORY))
-            self._piece_lengths = lengths
-            self._memory_level[0] = min(self._memory_level[0], 1)
+        return self._solve(loads, chained=True, jacobians=jacobians)
+
+    def solve_from_unloaded(self, loads, *, jacobians: bool = False) -> Equilibrium:
+        """Every case of ``loads`` solved from the unloaded arm, independently of the others
+        and of this Solver's state (what :func:`softarm.solve` returns)."""
+        return self._solve(loads, chained=False, jacobians=jacobians)
+
+    def _solve(self, loads, *, chained: bool, jacobians: bool) -> Equilibrium:
+        if not isinstance(jacobians, (bool, np.bool_)):
+            raise TypeError(f"jacobians must be True or False, got {jacobians!r}")
+        k = _kernels()
+        last = self._last if chained else None
+        loads, shape, count, pieces, channels = self._prepare(
+            loads, () if last is None else tuple(last[0]))
+        first_piece = np.zeros((pieces[0].size, k.PIECE_LOADS))
+        first_tip = np.zeros(k.TIP_LOADS)
+        memory = self._memory if chained else np.zeros(k.MEMORY)
+        if last is not None:
+            first_piece = _recut(last[0], last[1], pieces[0])
+            first_tip = last[2]
         S = self.s.size
         poses = np.empty((count, S, 4, 4))
         strains = np.empty((count, S, 6))
         stresses = np.empty((count, S, 6))
-        residual = np.empty(count)
-        estimate = np.empty(count)
-        status = np.empty(count, dtype=np.int64)
-        work = np.zeros((count, 2), dtype=np.int64)
-        _kernels.solve_cases(
-            self._base_kernel, self.length, lengths, piece_C, piece_f0, piece_mu, gravity,
-            dist, jumps, tip_dead, tip_fol, self._s_kernel, self._data.scale, tol,
-            self.max_iterations, self.continuation, self.max_step, n_initial,
-            max(self.max_steps, 2 * n_initial), self.max_shootings, self._memory,
-            self._piece_memory, self._memory_level, poses, strains, stresses, residual,
-            estimate, status, work)
-        failed = np.flatnonzero(status != _kernels.OK)
+        info = np.zeros((count, 5))
+        status = np.zeros(count, dtype=np.int64)
+        jac = np.zeros((count, 6, 6) if jacobians else (0, 6, 6))
+        motion = np.zeros((count, S, 6, 6) if jacobians else (1, S, 6, 6))
+        arm_tuple = pieces[:8]
+        k.solve_cases(self._base_kernel, arm_tuple, (channels.piece, channels.tip_loads),
+                      (first_piece, first_tip), self._options(chained, jacobians),
+                      self._s_kernel, memory, (poses, strains, stresses, info, status, jac,
+                                               motion))
+        failed = np.flatnonzero(status != k.OK)
         if failed.size:
-            self._n = None
-            self._memory_level[0] = 0
-            b = int(failed[0])
-            where = f" for load case {np.unravel_index(b, shape)}" if shape else ""
-            if status[b] == _kernels.TOO_MANY_STEPS:
-                raise ConvergenceError(
-                    f"the tip error estimate {estimate[b]:.3e} m stayed above tol·L = "
-                    f"{self.tol * self.length:.3e} m{where}",
-                    residual[b],
-                    f"step doubling up to {2 * int(work[b, 1])} RK4 steps",
-                )
-            raise ConvergenceError(
-                f"Newton's method on the base wrench did not converge{where}",
-                residual[b],
-                f"{int(work[b, 0])} shootings: Newton (max_iterations={self.max_iterations}) "
-                + ("with load stepping down to a load-factor step of 1e-5"
-                   if self.continuation else "without load stepping")
-                + f", {2 * int(work[b, 1])} RK4 steps",
-            )
-        self._n = int(work[-1, 1]) if count else None
-        # fresh arrays, frozen before reshaping (the views are read-only throughout):
-        # Equilibrium takes them as they are, with no copy
-        for array in (poses, strains, stresses, residual, estimate):
+            if chained:
+                self.reset()
+            raise _failure(k, failed[0], shape, status, info, self)
+        if chained and count:
+            self._last = (pieces[0], channels.piece[-1].copy(), channels.tip_loads[-1].copy())
+        tip_compliance = compliance = None
+        if jacobians:
+            tip_compliance, compliance = _compliances(jac, motion, shape)
+        # fresh arrays, frozen before reshaping: Equilibrium takes them without a copy
+        for array in (poses, strains, stresses, info):
             array.setflags(write=False)
         out_shape = (*shape, S)
+        residual, estimate = info[:, 0], info[:, 1]
         return Equilibrium(
             s=self.s,
             poses=poses.reshape(*out_shape, 4, 4),
@@ -338,9 +448,105 @@ class Solver:
             exact=True,
             residual=residual.reshape(shape) if shape else float(residual[0]),
             error_estimate=estimate.reshape(shape) if shape else float(estimate[0]),
+            tip_compliance=tip_compliance,
+            compliance=compliance,
         )
 
+    def shoot(self, loads, x, load_factor=1.0, *, steps=None) -> ShootResult:
+        """One integration from the base reaction ``x`` = (n(0); m(0)) (N, N m, spatial) at
+        load factor λ (the loads scaled by λ): the shooting primitive that continuation,
+        stability and inverse statics are written against.
 
-def solve_numeric(arm, loads, *, s=None, tol=1e-8, base=None, **options) -> Equilibrium:
-    """Solve the full static Cosserat rod by shooting; see :class:`Solver` for the options."""
-    return Solver(arm, s=s, tol=tol, base=base, **options).solve(loads)
+        ``loads`` must be a single case (batch shape ()). ``steps``: RK4 steps over the arm
+        (default: a fixed 200, spread over the pieces in proportion to their length).
+        """
+        k = _kernels()
+        _, shape, _, pieces, channels = self._prepare(loads)
+        if shape != ():
+            raise ValueError(f"Solver.shoot takes a single load case, got batch shape {shape}")
+        x = np.asarray(x, dtype=np.float64)
+        if x.shape != (6,) or not np.all(np.isfinite(x)):
+            raise ValueError(f"x must be 6 finite numbers (n(0); m(0)), got {x!r}")
+        n = 200 if steps is None else _check_count(steps, "steps", 1)
+        counts = np.maximum(1, np.floor(n * pieces[1] / self.length + 0.5)).astype(np.int64)
+        case = (np.zeros_like(channels.piece[0]), channels.piece[0].copy(),
+                np.zeros(k.TIP_LOADS), channels.tip_loads[0].copy())
+        r, J = np.empty(6), np.empty((6, 7))
+        y, T = np.empty(18), np.empty((7, 12))
+        k.shoot(x.copy(), float(load_factor), counts, self._base_kernel, pieces[:8], case,
+                r, J, y, T)
+        R = y[3:12].reshape(3, 3)
+        pose = np.eye(4)
+        pose[:3, :3], pose[:3, 3] = R, y[:3]
+        motion = np.empty((6, 6))
+        motion[:3] = T[:6, :3].T
+        motion[3:] = R @ T[:6, 3:6].T
+        return ShootResult(r, J[:, :6].copy(), J[:, 6].copy(), pose, motion)
+
+
+def _largest(load) -> float:
+    with np.errstate(over="ignore", invalid="ignore"):
+        return max(float(np.max(np.abs(getattr(load, name)), initial=0.0))
+                   for name, _ in load.vectors)
+
+
+def _recut(old_starts, old_piece, new_starts) -> np.ndarray:
+    """Piece loads given on the cut ``old_starts`` re-expressed on ``new_starts`` (a cut that
+    contains every old cut): distributed channels from the old piece that contains the new
+    piece, point wrenches where an old piece started."""
+    k = _kernels()
+    out = np.zeros((new_starts.size, k.PIECE_LOADS))
+    inside = np.clip(np.searchsorted(old_starts, new_starts, side="right") - 1, 0, None)
+    out[:, :k.JD] = old_piece[inside, :k.JD]
+    same = np.isin(new_starts, old_starts)
+    out[same, k.JD:] = old_piece[inside[same], k.JD:]
+    return out
+
+
+def _compliances(jac, motion, shape):
+    """Tip and station compliances C(s) = E(s) J_x⁻¹ (dead tip wrench → (δp; δθ) spatial):
+    a dead tip wrench δW changes the residual by -δW, so the base reaction by J_x⁻¹ δW."""
+    inverse = np.linalg.inv(jac)
+    station = np.einsum("bsij,bjk->bsik", motion, inverse)
+    tip = station[:, -1].copy()
+    for array in (station, tip):
+        array.setflags(write=False)
+    S = motion.shape[1]
+    return tip.reshape(*shape, 6, 6), station.reshape(*shape, S, 6, 6)
+
+
+def _failure(k, b, shape, status, info, solver) -> ConvergenceError:
+    """The ConvergenceError of the first failed case."""
+    b = int(b)
+    where = f" for load case {np.unravel_index(b, shape)}" if shape else ""
+    residual, estimate, reached, shootings, N = info[b]
+    code = int(status[b])
+    tried = f"{int(shootings)} shootings, {2 * int(N)} RK4 steps"
+    if code == k.TOO_MANY_STEPS:
+        return ConvergenceError(
+            f"the tip error estimate {estimate:.3e} m stayed above tol·L = "
+            f"{solver.tol * solver.length:.3e} m{where}", residual,
+            f"step doubling up to {2 * int(N)} RK4 steps")
+    if code == k.PATH_FAILED:
+        return ConvergenceError(
+            f"the loading path could not be followed beyond load factor λ = {reached:.6g}"
+            f"{where}: a limit point (fold) where the arm would snap to another shape, or a "
+            "point where the equilibrium is not unique", residual, tried,
+            load_factor=float(reached))
+    if code == k.BUDGET:
+        return ConvergenceError(
+            f"the shooting budget max_shootings={solver.max_shootings} ran out{where}",
+            residual, tried, load_factor=float(reached))
+    if code == k.NOT_FINITE:
+        return ConvergenceError(f"the solution became non-finite{where}", residual, tried)
+    return ConvergenceError(
+        f"Newton's method on the base wrench did not converge at the full load{where}",
+        residual, tried)
+
+
+def solve_numeric(arm, loads, *, s=None, tol=1e-8, base=None, jacobians=False,
+                  **options) -> Equilibrium:
+    """Solve the full static Cosserat rod by shooting with continuation from the unloaded arm
+    (every case independently); see :class:`Solver` for the options."""
+    return Solver(arm, s=s, tol=tol, base=base, **options).solve_from_unloaded(
+        loads, jacobians=jacobians)
