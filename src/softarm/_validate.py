@@ -224,9 +224,10 @@ def format_bytes(size: float) -> str:
 
 
 def memory_limit() -> int:
-    """Bytes of physical memory of this machine (the most one result may take), or 2⁴⁰."""
+    """The most one result may take, in bytes: half the physical memory of this machine (the
+    solver's work arrays and an export need room too), or 2⁴⁰ where that is unknown."""
     try:
-        return int(os.sysconf("SC_PAGE_SIZE")) * int(os.sysconf("SC_PHYS_PAGES"))
+        return int(os.sysconf("SC_PAGE_SIZE")) * int(os.sysconf("SC_PHYS_PAGES")) // 2
     except (AttributeError, ValueError, OSError):  # pragma: no cover - e.g. Windows
         return 1 << 40
 
@@ -251,8 +252,9 @@ def check_allocation(cases, stations, name: str = "the result") -> int:
     if size > limit:
         raise ValueError(
             f"{name}: {cases} load cases × {stations} stations would need {format_bytes(size)} "
-            "of memory for the poses, strains and stresses alone (this machine has "
-            f"{format_bytes(limit)}); solve fewer cases or stations at a time"
+            "of memory for the poses, strains and stresses alone, more than the "
+            f"{format_bytes(limit)} (half of this machine's memory) one result may take; solve "
+            "fewer cases or stations at a time"
         )
     return int(size)
 

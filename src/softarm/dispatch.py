@@ -7,10 +7,12 @@ this module is the only place that knows both.
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import numpy as np
 
 from . import analytic
+from ._validate import check_allocation, count, real, rigid_transform
 from .equilibrium import Equilibrium
 from .loads import DistributedForce, Gravity, PointLoad, TipLoad, as_loads, batch_shape
 from .statics import Solver
@@ -75,7 +77,10 @@ def solve(arm, loads, *, method="auto", s=None, tol=1e-8, base=None, **options) 
         Tolerance of the numerical solver on the tip position, relative to L (the step count
         is raised until the step-doubling error estimate is ≤ tol·L).
     base : array_like, shape (4, 4), optional
-        Pose of the clamped base in the spatial frame (default identity).
+        Pose of the clamped base in the spatial frame (default identity). A nearly rigid pose
+        (RᵀR = I to 1e-5, e.g. printed to a few digits or stored in float32) is
+        re-orthonormalised to the nearest rotation, the same on every route; a pose further
+        from a rigid transform is rejected.
     **options
         Passed to :class:`softarm.statics.Solver` (``max_iterations``, ``continuation``,
         ``max_step``, ``steps``, ``max_steps``, ``max_shootings``); checked on every route.
@@ -87,8 +92,13 @@ def solve(arm, loads, *, method="auto", s=None, tol=1e-8, base=None, **options) 
 
     Raises
     ------
+    TypeError
+        A string, bool, None or complex number where a number is expected (numpy scalars of
+        any width are accepted).
     ValueError
-        Bad method, stations, base, tolerance, or loads that do not fit the arm.
+        Bad method, stations, base, tolerance, or loads that do not fit the arm; a batch of
+        load cases and stations whose result would not fit in memory (checked before
+        allocating anything).
     ConvergenceError
         The numerical solver failed (never a silently wrong answer).
 
@@ -102,7 +112,38 @@ def solve(arm, loads, *, method="auto", s=None, tol=1e-8, base=None, **options) 
     ('numeric.shooting', 0.713792)
     """
     _check_method(method)
+    check_allocation(math.prod(batch_shape(as_loads(loads))), _station_count(s),
+                     "softarm.solve")
+    tol = real(tol, "tol", "units of the arm length")
+    if base is not None:
+        base = rigid_transform(base, "base")
+    options = {name: _option(name, value) for name, value in options.items()}
     return solve_prepared(Solver(arm, s=s, tol=tol, base=base, **options), loads, method)
+
+
+#: The solver options that are numbers: real (float) or integer ones.
+_REAL_OPTIONS = ("max_step",)
+_INTEGER_OPTIONS = ("max_iterations", "steps", "max_steps", "max_shootings")
+
+
+def _option(name: str, value):
+    """A numeric solver option as a plain Python number (numpy scalars of any width accepted,
+    strings, bools, None and complex numbers refused with a TypeError naming it); other
+    options unchanged, for the solver to check."""
+    if name in _REAL_OPTIONS:
+        return real(value, name)
+    if name in _INTEGER_OPTIONS and not (name == "steps" and value is None):
+        return count(value, name)
+    return value
+
+
+def _station_count(s) -> int:
+    """How many output stations ``s`` asks for (the default 101, a count, or an array's)."""
+    if s is None:
+        return 101
+    if isinstance(s, (int, np.integer)) and not isinstance(s, (bool, np.bool_)):
+        return max(int(s), 0)
+    return int(np.size(s))
 
 
 def _check_method(method) -> None:

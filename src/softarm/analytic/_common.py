@@ -252,7 +252,7 @@ def screw_poses(u, omega, s, twist=None, fields=None):
     buffer = np.empty((*batch, n, columns))
     flat = buffer.reshape(size, n, columns)
     if fields is not None:
-        fields = _broadcast(fields, (*batch, 3, columns - 16)).reshape(size, 3, -1)
+        fields = _broadcast(fields, (*batch, 3, columns - 16)).reshape(size, 3, columns - 16)
 
     def fill(first: int, last: int) -> None:
         """Write arms first..last-1, block by block, with scratch of its own."""
