@@ -251,7 +251,9 @@ def check_allocation(cases, stations, name: str = "the result") -> int:
     limit = memory_limit()
     if size > limit:
         raise ValueError(
-            f"{name}: {cases} load cases × {stations} stations would need {format_bytes(size)} "
+            f"{name + ': ' if name else ''}{cases} load case{'s' if cases != 1 else ''} × "
+            f"{stations} stations would need "
+            f"{format_bytes(size)} "
             "of memory for the poses, strains and stresses alone, more than the "
             f"{format_bytes(limit)} (half of this machine's memory) one result may take; solve "
             "fewer cases or stations at a time"

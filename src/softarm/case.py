@@ -739,7 +739,7 @@ def solve_case(case: Case, *, method: str | None = None, stations: int | None = 
               "s": int(stations if stations is not None else options.stations),
               "tol": float(tol if tol is not None else options.tol)}
     steps = len(case.sweep.values) if case.sweep is not None else 1
-    check_allocation(steps, kwargs["s"], f"{case.source or case.name}")
+    check_allocation(steps, kwargs["s"], "")
     if case.sweep is None:
         return solve(case.arm, case.loads, **kwargs)
     loads = case.batched_loads

@@ -17,6 +17,7 @@ import json
 import math
 import os
 import tempfile
+import zipfile
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -128,6 +129,12 @@ def write_atomic(path: str | os.PathLike, mode: str = "w"):
         with os.fdopen(handle, mode, **({"newline": ""} if "b" not in mode else {})) as stream:
             yield stream
         os.replace(tmp, path)
+    except OSError as error:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        if error.filename is None and error.errno is not None:  # name the file being written
+            raise OSError(error.errno, error.strerror, str(path)) from None
+        raise
     except BaseException:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
@@ -287,6 +294,9 @@ def load_saved(path: str | os.PathLike) -> SavedResult:
             sweep = document.get("sweep_values")
             sweep = None if sweep is None else _numbers(sweep, "sweep_values")
         elif suffix == ".npz":
+            if not zipfile.is_zipfile(path):
+                raise CaseError(f"{path}: not a softarm result file (not an NPZ archive, or "
+                                "truncated)")
             with np.load(path, allow_pickle=False) as data:
                 meta = json.loads(str(data["meta"]))
                 columns = {k: data[k] for k in COLUMNS}
