@@ -349,7 +349,7 @@ def _numbers(value, name: str) -> np.ndarray:
         return v is None or (isinstance(v, (int, float)) and not isinstance(v, bool))
 
     if not ok(value):
-        raise CaseError(f"{name} must hold numbers only")
+        raise ValueError(f"{name!r} must hold numbers only")
     return np.asarray(value, dtype=float)
 
 

@@ -105,6 +105,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 def run_command(args: argparse.Namespace) -> int:
     """Run ``softarm reproduce`` from parsed arguments; returns the exit status."""
+    if args.out.exists() and not args.out.is_dir():  # before any work, not after
+        raise ValueError(f"{args.out}: --out must be a folder, got an existing file")
     report = reproduce(args.out, cases=args.cases, data_dir=args.data,
                        figures=not args.no_figures)
     if args.strict:
