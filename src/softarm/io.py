@@ -119,8 +119,11 @@ def write_atomic(path: str | os.PathLike, mode: str = "w"):
         path = Path(os.path.realpath(path))
     if path.is_dir():
         raise IsADirectoryError(errno.EISDIR, "is a folder, not a file", str(path))
-    handle, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part",
-                                   dir=path.parent if str(path.parent) else ".")
+    try:
+        handle, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part",
+                                       dir=path.parent if str(path.parent) else ".")
+    except OSError as error:  # e.g. a read-only folder: name the file asked for
+        raise OSError(error.errno, error.strerror, str(path)) from None
     try:
         # mkstemp makes the file private (0600); give it the permissions of a normal new file
         umask = os.umask(0)
