@@ -2,9 +2,10 @@
 
 Each :class:`Case` carries a name, the problem, a reference tip position (m, spatial) or
 ``None``, and a string naming the reference's source. Exact references come from closed forms
-or from ``../shared/data``; where none exists the reference is a tight-tolerance solve by
-:func:`peers.shooting_cosserat` (tol 1e-12, DOP853), computed on first use and cached. That is
-a placeholder: the coordinator will swap in softarm's own tight solve.
+or from the reference tables shipped in ``softarm/validation/data``; where none exists the
+reference is a tight-tolerance solve by :func:`peers.shooting_cosserat` (tol 1e-12, DOP853),
+computed on first use and cached. That is a placeholder: the coordinator will swap in softarm's
+own tight solve.
 
 Conventions: the arm lies along +x, base clamped at the origin with R(0) = I. A force along +z
 bends the arm about -y towards +z; a positive moment about +y bends it towards -z.
@@ -35,8 +36,6 @@ from peers import (  # benchmarks/ is not a package (as in run.py and throughput
 
 __all__ = ["Case", "cases", "mattiasson_table"]
 
-_DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
-_MATTIASSON_JSON = _DATA / "mattiasson_cantilever.json"
 
 # "Inextensible, unshearable" stand-in: EA = GA = 1e9 EI / L^2. Under the largest Mattiasson
 # load (k = 10, |n| <= 10 EI/L^2) the axial and shear strains are <= 1e-8, so the tip differs
@@ -64,9 +63,15 @@ class Case:
     source: str
 
 
-def mattiasson_table(path: Path = _MATTIASSON_JSON) -> dict[float, dict]:
-    """The elliptic-integral table ("computed_here") of mattiasson_cantilever.json, keyed by k."""
-    data = json.loads(Path(path).read_text())
+def mattiasson_table(path: Path | None = None) -> dict[float, dict]:
+    """The elliptic-integral table ("computed_here") of mattiasson_cantilever.json, keyed by k
+    (the packaged one, :func:`softarm.validation.reference_table`, unless ``path`` is given)."""
+    if path is None:
+        from softarm.validation import reference_table
+
+        data = reference_table("mattiasson_cantilever.json")
+    else:
+        data = json.loads(Path(path).read_text())
     return {float(row["k"]): row for row in data["computed_here"]["table"]}
 
 
@@ -89,7 +94,7 @@ def _mattiasson(k: float) -> Case:
     reference = L * np.array([1.0 - row["u_over_L"], 0.0, row["w_over_L"]])
     source = (
         f"Mattiasson (1981) Table 1 / Bisshopp & Drucker (1945), k = {k:g}: elliptic-integral "
-        "values, 8 digits ('computed_here' in shared/data/mattiasson_cantilever.json); "
+        "values, 8 digits ('computed_here' in softarm/validation/data/mattiasson_cantilever.json); "
         "inextensible elastica, model here EA = GA = 1e9 EI/L^2"
     )
     return Case(f"mattiasson_k{k:g}", problem, reference, source)
@@ -121,7 +126,7 @@ def _pure_bending() -> Case:
 
 def _princeton() -> Case:
     # Stiffnesses: the paper's printed EI_y = 36.28 N m^2 and GA_z = 0.9039e6 N (the beam's
-    # chordwise/lag pair, see shared/data/princeton_beam.json 'pairing_note'); the others from
+    # chordwise/lag pair, see the packaged princeton_beam.json 'pairing_note'); the others from
     # MBDyn tests/benchmarks/princeton/princeton_gen.m. A force along +z bends about y, so it
     # engages exactly (GA_z, EI_y) as in the paper's Fig. 3.
     width, thickness = 0.0127, 0.003175

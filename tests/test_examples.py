@@ -67,7 +67,7 @@ def test_fig3_timoshenko():
 
 def test_mattiasson():
     """Mattiasson (1981), Table 1, k = 5: w/L = 0.71379, u/L = 0.38763
-    (../shared/data/mattiasson_cantilever.json)."""
+    (softarm/validation/data/mattiasson_cantilever.json)."""
     _, result = solve("mattiasson_cantilever")
     x, _, z = result.tip_position
     assert -z == pytest.approx(0.71379, abs=2e-5)

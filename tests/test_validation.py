@@ -17,11 +17,9 @@ import pytest
 from softarm.validation import CASES, Check, main, reproduce, run
 from softarm.validation._checks import STATUSES, finding, gate, skipped
 
-SHARED_DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
-
 # rod_benchmarks.json, shear_deformable_tip_force: parameters and the computed GA = 500 N row
 # (Simo-Reissner cantilever, L = 1, EI = 10, EA = 1e8, tip force 10 N; closed form of Batista
-# 2016 as computed there). Written out here so that the failure test needs no shared folder.
+# 2016 as computed there). Written out here so that the failure test can alter it.
 _SHEAR_CASE = {
     "shear_deformable_tip_force": {
         "found": {"params": {"L": 1, "E": 10, "I": 1, "A": 1e7, "J": 1e7, "F": 10}},
@@ -118,10 +116,8 @@ def test_a_wrong_reference_fails(tmp_path):
 
 
 def test_shear_finding_shows_the_flapwise_failure_of_the_small_displacement_solution():
-    """NOTES.md: at the flapwise stiffness (k up to 1.9) eq. 58 is off by tens of percent."""
-    if not SHARED_DATA.is_dir():
-        pytest.fail(f"reference folder {SHARED_DATA} not found: shared/ must sit beside the repo")
-    report = run(["fig3_shear_load"], data_dir=SHARED_DATA, progress=None)
+    """At the flapwise stiffness (k up to 1.9) eq. 58 is off by tens of percent."""
+    report = run(["fig3_shear_load"], progress=None)  # the packaged tables
     tips = {c.item.split(":")[0]: c for c in report.checks
             if c.status == "finding" and c.quantity.startswith("z at r/L = 1 ")
             and "17.792" in c.item}
@@ -190,10 +186,8 @@ def test_unknown_case_is_rejected():
 
 @pytest.mark.slow
 def test_full_reproduction(tmp_path):
-    """Every case of ``softarm reproduce`` against ../shared/data: all gated checks pass."""
-    if not SHARED_DATA.is_dir():
-        pytest.fail(f"reference folder {SHARED_DATA} not found: shared/ must sit beside the repo")
-    report = reproduce(tmp_path, data_dir=SHARED_DATA, progress=None)
+    """Every case of ``softarm reproduce`` against the packaged tables: all gated checks pass."""
+    report = reproduce(tmp_path, progress=None)
     failed = [c for c in report.checks if c.status == "fail"]
     assert not failed, failed[:5]
     assert report.count("skipped") == 0

@@ -2,26 +2,130 @@
 
 Every failure is a ValueError (or TypeError) that names the parameter, what was expected and what
 was received, so a user never has to read a traceback to learn what to fix.
+
+Numbers are read strictly: a string, a bool, None or a complex number where a real number is
+expected is a TypeError (never silently converted: ``"1"`` is not 1 and ``True`` is not 1.0),
+while Python ints and floats and numpy integer and floating scalars and arrays of any width
+(``np.float32(2)``, ``np.float16``) are accepted alike.
 """
 
 from __future__ import annotations
 
 import math
-from numbers import Real
+import os
+from numbers import Integral, Real
 
 import numpy as np
 
-__all__ = ["as_array", "as_matrices", "as_vectors", "positive", "stations"]
+__all__ = [
+    "LENGTH_RANGE",
+    "as_array",
+    "as_matrices",
+    "as_vectors",
+    "check_allocation",
+    "count",
+    "format_bytes",
+    "length",
+    "memory_limit",
+    "positive",
+    "real",
+    "rigid_transform",
+    "stations",
+]
+
+#: Accepted lengths in m (arm lengths, radii, widths): far beyond any rod, and narrow enough
+#: that every derived quantity (L², r⁴, E r⁴ / L², ...) stays a normal float64.
+LENGTH_RANGE = (1e-12, 1e12)
+
+#: Bytes of output per load case and station: a pose (16), strains (6) and stresses (6),
+#: float64.
+BYTES_PER_STATION = 28 * 8
+
+#: Largest deviation ‖RᵀR − I‖ (max entry) of a base rotation that is re-orthonormalised; a
+#: rotation off by more is rejected.
+ROTATION_TOLERANCE = 1e-5
+
+_OK = object()
+
+
+def _short(value, limit: int = 80) -> str:
+    """repr of ``value`` cut to ``limit`` characters (error messages stay one short line)."""
+    if isinstance(value, np.ndarray) and value.size > 8:
+        return f"array of shape {value.shape} and dtype {value.dtype}"
+    text = " ".join(repr(value).split())
+    return text if len(text) <= limit else text[: limit - 1] + "…"
+
+
+def _first_non_real(value):
+    """The first element of ``value`` that is not a real number (``_OK`` if there is none).
+
+    Bools, strings, None, complex numbers and other objects are not real numbers; ints, floats
+    and numpy integer and floating scalars or arrays are.
+    """
+    if isinstance(value, np.ndarray):
+        kind = value.dtype.kind
+        if kind in "fiu":
+            return _OK
+        if kind == "O":
+            for item in value.flat:
+                bad = _first_non_real(item)
+                if bad is not _OK:
+                    return bad
+            return _OK
+        return value.flat[0] if value.size else value  # bool, complex, str, bytes arrays
+    if isinstance(value, (list, tuple)):
+        for item in value:
+            bad = _first_non_real(item)
+            if bad is not _OK:
+                return bad
+        return _OK
+    if isinstance(value, (bool, np.bool_)):
+        return value
+    if isinstance(value, (Real, np.integer, np.floating)):
+        return _OK
+    if hasattr(value, "__array__") and not isinstance(value, (str, bytes)):
+        return _first_non_real(np.asarray(value))
+    return value
+
+
+def _kind(value) -> str:
+    if isinstance(value, (bool, np.bool_)):
+        return "a bool"
+    if isinstance(value, (str, np.str_)):
+        return "a string"
+    if value is None:
+        return "None"
+    if isinstance(value, (complex, np.complexfloating)):
+        return "a complex number"
+    if isinstance(value, np.ndarray):
+        return f"an array of dtype {value.dtype}"
+    return f"a {type(value).__name__}"
 
 
 def as_array(value, name: str) -> np.ndarray:
-    """``value`` as a finite float64 array, or ValueError/TypeError naming ``name``."""
+    """``value`` as a finite float64 array, or ValueError/TypeError naming ``name``.
+
+    Examples
+    --------
+    >>> as_array([0, 0, np.float32(1.5)], "force")
+    array([0. , 0. , 1.5])
+    >>> as_array([0, 0, "1"], "force")
+    Traceback (most recent call last):
+    ...
+    TypeError: force must be numeric (real numbers), got a string ('1') in [0, 0, '1']
+    """
+    bad = _first_non_real(value)
+    if bad is not _OK:
+        where = "" if bad is value else f" in {_short(value)}"
+        raise TypeError(f"{name} must be numeric (real numbers), got {_kind(bad)} "
+                        f"({_short(bad, 40)}){where}")
     try:
         array = np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError) as error:
-        raise TypeError(f"{name} must be numeric, got {value!r}") from error
+    except (TypeError, ValueError) as error:  # e.g. ragged nested lists
+        raise ValueError(f"{name} must be a (nested) list or array of numbers of one shape, "
+                         f"got {_short(value)}") from error
     if not np.all(np.isfinite(array)):
-        raise ValueError(f"{name} must be finite, got {value!r}")
+        raise ValueError(f"{name} must be finite, got {_short(value)}")
     return array
 
 
@@ -42,31 +146,180 @@ def as_matrices(value, name: str, rows: int, cols: int | None = None) -> np.ndar
     return array
 
 
+def real(value, name: str, unit: str = "") -> float:
+    """A finite real number as a Python float: int, float or a numpy scalar of any width.
+
+    TypeError for a bool, string, None, complex or anything else; ValueError if not finite.
+
+    Examples
+    --------
+    >>> real(np.float32(2.0), "max_step")
+    2.0
+    >>> real(True, "max_step")
+    Traceback (most recent call last):
+    ...
+    TypeError: max_step must be a real number, got a bool (True)
+    """
+    in_unit = f" in {unit}" if unit else ""
+    if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "fiu":
+        value = value[()]
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (Real, np.integer,
+                                                                      np.floating)):
+        raise TypeError(f"{name} must be a real number{in_unit}, got {_kind(value)} "
+                        f"({_short(value, 40)})")
+    number = float(value)
+    if not math.isfinite(number):
+        raise ValueError(f"{name} must be a finite number{in_unit}, got {value!r}")
+    return number
+
+
 def positive(value, name: str, unit: str) -> float:
-    """A positive finite real number, as float."""
-    if isinstance(value, bool) or not isinstance(value, Real):
-        raise TypeError(f"{name} must be a positive number in {unit}, got {value!r}")
-    if not (math.isfinite(value) and value > 0):
+    """A positive finite real number, as float (numpy scalars of any width accepted)."""
+    try:
+        number = real(value, name, unit)
+    except TypeError:
+        raise TypeError(f"{name} must be a positive number in {unit}, got {_kind(value)} "
+                        f"({_short(value, 40)})") from None
+    except ValueError:
+        number = math.nan
+    if not number > 0:
         raise ValueError(f"{name} must be a positive finite value in {unit}, got {value!r}")
-    return float(value)
+    return number
+
+
+def length(value, name: str) -> float:
+    """A length in m within :data:`LENGTH_RANGE` (Arm.length, Circle.radius, ...), as float.
+
+    Examples
+    --------
+    >>> length(1e-300, "Circle.radius")
+    Traceback (most recent call last):
+    ...
+    ValueError: Circle.radius must be a length in m between 1e-12 and 1e+12, got 1e-300
+    """
+    number = positive(value, name, "m")
+    low, high = LENGTH_RANGE
+    if not low <= number <= high:
+        raise ValueError(f"{name} must be a length in m between {low:g} and {high:g}, got "
+                         f"{value!r}")
+    return number
+
+
+def count(value, name: str, minimum: int = 0) -> int:
+    """An integer >= ``minimum`` (Python or numpy integer; not a bool or a float), as int."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (Integral, np.integer)):
+        raise TypeError(f"{name} must be an integer, got {_kind(value)} ({_short(value, 40)})")
+    if value < minimum:
+        raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}")
+    return int(value)
+
+
+def format_bytes(size: float) -> str:
+    """``size`` bytes in a readable unit, e.g. ``'224 GB'`` (powers of 1000)."""
+    for unit in ("B", "kB", "MB", "GB", "TB", "PB"):
+        if size < 1000 or unit == "PB":
+            return f"{size:.3g} {unit}"
+        size /= 1000
+    raise AssertionError("unreachable")  # pragma: no cover
+
+
+def memory_limit() -> int:
+    """The most one result may take, in bytes: half the physical memory of this machine (the
+    solver's work arrays and an export need room too), or 2⁴⁰ where that is unknown."""
+    try:
+        return int(os.sysconf("SC_PAGE_SIZE")) * int(os.sysconf("SC_PHYS_PAGES")) // 2
+    except (AttributeError, ValueError, OSError):  # pragma: no cover - e.g. Windows
+        return 1 << 40
+
+
+def check_allocation(cases, stations, name: str = "the result") -> int:
+    """Reject, before allocating, a result of ``cases`` × ``stations`` that cannot fit in memory.
+
+    The output of one solve is a pose, strains and stresses per load case and station
+    (:data:`BYTES_PER_STATION`). ValueError naming the sizes and the memory they would need if
+    that exceeds :func:`memory_limit`; else the number of bytes.
+
+    Examples
+    --------
+    >>> try:
+    ...     check_allocation(10**7, 101, "loads")
+    ... except ValueError as error:
+    ...     print(str(error)[:69])
+    loads: 10000000 load cases × 101 stations would need 226 GB of memory
+    """
+    size = float(cases) * float(stations) * BYTES_PER_STATION
+    limit = memory_limit()
+    if size > limit:
+        raise ValueError(
+            f"{name + ': ' if name else ''}{cases} load case{'s' if cases != 1 else ''} × "
+            f"{stations} stations would need "
+            f"{format_bytes(size)} "
+            "of memory for the poses, strains and stresses alone, more than the "
+            f"{format_bytes(limit)} (half of this machine's memory) one result may take; solve "
+            "fewer cases or stations at a time"
+        )
+    return int(size)
+
+
+def rigid_transform(value, name: str = "base") -> np.ndarray:
+    """A single 4×4 rigid transform [[R, p], [0, 0, 0, 1]] with R exactly orthonormal.
+
+    A nearly rigid pose (‖RᵀR − I‖ ≤ :data:`ROTATION_TOLERANCE`, entrywise, det R > 0, e.g.
+    printed to a few digits or stored in float32) is re-orthonormalised to the nearest rotation
+    (polar decomposition, R → U Vᵀ from the SVD R = U S Vᵀ); anything else is rejected with a
+    ValueError naming ``name``. Returns a fresh float64 array.
+
+    Examples
+    --------
+    >>> H = np.eye(4); H[:3, :3] = [[1.0, 1e-7, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+    >>> R = rigid_transform(H)[:3, :3]
+    >>> bool(np.allclose(R.T @ R, np.eye(3), rtol=0.0, atol=1e-15))
+    True
+    """
+    H = as_matrices(value, name, 4)
+    if H.shape != (4, 4):
+        raise ValueError(f"{name} must be a single 4×4 rigid transform, got shape {H.shape}")
+    R = H[:3, :3]
+    deviation = float(np.max(np.abs(R.T @ R - np.eye(3))))
+    if not (np.allclose(H[3], [0.0, 0.0, 0.0, 1.0], rtol=0.0, atol=1e-12)
+            and deviation <= ROTATION_TOLERANCE and np.linalg.det(R) > 0.0):
+        raise ValueError(
+            f"{name} must be a rigid transform [[R, p], [0, 0, 0, 1]] with R a proper rotation "
+            f"(RᵀR = I to {ROTATION_TOLERANCE:g}, det R = +1, last row 0, 0, 0, 1), got "
+            f"{_short(H.tolist(), 200)}"
+        )
+    U, _, Vt = np.linalg.svd(R)
+    out = np.eye(4)
+    out[:3, :3] = U @ Vt
+    out[:3, 3] = H[:3, 3]
+    return out
 
 
 def stations(s, length: float, name: str = "s", default: int = 101) -> np.ndarray:
-    """Arc-length stations: ``default`` uniform points on [0, L] if None, else validated."""
+    """Arc-length stations: ``default`` uniform points on [0, L] if None, else validated.
+
+    An int gives that many uniform stations (checked against the memory first, see
+    :func:`check_allocation`). An array is checked to be strictly increasing within [0, L],
+    up to the rounding of its own precision (float32 stations ending at float32(L) are
+    accepted), and clipped to [0, L].
+    """
     if s is None:
         return np.linspace(0.0, length, default)
-    if isinstance(s, (int, np.integer)) and not isinstance(s, bool):
+    if isinstance(s, (int, np.integer)) and not isinstance(s, (bool, np.bool_)):
         if s < 2:
             raise ValueError(f"{name} as a count of stations must be >= 2, got {s}")
+        check_allocation(1, int(s), name)
         return np.linspace(0.0, length, int(s))
     array = as_array(s, name)
     if array.ndim != 1 or array.size < 1:
         raise ValueError(f"{name} must be a 1-D array of stations in m, got shape {array.shape}")
-    tolerance = 8 * np.finfo(float).eps * length
+    given = s.dtype if isinstance(s, np.ndarray) else np.asarray(s).dtype
+    eps = np.finfo(given).eps if given.kind == "f" else np.finfo(np.float64).eps
+    tolerance = 8 * max(float(eps), float(np.finfo(np.float64).eps)) * length
     if array[0] < -tolerance or array[-1] > length + tolerance:
         raise ValueError(
             f"{name} must lie in [0, L] = [0, {length!r}] m, got [{array[0]!r}, {array[-1]!r}]"
         )
     if np.any(np.diff(array) <= 0):
-        raise ValueError(f"{name} must be strictly increasing, got {s!r}")
+        raise ValueError(f"{name} must be strictly increasing, got {_short(s)}")
     return np.clip(array, 0.0, length)

@@ -30,6 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ._validate import as_array, check_allocation
 from .equilibrium import Equilibrium
 from .loads import DistributedForce, Gravity, PointLoad, TipLoad, as_loads
 from .model import Arm, Circle, Material, Rectangle, Rigidities, Section, SegmentedArm, Tube
@@ -43,6 +44,7 @@ else:  # pragma: no cover - exercised on Python 3.10 only
 __all__ = [
     "Case",
     "CaseError",
+    "CaseTypeError",
     "SolveOptions",
     "Sweep",
     "arm_to_dict",
@@ -55,6 +57,11 @@ __all__ = [
 
 class CaseError(ValueError):
     """A case or result file that cannot be used: the message names the file, key and fault."""
+
+
+class CaseTypeError(CaseError, TypeError):
+    """A value of the wrong type in a case file (a string, bool or array where a number is
+    expected, ...): a :class:`CaseError` that is also a TypeError, as the library raises."""
 
 
 # --------------------------------------------------------------------------------------------
@@ -221,8 +228,11 @@ class _Table:
     def key(self, key: str) -> str:
         return f"{self.path}.{key}" if self.path else key
 
-    def error(self, key: str | None, what: str) -> CaseError:
-        return CaseError(f"{self.where}: {self.key(key) if key else self.path}: {what}")
+    def error(self, key: str | None, what: str, kind: type = CaseError) -> CaseError:
+        return kind(f"{self.where}: {self.key(key) if key else self.path}: {what}")
+
+    def type_error(self, key: str | None, what: str) -> CaseError:
+        return self.error(key, what, CaseTypeError)
 
     def missing(self, key: str, what: str) -> CaseError:
         """'missing', or 'unknown key' when a present key looks like a misspelling of it."""
@@ -248,7 +258,7 @@ class _Table:
             return default
         value = self.raw(key)
         if isinstance(value, bool) or not isinstance(value, Real):
-            raise self.error(key, f"must be a number in {unit}, got {value!r}")
+            raise self.type_error(key, f"must be a number in {unit}, got {value!r}")
         value = float(value)
         if not math.isfinite(value):
             raise self.error(key, f"must be finite, got {value!r}")
@@ -264,7 +274,7 @@ class _Table:
             return default
         value = self.raw(key)
         if isinstance(value, bool) or not isinstance(value, Integral):
-            raise self.error(key, f"must be an integer, got {value!r}")
+            raise self.type_error(key, f"must be an integer, got {value!r}")
         if value < minimum:
             raise self.error(key, f"must be >= {minimum}, got {value!r}")
         return int(value)
@@ -277,7 +287,7 @@ class _Table:
             return default
         value = self.raw(key)
         if not isinstance(value, str):
-            raise self.error(key, f"must be a string, got {value!r}")
+            raise self.type_error(key, f"must be a string, got {value!r}")
         if choices is not None and value not in choices:
             raise self.error(key, f"unknown value {value!r}; expected one of "
                              f"{_quoted(choices)}{_suggest(value, choices)}")
@@ -286,20 +296,20 @@ class _Table:
     def boolean(self, key: str, *, default: bool) -> bool:
         value = self.raw(key, default)
         if not isinstance(value, bool):
-            raise self.error(key, f"must be true or false, got {value!r}")
+            raise self.type_error(key, f"must be true or false, got {value!r}")
         return value
 
     def vector(self, key: str, unit: str, *, default=(0.0, 0.0, 0.0)) -> np.ndarray:
         value = self.raw(key, default)
+        what = f"must be a list of 3 finite numbers in {unit}, got {value!r}"
         try:
-            array = np.asarray(value, dtype=np.float64)
-            ok = array.ndim >= 1 and array.shape[-1] == 3 and bool(np.all(np.isfinite(array)))
-            ok = ok and (self.batched or array.ndim == 1) and not _has_bool(value)
-        except (TypeError, ValueError):
-            ok = False
-        if not ok:
-            raise self.error(key, f"must be a list of 3 finite numbers in {unit}, "
-                             f"got {value!r}")
+            array = as_array(value, key)  # strict: no strings, bools or complex numbers
+        except TypeError as error:
+            raise self.type_error(key, f"{what} ({str(error).split(', got ')[-1]})") from None
+        except ValueError:
+            raise self.error(key, what) from None
+        if not (array.ndim >= 1 and array.shape[-1] == 3 and (self.batched or array.ndim == 1)):
+            raise self.error(key, what)
         return array
 
     def table(self, key: str) -> _Table:
@@ -356,7 +366,9 @@ def _model(table: _Table, build: Callable):
     """Call a model constructor, turning its ValueError/TypeError into a CaseError."""
     try:
         return build()
-    except (TypeError, ValueError) as error:
+    except TypeError as error:
+        raise table.type_error(None, str(error)) from None
+    except ValueError as error:
         raise table.error(None, str(error)) from None
 
 
@@ -444,10 +456,15 @@ def _load(table: _Table):
     return _model(table, build)
 
 
+def _stations(table: _Table) -> int:
+    _check_size(table, "stations", 1, table.data.get("stations"))  # before the type
+    return table.integer("stations", default=101, minimum=2)
+
+
 def _solve_options(table: _Table) -> SolveOptions:
     options = SolveOptions(
         method=table.string("method", _METHODS, default="auto"),
-        stations=table.integer("stations", default=101, minimum=2),
+        stations=_stations(table),
         tol=table.number("tol", "units of the arm length", required=False, default=1e-8),
     )
     try:
@@ -458,7 +475,7 @@ def _solve_options(table: _Table) -> SolveOptions:
     return options
 
 
-def _sweep(table: _Table, loads: tuple) -> Sweep:
+def _sweep(table: _Table, loads: tuple, stations: int) -> Sweep:
     index = table.integer("load", default=1, minimum=1)
     if index > len(loads):
         raise table.error("load", f"there are {len(loads)} [[load]] tables, got load = "
@@ -477,11 +494,15 @@ def _sweep(table: _Table, loads: tuple) -> Sweep:
         if (not isinstance(raw, list) or not raw or _has_bool(raw)
                 or not all(isinstance(v, Real) and math.isfinite(v) for v in raw)):
             raise table.error("values", f"must be a non-empty list of finite numbers, got "
-                              f"{raw!r}")
+                              f"{raw!r}", CaseTypeError if isinstance(raw, list) and raw
+                              and not all(isinstance(v, Real) and not isinstance(v, bool)
+                                          for v in raw) else CaseError)
+        _check_size(table, "values", len(raw), stations)
         values = tuple(float(v) for v in raw)
     else:
         start = table.number("start", fields[field_name], positive=False)
         stop = table.number("stop", fields[field_name], positive=False)
+        _check_size(table, "steps", table.data.get("steps"), stations)  # before the type
         steps = table.integer("steps", minimum=2)
         values = tuple(np.linspace(start, stop, steps).tolist())
     table.done()
@@ -490,6 +511,20 @@ def _sweep(table: _Table, loads: tuple) -> Sweep:
         raise table.error("component", f"'magnitude' needs a nonzero {field_name} in load "
                           f"{index} to give the direction, got (0, 0, 0)")
     return Sweep(index - 1, kind, field_name, component, values, label)
+
+
+def _check_size(table: _Table, key: str, steps, stations) -> None:
+    """A sweep of ``steps`` × ``stations`` whose result cannot fit in memory, rejected with the
+    memory it would need (before anything is allocated; an integral float counts too)."""
+    if isinstance(steps, bool) or not isinstance(steps, Real) or not math.isfinite(steps):
+        return
+    if isinstance(stations, bool) or not isinstance(stations, Real) or \
+            not math.isfinite(stations):
+        return
+    try:
+        check_allocation(int(steps), int(stations), "the sweep")
+    except ValueError as error:
+        raise table.error(key, str(error).removeprefix("the sweep: ")) from None
 
 
 def parse_case(data: dict, source: str | os.PathLike | None = None, *,
@@ -541,7 +576,7 @@ def _parse(data, source, *, name=None, batched=False) -> Case:
             raise CaseError(f"{where}: load[{i + 1}]: gravity needs the arm's mass: give "
                             "material.density or mass_per_length")
     options = _solve_options(top.table("solve")) if top.has("solve") else SolveOptions()
-    sweep = _sweep(top.table("sweep"), loads) if top.has("sweep") else None
+    sweep = _sweep(top.table("sweep"), loads, options.stations) if top.has("sweep") else None
     top.done()
     clean = dict(data)
     clean.setdefault("name", case_name)
@@ -703,6 +738,8 @@ def solve_case(case: Case, *, method: str | None = None, stations: int | None = 
     kwargs = {"method": method or options.method,
               "s": int(stations if stations is not None else options.stations),
               "tol": float(tol if tol is not None else options.tol)}
+    steps = len(case.sweep.values) if case.sweep is not None else 1
+    check_allocation(steps, kwargs["s"], "")
     if case.sweep is None:
         return solve(case.arm, case.loads, **kwargs)
     loads = case.batched_loads

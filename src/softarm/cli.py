@@ -8,17 +8,24 @@
     softarm demo [--out DIR]
     softarm reproduce [--out DIR]
 
-Exit codes: 0 success; 1 the solver did not converge (one line with the residual); 2 bad input
-(a missing or misspelled key, a wrong type or value, a missing file, an unknown output format:
-one line naming the file, the key and what is wrong). Outputs are written to a temporary file
-beside the target and renamed, so a failure never leaves a half-written result.
+Exit codes (docs/cli.md): 0 success; 1 a failure: the solver did not converge (one line with
+the residual), a failed check of ``softarm reproduce``, a full disk or a file-size limit, out of
+memory; 2 bad input: a missing or misspelled key, a wrong type or value, a missing or unreadable
+file, an unknown output format, an output path that is a folder or the input file, a size whose
+result cannot fit in memory (one line naming the file, the key and what is wrong); 130
+interrupted (Ctrl-C), at any moment. Every error is one line on stderr, never a traceback.
+Outputs are written to a temporary file beside the target and renamed, so a failure never leaves
+a half-written result and an existing output stays intact; a symbolic link as output path is
+written through (its target is replaced, the link kept).
 """
 
 from __future__ import annotations
 
 import argparse
 import contextlib
+import errno
 import os
+import signal
 import sys
 import threading
 import time
@@ -75,7 +82,13 @@ def _stations(text: str) -> int:
     try:
         value = int(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"must be an integer, got {text!r}") from None
+        try:  # an integer written as a float, e.g. 1e3
+            number = float(text)
+        except ValueError:
+            number = None
+        if number is None or not number.is_integer():
+            raise argparse.ArgumentTypeError(f"must be an integer, got {text!r}") from None
+        value = int(number)
     if value < 2:
         raise argparse.ArgumentTypeError(f"must be >= 2, got {value}")
     return value
@@ -137,7 +150,14 @@ def _parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the ``softarm`` command with ``argv`` (default ``sys.argv[1:]``); return the exit
-    code."""
+    code (see the module docstring and docs/cli.md)."""
+    try:
+        return _main(argv)
+    except KeyboardInterrupt:
+        return interrupted()
+
+
+def _main(argv: Sequence[str] | None) -> int:
     parser = _parser()
     try:
         args = parser.parse_args(argv)
@@ -146,32 +166,82 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return args.run(args)
     except CaseError as error:
-        print(f"softarm: error: {error}", file=sys.stderr)
-        return 2
+        return _fail(2, f"softarm: error: {error}")
     except ConvergenceError as error:
-        print(f"softarm: the solver did not converge: residual {error.residual:.3e} (N, N m)"
-              f"{'; tried ' + error.tried if error.tried else ''}", file=sys.stderr)
-        return 1
+        return _fail(1, f"softarm: the solver did not converge: residual {error.residual:.3e} "
+                     f"(N, N m){'; tried ' + error.tried if error.tried else ''}")
     except BrokenPipeError:  # e.g. `softarm solve case.toml | head`
         with contextlib.suppress(OSError):
             os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
-    except KeyboardInterrupt:
-        print("softarm: interrupted", file=sys.stderr)
-        return 130
+    except OSError as error:  # writing an output: full disk, size limit, permissions, ...
+        where = f"{error.filename}: " if error.filename else ""
+        what = error.strerror or str(error)
+        code = 1 if error.errno in _FAILURES else 2
+        return _fail(code, f"softarm: error: {where}cannot write: {what}")
+    except MemoryError:
+        return _fail(1, "softarm: out of memory (solve fewer cases or stations at a time)")
+    except (ValueError, TypeError) as error:  # bad input found by the library
+        return _fail(2, f"softarm: error: {error}")
+
+
+#: errno values of an OSError that are a failure of the machine (exit 1), not bad input.
+_FAILURES = {errno.ENOSPC, errno.EFBIG, errno.EIO, getattr(errno, "EDQUOT", errno.ENOSPC)}
+
+
+def _line(message: str, limit: int = 400) -> str:
+    """``message`` on one line, cut to ``limit`` characters (no multi-line array dumps)."""
+    text = " ".join(str(message).split())
+    return text if len(text) <= limit else text[: limit - 1] + "…"
+
+
+def _fail(code: int, message: str) -> int:
+    print(_line(message), file=sys.stderr)
+    return code
+
+
+def interrupted() -> int:
+    """Ctrl-C: say so in one line and return 130; a second Ctrl-C is ignored from here on."""
+    with contextlib.suppress(ValueError, OSError):  # ValueError: not the main thread
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+    with contextlib.suppress(OSError, ValueError):
+        print("softarm: interrupted", file=sys.stderr, flush=True)
+    return 130
 
 
 # --------------------------------------------------------------------------------------------
 
 
-def _check_output(path: str, suffixes: tuple[str, ...], what: str) -> Path:
+def _check_output(path: str, suffixes: tuple[str, ...], what: str, inputs=(),
+                  taken=()) -> Path:
+    """An output path that can be written: a known suffix, an existing folder, not a folder
+    itself, not one of ``inputs`` nor ``taken`` (the other outputs), even through a link."""
     out = Path(path)
     if out.suffix.lower() not in suffixes:
         raise CaseError(f"{out}: unknown {what} format {out.suffix or '(no suffix)'!r}; use "
                         f"one of {', '.join(suffixes)}")
-    if not out.parent.is_dir():
-        raise CaseError(f"{out}: folder {out.parent} does not exist")
+    target = Path(os.path.realpath(out))  # a symbolic link is written through to its target
+    if not target.parent.is_dir():
+        raise CaseError(f"{out}: folder {target.parent} does not exist")
+    if target.is_dir():
+        raise CaseError(f"{out}: is a folder; give a file name ending in {suffixes[0]}")
+    for other in inputs:
+        if _same_file(out, Path(other)):
+            raise CaseError(f"{out}: is the input file {other}; choose another output")
+    for other in taken:
+        if _same_file(out, Path(other)):
+            raise CaseError(f"{out}: given twice as an output")
     return out
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    """True if ``a`` and ``b`` name the same file (links and relative paths resolved)."""
+    try:
+        if a.exists() and b.exists():
+            return os.path.samefile(a, b)
+    except OSError:
+        return False
+    return os.path.realpath(a) == os.path.realpath(b)
 
 
 def _solve(case: Case, args) -> tuple:
@@ -197,8 +267,11 @@ def _solve(case: Case, args) -> tuple:
 
 
 def _run_solve(args) -> int:
-    outputs = [_check_output(o, FORMATS, "output") for o in args.output]
-    picture = _check_output(args.plot, _PICTURE_SUFFIXES, "picture") if args.plot else None
+    outputs: list[Path] = []
+    for name in args.output:
+        outputs.append(_check_output(name, FORMATS, "output", [args.case], outputs))
+    picture = (_check_output(args.plot, _PICTURE_SUFFIXES, "picture", [args.case], outputs)
+               if args.plot else None)
     case = load_case(args.case)
     result, seconds = _solve(case, args)
     print(_summary(case, result, seconds))
@@ -232,7 +305,7 @@ def _plot(case: Case, result, picture: Path) -> None:
 def _run_plot(args) -> int:
     source = Path(args.result)
     picture = _check_output(args.output or str(source.with_suffix(".png")), _PICTURE_SUFFIXES,
-                            "picture")
+                            "picture", [source])
     saved = load_saved(source)
     from . import plot
 
@@ -247,10 +320,11 @@ def _run_demo(args) -> int:
         raise CaseError(f"{folder}: folder does not exist")
     with resources.as_file(resources.files("softarm") / "data" / "demo.toml") as path:
         case = load_case(path)
+    table = _check_output(str(folder / "demo.csv"), FORMATS, "output")
+    picture = _check_output(str(folder / "demo.png"), _PICTURE_SUFFIXES, "picture")
     args.method = args.stations = args.tol = None
     result, seconds = _solve(case, args)
     print(_summary(case, result, seconds))
-    picture, table = folder / "demo.png", folder / "demo.csv"
     _write(case, result, [table], picture)
     print(f"the demo case file is {resources.files('softarm') / 'data' / 'demo.toml'}; "
           f"copy it to start your own: softarm solve my_arm.toml --plot my_arm.png")

@@ -67,7 +67,10 @@ def solve(arm, loads, *, method="auto", s=None, tol=1e-8, base=None, jacobians=F
         Tolerance of the numerical solver on the tip position, relative to L (the step count
         is raised until the step-doubling error estimate is ≤ tol·L).
     base : array_like, shape (4, 4), optional
-        Pose of the clamped base in the spatial frame (default identity).
+        Pose of the clamped base in the spatial frame (default identity). A nearly rigid pose
+        (RᵀR = I to 1e-5, e.g. printed to a few digits or stored in float32) is
+        re-orthonormalised to the nearest rotation, the same on every route; a pose further
+        from a rigid transform is rejected.
     jacobians : bool
         If True, also return the exact tip compliance ``tip_compliance`` (B..., 6, 6) and the
         station compliances ``compliance`` (B..., N, 6, 6): (δp; δθ), spatial, per unit extra
@@ -84,8 +87,13 @@ def solve(arm, loads, *, method="auto", s=None, tol=1e-8, base=None, jacobians=F
 
     Raises
     ------
+    TypeError
+        A string, bool, None or complex number where a number is expected (numpy scalars of
+        any width are accepted).
     ValueError
-        Bad method, stations, base, tolerance, or loads that do not fit the arm.
+        Bad method, stations, base, tolerance, or loads that do not fit the arm; a batch of
+        load cases and stations whose result would not fit in memory (checked before
+        allocating anything).
     ConvergenceError
         The numerical solver failed (never a silently wrong answer).
 
@@ -108,6 +116,9 @@ def solve(arm, loads, *, method="auto", s=None, tol=1e-8, base=None, jacobians=F
                              "'numeric'")
         return solver.solve_from_unloaded(loads, jacobians=True)
     return solve_prepared(solver, loads, method)
+
+
+#: The solver options that are numbers: real (float) or integer ones.
 
 
 def _check_method(method) -> None:

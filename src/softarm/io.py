@@ -11,10 +11,13 @@ from __future__ import annotations
 
 import contextlib
 import csv
+import errno
 import io as _stdio
 import json
+import math
 import os
 import tempfile
+import zipfile
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -106,12 +109,21 @@ def _meta(result: Equilibrium, case: Case | None) -> dict:
 def write_atomic(path: str | os.PathLike, mode: str = "w"):
     """Open a temporary file beside ``path``; rename it to ``path`` only if the block succeeds.
 
-    A failure (or an interrupt) removes the temporary file and leaves any old ``path`` as it
-    was.
+    A failure (a full disk, a file-size limit, an interrupt) removes the temporary file and
+    leaves any old ``path`` as it was. A symbolic link as ``path`` is written through: its
+    target is replaced and the link kept. A folder as ``path`` is an IsADirectoryError before
+    anything is written.
     """
     path = Path(path)
-    handle, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part",
-                                   dir=path.parent if str(path.parent) else ".")
+    if path.is_symlink():  # write through the link (to its final target)
+        path = Path(os.path.realpath(path))
+    if path.is_dir():
+        raise IsADirectoryError(errno.EISDIR, "is a folder, not a file", str(path))
+    try:
+        handle, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part",
+                                       dir=path.parent if str(path.parent) else ".")
+    except OSError as error:  # e.g. a read-only folder: name the file asked for
+        raise OSError(error.errno, error.strerror, str(path)) from None
     try:
         # mkstemp makes the file private (0600); give it the permissions of a normal new file
         umask = os.umask(0)
@@ -120,6 +132,12 @@ def write_atomic(path: str | os.PathLike, mode: str = "w"):
         with os.fdopen(handle, mode, **({"newline": ""} if "b" not in mode else {})) as stream:
             yield stream
         os.replace(tmp, path)
+    except OSError as error:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        if error.filename is None and error.errno is not None:  # name the file being written
+            raise OSError(error.errno, error.strerror, str(path)) from None
+        raise
     except BaseException:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
@@ -264,16 +282,24 @@ def load_saved(path: str | os.PathLike) -> SavedResult:
                         f"{', '.join(FORMATS)}")
     if not path.exists():
         raise CaseError(f"{path}: no such file")
+    if path.is_dir():
+        raise CaseError(f"{path}: is a folder, not a result file")
     try:
         if suffix == ".json":
             document = json.loads(path.read_text(encoding="utf-8"))
+            if not isinstance(document, dict):
+                raise CaseError(f"{path}: not a softarm result file (not a JSON object)")
             meta = document
-            columns = {k: np.asarray(v, dtype=float) for k, v in document["columns"].items()}
-            poses = np.asarray(document["poses"], dtype=float)
-            residual = np.asarray(document["residual"], dtype=float)
-            estimate = np.asarray(document["error_estimate"], dtype=float)
+            columns = {k: _numbers(v, k) for k, v in document["columns"].items()}
+            poses = _numbers(document["poses"], "poses")
+            residual = _numbers(document["residual"], "residual")
+            estimate = _numbers(document["error_estimate"], "error_estimate")
             sweep = document.get("sweep_values")
+            sweep = None if sweep is None else _numbers(sweep, "sweep_values")
         elif suffix == ".npz":
+            if not zipfile.is_zipfile(path):
+                raise CaseError(f"{path}: not a softarm result file (not an NPZ archive, or "
+                                "truncated)")
             with np.load(path, allow_pickle=False) as data:
                 meta = json.loads(str(data["meta"]))
                 columns = {k: data[k] for k in COLUMNS}
@@ -282,18 +308,20 @@ def load_saved(path: str | os.PathLike) -> SavedResult:
                 sweep = data["sweep_values"] if "sweep_values" in data.files else None
         else:
             meta, columns, poses, residual, estimate, sweep = _read_csv(path)
-    except CaseError:
+    except (CaseError, MemoryError):
         raise
-    except (OSError, KeyError, ValueError, TypeError) as error:
+    except KeyError as error:
+        raise CaseError(f"{path}: not a softarm result file (no {error} entry)") from None
+    except Exception as error:  # any failure to parse: truncated or garbage files included
         raise CaseError(f"{path}: not a softarm result file ({type(error).__name__}: "
-                        f"{error})") from None
+                        f"{_brief(error)})") from None
+    batch = _check_saved(path, meta, columns, poses, residual, estimate, sweep)
     case = None
     if meta.get("case"):
         try:
             case = _parse(meta["case"], path, batched=True)
         except CaseError as error:
             raise CaseError(f"{path}: embedded case: {error}") from None
-    batch = tuple(meta.get("batch_shape", ()))
     s = columns["s_m"].reshape(-1, columns["s_m"].shape[-1])[0]
     strains = _stack(columns, COLUMNS[11:17])
     stresses = _stack(columns, COLUMNS[17:23])
@@ -302,7 +330,7 @@ def load_saved(path: str | os.PathLike) -> SavedResult:
     result = Equilibrium(
         s=s, poses=poses.reshape(*batch, s.size, 4, 4),
         strains=strains.reshape(*batch, s.size, 6), stresses=stresses.reshape(*batch, s.size, 6),
-        arm=case.arm, loads=case.batched_loads, method=meta["method"], exact=bool(meta["exact"]),
+        arm=case.arm, loads=case.batched_loads, method=meta["method"], exact=meta["exact"],
         residual=residual.reshape(batch) if batch else float(residual),
         error_estimate=estimate.reshape(batch) if batch else float(estimate))
     sweep = None if sweep is None else np.asarray(sweep, dtype=float)
@@ -310,12 +338,105 @@ def load_saved(path: str | os.PathLike) -> SavedResult:
                        meta.get("sweep_label"), path)
 
 
+def _brief(error: BaseException, limit: int = 120) -> str:
+    """An exception's message on one line, cut to ``limit`` characters."""
+    text = " ".join(str(error).split())
+    return text if len(text) <= limit else text[: limit - 1] + "…"
+
+
+def _numbers(value, name: str) -> np.ndarray:
+    """A JSON value as a float array: numbers (and null for NaN) only, never strings or bools."""
+    def ok(v):
+        if isinstance(v, list):
+            return all(ok(x) for x in v)
+        return v is None or (isinstance(v, (int, float)) and not isinstance(v, bool))
+
+    if not ok(value):
+        raise ValueError(f"{name!r} must hold numbers only")
+    return np.asarray(value, dtype=float)
+
+
+def _check_saved(path: Path, meta, columns, poses, residual, estimate, sweep) -> tuple:
+    """Every field of a result file checked: types, shapes, finiteness, rigid poses.
+
+    Returns the batch shape; CaseError naming the file and the field otherwise.
+    """
+    def fail(what: str) -> CaseError:
+        return CaseError(f"{path}: not a valid softarm result: {what}")
+
+    if not isinstance(meta, dict):
+        raise fail("the metadata is not an object")
+    if not isinstance(meta.get("method"), str):
+        raise fail(f"'method' must be a string, got {meta.get('method')!r}")
+    if not isinstance(meta.get("exact"), bool):
+        raise fail(f"'exact' must be true or false, got {meta.get('exact')!r}")
+    shape = meta.get("batch_shape", [])
+    if not (isinstance(shape, list) and all(isinstance(b, int) and not isinstance(b, bool)
+                                            and b >= 0 for b in shape)):
+        raise fail(f"'batch_shape' must be a list of integers >= 0, got {shape!r}")
+    n = meta.get("stations")
+    if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+        raise fail(f"'stations' must be an integer >= 1, got {n!r}")
+    batch = tuple(shape)
+    expected = (*batch, n)
+    for name in COLUMNS:
+        column = np.asarray(columns[name])
+        if column.dtype.kind not in "fiu":
+            raise fail(f"column {name!r} holds {column.dtype} values, not numbers")
+        if column.shape != expected:
+            raise fail(f"column {name!r} has shape {column.shape}, expected {expected} "
+                       f"(batch {batch}, {n} stations)")
+        bad = np.flatnonzero(~np.isfinite(column).reshape(-1))
+        if bad.size:
+            index = np.unravel_index(int(bad[0]), expected)
+            raise fail(f"column {name!r} is not finite at index {tuple(map(int, index))}")
+    s = np.asarray(columns["s_m"]).reshape(-1, n)
+    if np.any(np.diff(s, axis=-1) <= 0) or np.any(s != s[:1]):
+        raise fail("column 's_m' must be the same strictly increasing stations for every case")
+    poses = np.asarray(poses)
+    if poses.shape != (*expected, 4, 4):
+        raise fail(f"'poses' has shape {poses.shape}, expected {(*expected, 4, 4)}")
+    if not np.all(np.isfinite(poses)):
+        raise fail("'poses' is not finite")
+    R = poses[..., :3, :3]
+    deviation = np.max(np.abs(np.swapaxes(R, -1, -2) @ R - np.eye(3)), initial=0.0)
+    if deviation > 1e-6 or not np.allclose(poses[..., 3, :], [0.0, 0.0, 0.0, 1.0], atol=1e-12,
+                                           rtol=0.0):
+        raise fail(f"'poses' are not rigid transforms (RᵀR − I up to {deviation:.1e})")
+    positions = _stack(columns, ("x_m", "y_m", "z_m"))
+    scale = max(1.0, float(np.max(np.abs(positions), initial=0.0)))
+    if np.max(np.abs(positions - poses[..., :3, 3]), initial=0.0) > 1e-9 * scale:
+        raise fail("columns x_m, y_m, z_m disagree with the positions in 'poses'")
+    quat = _stack(columns, ("quat_w", "quat_x", "quat_y", "quat_z"))
+    if np.max(np.abs(np.linalg.norm(quat, axis=-1) - 1.0), initial=0.0) > 1e-6:
+        raise fail("columns quat_* are not unit quaternions")
+    for name, values, finite in (("residual", residual, True),
+                                 ("error_estimate", estimate, False)):
+        values = np.asarray(values)
+        if values.dtype.kind not in "fiu" or values.shape not in (batch, ()):
+            raise fail(f"'{name}' must be numbers of shape {batch}, got shape {values.shape}")
+        if finite and not np.all(np.isfinite(values)):
+            raise fail(f"'{name}' is not finite")
+        if not finite and np.any(np.isinf(values)):
+            raise fail(f"'{name}' is infinite")
+    if sweep is not None:
+        sweep = np.asarray(sweep)
+        if sweep.dtype.kind not in "fiu" or sweep.shape != batch[:1] or len(batch) != 1 \
+                or not np.all(np.isfinite(sweep)):
+            raise fail(f"'sweep_values' must be {batch[:1]} finite numbers, got shape "
+                       f"{sweep.shape}")
+    for key in ("softarm_version", "sweep_label", "sweep_column"):
+        if meta.get(key) is not None and not isinstance(meta[key], str):
+            raise fail(f"{key!r} must be a string, got {meta[key]!r}")
+    return batch
+
+
 def _read_csv(path: Path):
     meta: dict = {}
     header = None
     rows = []
     with path.open(newline="", encoding="utf-8") as stream:
-        for line in stream:
+        for number, line in enumerate(stream, start=1):
             if line.startswith("# meta: "):
                 meta.update(json.loads(line[len("# meta: "):]))
             elif line.startswith("# case: "):
@@ -325,16 +446,34 @@ def _read_csv(path: Path):
             elif header is None:
                 header = next(csv.reader([line]))
             else:
-                rows.append([float(v) for v in next(csv.reader([line]))])
+                fields = next(csv.reader([line]))
+                if len(fields) != len(header):
+                    raise CaseError(f"{path}: line {number}: {len(fields)} values, expected "
+                                    f"{len(header)} (one per column of the header)")
+                try:
+                    row = [float(v) for v in fields]
+                except ValueError:
+                    raise CaseError(f"{path}: line {number}: not a row of numbers") from None
+                if not all(math.isfinite(v) for v in row):
+                    column = header[next(i for i, v in enumerate(row) if not math.isfinite(v))]
+                    raise CaseError(f"{path}: line {number}: column {column!r} is not finite")
+                rows.append(row)
     if header is None or "method" not in meta:
         raise CaseError(f"{path}: not a softarm result file (no '# meta:' line or header)")
     missing = [c for c in COLUMNS if c not in header]
     if missing:
         raise CaseError(f"{path}: column {missing[0]!r} missing from the header")
-    table = np.asarray(rows, dtype=float).reshape(-1, len(header))
     batch = tuple(meta.get("batch_shape", ()))
-    n = int(meta["stations"])
+    n = meta.get("stations")
+    if isinstance(n, bool) or not isinstance(n, int) or n < 1 or not all(
+            isinstance(b, int) and not isinstance(b, bool) and b >= 0 for b in batch):
+        raise CaseError(f"{path}: not a valid softarm result: 'stations' {n!r} and "
+                        f"'batch_shape' {list(batch)!r} must be integers")
     shape = (*batch, n)
+    if len(rows) != math.prod(shape):
+        raise CaseError(f"{path}: {len(rows)} rows, expected {math.prod(shape)} (batch "
+                        f"{batch}, {n} stations)")
+    table = np.asarray(rows, dtype=float).reshape(-1, len(header))
     columns = {c: table[:, header.index(c)].reshape(shape) for c in COLUMNS}
     positions = _stack(columns, ("x_m", "y_m", "z_m"))
     quat = _stack(columns, ("quat_w", "quat_x", "quat_y", "quat_z"))

@@ -67,7 +67,7 @@ def _arm(L=1.0, EA=1e6, GAy=1e6, GAz=1e6, GJ=1.0, EIy=1.0, EIz=1.0, curvature=(0
 @pytest.mark.parametrize("follower", [False, True])
 @pytest.mark.parametrize("twist", [0.0, 0.7])
 def test_helix_matches_shooting(follower, twist):
-    # NOTES.md note 4 arm (GJ = 1/1.3, EI = 1), moment (1, 1, 0); twist 0.7 1/m checks the
+    # docs/closed-forms.md arm (GJ = 1/1.3, EI = 1), moment (1, 1, 0); twist 0.7 1/m checks the
     # extension to an initially twisted straight arm (c = κ⁰₁ + M₁ (1/GJ - 1/B)).
     arm = _arm(GJ=1 / 1.3, curvature=(twist, 0.0, 0.0))
     s = np.linspace(0.0, 1.0, 11)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import shared_table
+from conftest import reference_table
 
 from softarm import Arm
 from softarm.analytic import elastica, shear_force
@@ -16,9 +16,9 @@ def _arm(EA=1e6, GAy=1e6, GAz=1e6, EIy=1.0, EIz=2.0, L=1.0, curvature=(0.0, 0.0,
 
 
 def _mattiasson():
-    # ../shared/data/mattiasson_cantilever.json, "computed_here" table: elliptic-integral
+    # softarm/validation/data/mattiasson_cantilever.json, "computed_here" table: elliptic-integral
     # values that match Mattiasson (1981) Table 1 to every quoted digit.
-    rows = shared_table("mattiasson_cantilever.json")["computed_here"]["table"]
+    rows = reference_table("mattiasson_cantilever.json")["computed_here"]["table"]
     return {key: np.array([row[key] for row in rows])
             for key in ("k", "w_over_L", "x_tip_over_L", "tip_rotation_rad")}
 
@@ -51,7 +51,7 @@ def test_fundamental_branch():
 
 
 def test_signs():
-    # NOTES.md sign checks: +z force -> +z deflection, κ_y < 0 (x-z plane, EIy);
+    # docs/closed-forms.md sign checks: +z force -> +z deflection, κ_y < 0 (x-z plane, EIy);
     # +y force -> +y deflection, κ_z > 0 (x-y plane, EIz).
     eq = elastica(_arm(), [0.0, 0.0, 0.5])
     assert np.all(eq.positions[1:, 2] > 0) and np.all(eq.strains[:-1, 4] < 0)

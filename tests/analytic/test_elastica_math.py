@@ -2,9 +2,6 @@
 
 from __future__ import annotations
 
-import json
-from pathlib import Path
-
 import mpmath as mp
 import numpy as np
 import pytest
@@ -16,12 +13,11 @@ from scipy.special import ellipe, ellipk
 
 from softarm.analytic import _elastica_math
 from softarm.analytic._elastica_math import K_MAX, planar_elastica
-
-SHARED_DATA = Path(__file__).resolve().parents[3] / "shared" / "data"
+from softarm.validation import reference_table
 
 
 def _table(name):
-    return json.loads((SHARED_DATA / name).read_text())
+    return reference_table(name)  # softarm/validation/data, shipped with the package
 
 
 def shoot(k, phi, s, axial_ratio=0.0, shear_ratio=0.0, *, kappa0_guess):
@@ -61,7 +57,7 @@ def shoot(k, phi, s, axial_ratio=0.0, shear_ratio=0.0, *, kappa0_guess):
 # --------------------------------------------------------------------------------------------
 def test_mattiasson_table_every_k():
     # Mattiasson (1981) Table 1 / Bisshopp & Drucker (1945), recomputed to 8 digits:
-    # ../shared/data/mattiasson_cantilever.json "computed_here"."table".
+    # softarm/validation/data/mattiasson_cantilever.json "computed_here"."table".
     rows = _table("mattiasson_cantilever.json")["computed_here"]["table"]
     k = np.array([row["k"] for row in rows])
     sol = planar_elastica(k, np.pi / 2, np.array([0.0, 1.0]))
@@ -75,7 +71,7 @@ def test_mattiasson_table_every_k():
 
 def test_mattiasson_published_five_digits():
     # Mattiasson (1981) Table 1 as quoted (5 digits) in public test suites:
-    # ../shared/data/mattiasson_cantilever.json "found_values"[0].
+    # softarm/validation/data/mattiasson_cantilever.json "found_values"[0].
     found = _table("mattiasson_cantilever.json")["found_values"][0]["values"]
     k = np.array([float(key) for key in found])
     sol = planar_elastica(k, np.pi / 2, np.array([1.0]))
@@ -86,7 +82,7 @@ def test_mattiasson_published_five_digits():
 
 @pytest.mark.parametrize("case", range(3))
 def test_shear_deformable_tip_force(case):
-    # ../shared/data/rod_benchmarks.json "shear_deformable_tip_force" (OpenSees gallery
+    # softarm/validation/data/rod_benchmarks.json "shear_deformable_tip_force" (OpenSees gallery
     # FrameCircle: L = 1, EI = 10, EA = 1e8, F = 10 so k = 1; GA = 500, 10, inf), values
     # "computed_here" by an independent shooting solution.
     bench = _table("rod_benchmarks.json")["shear_deformable_tip_force"]

@@ -9,7 +9,7 @@ from softarm import Arm
 from softarm.analytic import axial_force, elastica, shear_force
 
 # Grazioso et al. 2018, §IV.B (Princeton beam as printed): EIy = 36.28 N m²,
-# GAz = 0.9039e6 N, L = 0.508 m; the other stiffnesses from ../shared/data/princeton_beam.json
+# GAz = 0.9039e6 N, L = 0.508 m; the other stiffnesses from validation/data/princeton_beam.json
 # (MBDyn princeton_gen.m values: EA 2841910 N, GAy 640131 N, GJ 3.10338 N m², EIz 2.42873).
 PRINCETON = Arm.from_stiffness(0.508, EA=2841910.0, GAy=640131.0, GAz=0.9039e6, GJ=3.10338,
                                EIy=36.28, EIz=2.42873)
@@ -71,7 +71,7 @@ def test_shear_force_princeton_timoshenko(P):
 
 
 def test_shear_force_signs():
-    # NOTES.md sign check (eqs. 50, 58): +z tip force -> +z deflection, negative κ_y.
+    # docs/closed-forms.md sign check (eqs. 50, 58): +z tip force -> +z deflection, negative κ_y.
     eq = shear_force(_arm(), [0.0, 0.0, 0.01])
     assert np.all(eq.positions[1:, 2] > 0)
     assert np.all(eq.strains[:-1, 4] < 0)

@@ -1,14 +1,15 @@
 """The geometrically exact solver (softarm.solve, method="numeric") against exact references.
 
-References are never our own code: published or independently computed tables in ../shared/data,
-closed forms written out here from their source, scipy.linalg.expm, and conservation laws.
+References are never our own code: published or independently computed tables in
+softarm/validation/data, closed forms written out here from their source, scipy.linalg.expm,
+and conservation laws.
 """
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import shared_table
+from conftest import reference_table
 from scipy.linalg import expm
 
 import softarm
@@ -43,13 +44,13 @@ def hat(w):
 
 # --- exact references ----------------------------------------------------------------------
 
-MATTIASSON = shared_table("mattiasson_cantilever.json")["computed_here"]["table"]
+MATTIASSON = reference_table("mattiasson_cantilever.json")["computed_here"]["table"]
 
 
 @pytest.mark.parametrize("row", MATTIASSON, ids=lambda row: f"k={row['k']}")
 def test_mattiasson_dead_tip_force_every_k(row):
     # Mattiasson (1981) Table 1 / Bisshopp & Drucker (1945), recomputed to 8 digits from the
-    # elliptic integrals in ../shared/data/mattiasson_cantilever.json ("computed_here").
+    # elliptic integrals in softarm/validation/data/mattiasson_cantilever.json ("computed_here").
     # Inextensible reference: EA = GA = 1e10 EI/L² (axial strain ≤ 2e-9), straight start.
     k = row["k"]
     eq = numeric(rigid_arm(), TipLoad(force=[0.0, 0.0, k]), tol=1e-10, s=2)
@@ -66,7 +67,7 @@ def test_mattiasson_dead_tip_force_every_k(row):
 def test_tip_moment_rolls_a_circular_arc(fraction):
     # Simo & Vu-Quoc (1986) roll-up: M = λ 2π EI/L bends the arm into an arc of curvature
     # M/EI, x = (EI/M) sin(sM/EI), z = -(EI/M)(1 - cos(sM/EI)) for a moment about +y
-    # (../shared/data/rod_benchmarks.json rollup_end_moment, "analytic").
+    # (softarm/validation/data/rod_benchmarks.json rollup_end_moment, "analytic").
     EI, L = 2.0, 1.5
     arm = Arm.from_stiffness(L, EA=50.0, GAy=30.0, GAz=30.0, GJ=1.5, EIy=EI, EIz=EI)
     kappa = fraction * 2 * np.pi / L
@@ -79,9 +80,9 @@ def test_tip_moment_rolls_a_circular_arc(fraction):
 
 
 def test_rollup_closes_the_circle():
-    # ../shared/data/rod_benchmarks.json rollup_end_moment (kynema/kynema rollup case: L = 10,
+    # validation/data/rod_benchmarks.json rollup_end_moment (kynema/kynema rollup case: L = 10,
     # EI = 86900, M = 2π EI/L): the tip returns to the root, axial tip displacement -L.
-    table = shared_table("rod_benchmarks.json")["rollup_end_moment"]
+    table = reference_table("rod_benchmarks.json")["rollup_end_moment"]
     case = table["found"][0]
     L, EI = case["L"], case["EI"]
     arm = Arm.from_stiffness(L, EA=1e3 * EI, GAy=1e3 * EI, GAz=1e3 * EI, GJ=EI, EIy=EI,
@@ -111,7 +112,7 @@ def test_axial_force_stretches_by_F_over_EA():
 
 @pytest.mark.parametrize("follower", [False, True])
 def test_helix_under_any_end_moment(follower):
-    # NOTES.md note 4: equal bending stiffnesses B, straight arm, any end moment: the spatial
+    # docs/closed-forms.md: equal bending stiffnesses B, straight arm, any end moment: the spatial
     # moment M is constant, R(s) = exp(s M/B) exp(s c e1), c = M₁(1/GJ - 1/B), centreline =
     # translation of exp_SE3(s [e1; M/B]); a follower moment g gives M = exp(L c e1) g.
     # Tips quoted in the note: dead (0.8492, 0.1508, -0.4220), follower (0.8492, 0.2688,
@@ -134,10 +135,10 @@ def test_helix_under_any_end_moment(follower):
 
 
 def test_follower_tip_force_table_fundamental_branch():
-    # ../shared/data/rod_benchmarks.json follower_tip_force_planar (inextensible, L = EI = 1,
+    # validation/data/rod_benchmarks.json follower_tip_force_planar (inextensible, L = EI = 1,
     # force perpendicular to the deformed tip, continuation from k = 0 on the fundamental
     # branch; Argyris & Symeonidis 1981 is the usual citation). Each k solved from cold.
-    rows = shared_table("rod_benchmarks.json")["follower_tip_force_planar"]["computed_here"]
+    rows = reference_table("rod_benchmarks.json")["follower_tip_force_planar"]["computed_here"]
     arm = rigid_arm()
     for row in rows:
         k = row["k=PL^2/EI"]
@@ -150,12 +151,12 @@ def test_follower_tip_force_table_fundamental_branch():
 
 
 def test_shear_deformable_tip_force_table():
-    # ../shared/data/rod_benchmarks.json shear_deformable_tip_force (STAIRlab/opensees-gallery
+    # validation/data/rod_benchmarks.json shear_deformable_tip_force (STAIRlab/opensees-gallery
     # FrameCircle: L = 1, E = 10, I = 1, A = J = 1e7, F = 10 so EI = 10, k = 1; GA = 500, 10;
     # Batista 2016 closed form). EA = E A = 1e8, GJ large; tip_x is the axial tip coordinate,
     # tip_transverse the deflection along F, tip_rotation the slope of the section normal.
     # The table's GA = 10 row matches EA = 1e8 to 1e-10; its GA = 500 row to 4e-8.
-    data = shared_table("rod_benchmarks.json")["shear_deformable_tip_force"]
+    data = reference_table("rod_benchmarks.json")["shear_deformable_tip_force"]
     for row in data["computed_here"]:
         GA = float(row["GA"])
         GA = 1e12 if np.isinf(GA) else GA
@@ -345,7 +346,7 @@ def test_base_pose_moves_the_solution_rigidly():
     np.testing.assert_allclose(moved.stresses, at_identity.stresses, atol=1e-10)
 
 
-# --- signs pinned by simple cases (NOTES.md) -------------------------------------------------
+# --- signs pinned by simple cases (docs/closed-forms.md) ------------------------------------
 
 def test_signs():
     arm = Arm.from_stiffness(1.0, EA=1e4, GAy=1e4, GAz=1e4, GJ=1.0, EIy=1.0, EIz=1.0)

@@ -5,7 +5,7 @@ s (N,); :func:`build` broadcasts them to one batch shape, forms the stresses σ 
 given, and returns the :class:`~softarm.Equilibrium` without copying the arrays.
 
 :func:`screw_poses` is the fast kernel of the constant-strain and helix closed forms,
-H(s) = exp_SE3(s (u; ω)) · exp_SE3(s (0; τ e1)) (NOTES.md note 4, eq. 32 for τ = 0).
+H(s) = exp_SE3(s (u; ω)) · exp_SE3(s (0; τ e1)) (docs/closed-forms.md, eq. 32 for τ = 0).
 """
 
 from __future__ import annotations
@@ -79,7 +79,7 @@ def moment_is_principal(arm: Arm, moment: np.ndarray) -> np.ndarray:
 
     True when the moment is an eigenvector of K_ωω (its non-zero components share one
     stiffness) and the initial curvature κ⁰ is parallel to it (or zero): then m' = -κ × m
-    vanishes, σ is constant and H = exp(s (f⁰ + ε)) is exact (NOTES.md note 2), for a dead or
+    vanishes, σ is constant and H = exp(s (f⁰ + ε)) is exact (docs/closed-forms.md), for a dead or
     a follower moment alike (the tip turns about the moment axis).
     """
     k = rotational_stiffness(arm)
@@ -252,7 +252,7 @@ def screw_poses(u, omega, s, twist=None, fields=None):
     buffer = np.empty((*batch, n, columns))
     flat = buffer.reshape(size, n, columns)
     if fields is not None:
-        fields = _broadcast(fields, (*batch, 3, columns - 16)).reshape(size, 3, -1)
+        fields = _broadcast(fields, (*batch, 3, columns - 16)).reshape(size, 3, columns - 16)
 
     def fill(first: int, last: int) -> None:
         """Write arms first..last-1, block by block, with scratch of its own."""

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import as_vectors, positive
+from .._validate import as_vectors, length, positive
 from .material import Material
 from .sections import Circle, Rectangle, Rigidities, Section, Tube
 
@@ -54,7 +54,7 @@ class Arm:
     mass_per_length: float | None = None
 
     def __post_init__(self):
-        positive(self.length, "Arm.length", "m")
+        object.__setattr__(self, "length", length(self.length, "Arm.length"))
         if not isinstance(self.section, _SECTION_KINDS):
             raise TypeError(
                 "Arm.section must be a Circle, Tube, Rectangle, Section or Rigidities, got "
@@ -73,7 +73,8 @@ class Arm:
             raise ValueError(f"Arm.curvature must have shape (3,), got shape {curvature.shape}")
         object.__setattr__(self, "curvature", tuple(float(c) for c in curvature))
         if self.mass_per_length is not None:
-            positive(self.mass_per_length, "Arm.mass_per_length", "kg/m")
+            object.__setattr__(self, "mass_per_length",
+                               positive(self.mass_per_length, "Arm.mass_per_length", "kg/m"))
 
     @classmethod
     def from_stiffness(cls, length, EA, GAy, GAz, GJ, EIy, EIz, curvature=(0.0, 0.0, 0.0),

@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from .._validate import positive
+from .._validate import positive, real
 
 __all__ = ["Material"]
 
@@ -41,18 +41,25 @@ class Material:
     density: float | None = None
 
     def __post_init__(self):
-        positive(self.youngs_modulus, "Material.youngs_modulus", "Pa")
+        object.__setattr__(self, "youngs_modulus",
+                           positive(self.youngs_modulus, "Material.youngs_modulus", "Pa"))
         if (self.poisson_ratio is None) == (self.shear_modulus is None):
             raise ValueError(
                 "Material needs exactly one of poisson_ratio and shear_modulus, got "
                 f"poisson_ratio={self.poisson_ratio!r}, shear_modulus={self.shear_modulus!r}"
             )
         if self.shear_modulus is not None:
-            positive(self.shear_modulus, "Material.shear_modulus", "Pa")
-        if self.poisson_ratio is not None and (
-            isinstance(self.poisson_ratio, bool) or not isinstance(self.poisson_ratio, (int, float))
-        ):
-            raise TypeError(f"Material.poisson_ratio must be a number, got {self.poisson_ratio!r}")
+            object.__setattr__(self, "shear_modulus",
+                               positive(self.shear_modulus, "Material.shear_modulus", "Pa"))
+        if self.poisson_ratio is not None:  # any real number, numpy scalars of any width too
+            try:
+                object.__setattr__(self, "poisson_ratio",
+                                   real(self.poisson_ratio, "Material.poisson_ratio"))
+            except TypeError:
+                raise TypeError(f"Material.poisson_ratio must be a number, got "
+                                f"{self.poisson_ratio!r}") from None
+            except ValueError:  # not finite: reported by the range check below
+                pass
         nu = self.nu
         if not (math.isfinite(nu) and -1.0 < nu <= 0.5):
             what = (
@@ -62,7 +69,8 @@ class Material:
             )
             raise ValueError(f"Material.poisson_ratio must lie in (-1, 0.5], got {what}")
         if self.density is not None:
-            positive(self.density, "Material.density", "kg/m³")
+            object.__setattr__(self, "density",
+                               positive(self.density, "Material.density", "kg/m³"))
 
     @property
     def E(self) -> float:

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import positive
+from .._validate import length, positive
 from .material import Material
 
 __all__ = ["Circle", "Rectangle", "Rigidities", "Section", "Tube"]
@@ -46,7 +46,8 @@ class Rigidities:
     def __post_init__(self):
         for name, unit in (("EA", "N"), ("GAy", "N"), ("GAz", "N"), ("GJ", "N m²"),
                            ("EIy", "N m²"), ("EIz", "N m²")):
-            positive(getattr(self, name), f"Rigidities.{name}", unit)
+            object.__setattr__(self, name, positive(getattr(self, name), f"Rigidities.{name}",
+                                                    unit))
 
     @property
     def matrix(self) -> np.ndarray:
@@ -78,13 +79,14 @@ class Section:
     shear_factor_z: float = 1.0
 
     def __post_init__(self):
-        positive(self.area, "Section.area", "m²")
+        object.__setattr__(self, "area", positive(self.area, "Section.area", "m²"))
         for name in ("Iy", "Iz", "J"):
-            positive(getattr(self, name), f"Section.{name}", "m⁴")
+            object.__setattr__(self, name, positive(getattr(self, name), f"Section.{name}", "m⁴"))
         for name in ("shear_factor_y", "shear_factor_z"):
             value = positive(getattr(self, name), f"Section.{name}", "(dimensionless)")
             if value > 1.0:
                 raise ValueError(f"Section.{name} must lie in (0, 1], got {value!r}")
+            object.__setattr__(self, name, value)
 
     def properties(self, poisson_ratio: float) -> Section:
         """This section's properties (the shear factors were given, so ν is not used)."""
@@ -138,7 +140,7 @@ class Circle(_Shape):
     radius: float
 
     def __post_init__(self):
-        positive(self.radius, "Circle.radius", "m")
+        object.__setattr__(self, "radius", length(self.radius, "Circle.radius"))
 
     def properties(self, poisson_ratio: float) -> Section:
         r, nu = self.radius, poisson_ratio
@@ -168,8 +170,8 @@ class Tube(_Shape):
     inner_radius: float
 
     def __post_init__(self):
-        positive(self.outer_radius, "Tube.outer_radius", "m")
-        positive(self.inner_radius, "Tube.inner_radius", "m")
+        for name in ("outer_radius", "inner_radius"):
+            object.__setattr__(self, name, length(getattr(self, name), f"Tube.{name}"))
         if self.inner_radius >= self.outer_radius:
             raise ValueError(
                 "Tube.inner_radius must be smaller than Tube.outer_radius, got "
@@ -214,8 +216,8 @@ class Rectangle(_Shape):
     height: float
 
     def __post_init__(self):
-        positive(self.width, "Rectangle.width", "m")
-        positive(self.height, "Rectangle.height", "m")
+        object.__setattr__(self, "width", length(self.width, "Rectangle.width"))
+        object.__setattr__(self, "height", length(self.height, "Rectangle.height"))
 
     def properties(self, poisson_ratio: float) -> Section:
         w, h, nu = self.width, self.height, poisson_ratio

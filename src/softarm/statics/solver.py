@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import as_matrices, stations
+from .._validate import check_allocation, count, real, rigid_transform, stations
 from ..equilibrium import Equilibrium
 from ..errors import ConvergenceError
 from ..loads import as_loads, batch_shape
@@ -31,7 +31,6 @@ _IDENTITY.setflags(write=False)
 #: The largest load accepted, in units of the bending scale (EI/L², EI/L): beyond it the rod
 #: is a string whose shape double precision cannot follow.
 _LOAD_LIMIT = 1e12
-_BYTES_LIMIT = 1 << 34  # 16 GiB of outputs: refuse before allocating
 
 
 def _kernels():
@@ -43,23 +42,9 @@ def _kernels():
 
 
 def check_base(base) -> np.ndarray:
-    """The base pose as a (4, 4) rigid transform, or ValueError naming ``base``."""
-    if base is None:
-        return _IDENTITY
-    H = as_matrices(base, "base", 4)
-    if H.shape != (4, 4):
-        raise ValueError(f"base must be a single 4×4 rigid transform, got shape {H.shape}")
-    R = H[:3, :3]
-    if not (np.allclose(H[3], [0.0, 0.0, 0.0, 1.0], rtol=0.0, atol=1e-12)
-            and np.allclose(R.T @ R, np.eye(3), rtol=0.0, atol=1e-9)
-            and np.linalg.det(R) > 0.0):
-        raise ValueError(
-            "base must be a rigid transform [[R, p], [0, 0, 0, 1]] with R a proper rotation "
-            f"(RᵀR = I to 1e-9, det R = +1), got {H.tolist()!r}"
-        )
-    out = H.copy()
-    out[3] = (0.0, 0.0, 0.0, 1.0)
-    return out
+    """The base pose as a (4, 4) rigid transform (a nearly rigid one re-orthonormalised, the
+    same rule on every route), or ValueError naming ``base``."""
+    return _IDENTITY if base is None else rigid_transform(base, "base")
 
 
 def _check_arm(arm):
@@ -69,10 +54,8 @@ def _check_arm(arm):
 
 
 def check_tol(tol) -> float:
-    if isinstance(tol, bool) or not isinstance(tol, (int, float, np.floating, np.integer)):
-        raise TypeError(f"tol must be a number (tip position tolerance / L), got {tol!r}")
-    tol = float(tol)
-    if not (math.isfinite(tol) and 1e-13 <= tol <= 1e-1):
+    tol = real(tol, "tol", "units of the arm length")
+    if not 1e-13 <= tol <= 1e-1:
         raise ValueError(
             f"tol must be a relative tip-position tolerance in [1e-13, 0.1], got {tol!r}"
         )
@@ -80,9 +63,7 @@ def check_tol(tol) -> float:
 
 
 def _check_count(value, name: str, low: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low:
-        raise ValueError(f"{name} must be an integer >= {low}, got {value!r}")
-    return int(value)
+    return count(value, name, low)
 
 
 def _normal_positive(values, what: str) -> None:
@@ -290,6 +271,8 @@ class Solver:
         self.arm = _check_arm(arm)
         self._data = _arm_data(arm)
         self.length = self._data.length
+        if isinstance(s, (int, np.integer)) and not isinstance(s, (bool, np.bool_)):
+            check_allocation(1, int(s), "s")
         if s is None or (isinstance(s, (int, np.integer)) and not isinstance(s, bool)
                          and s >= 2):
             self.s, self._s_kernel = _uniform_stations(self.length, 101 if s is None else int(s))
@@ -301,12 +284,10 @@ class Solver:
         self.base = check_base(base)
         self._base_kernel = self.base.copy()  # private and writable (one kernel type)
         self.max_iterations = _check_count(max_iterations, "max_iterations", 1)
-        if isinstance(max_load_step, bool) or not isinstance(
-                max_load_step, (int, float, np.integer, np.floating)) \
-                or not 0.0 < float(max_load_step) <= 1.0:
+        self.max_load_step = real(max_load_step, "max_load_step")
+        if not 0.0 < self.max_load_step <= 1.0:
             raise ValueError(f"max_load_step must be a load-factor step in (0, 1], got "
                              f"{max_load_step!r}")
-        self.max_load_step = float(max_load_step)
         if steps is not None and (_check_count(steps, "steps", 2) % 2 or steps > _N_MAX):
             raise ValueError(f"steps must be an even integer in [2, {_N_MAX}], got {steps!r}")
         self.steps = steps
@@ -332,13 +313,7 @@ class Solver:
         cuts = tuple(sorted({float(c) for load in loads for c in load.cuts(self.arm)}
                             | {float(c) for c in extra_cuts}))
         pieces = data.pieces(cuts)
-        S = self.s.size
-        need = count * (S * (16 + 12) * 8 + pieces[0].size * 24 * 8)
-        if need > _BYTES_LIMIT:
-            raise ValueError(
-                f"a batch of {count} load cases at {S} stations needs about "
-                f"{need / 2**30:.3g} GiB of outputs (limit {_BYTES_LIMIT / 2**30:.0f} GiB): "
-                "solve it in chunks or with fewer stations")
+        check_allocation(count, self.s.size, "loads")
         channels = _Channels(data, pieces, shape, count)
         for load in loads:
             load.apply(channels)

@@ -1,22 +1,27 @@
-"""Checks, case results and the location of the shared reference tables."""
+"""Checks, case results and the reference tables shipped with the package."""
 
 from __future__ import annotations
 
 import json
 import math
+import os
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from importlib import resources
 from pathlib import Path
+from typing import Any
 
 __all__ = [
     "GATED",
     "STATUSES",
+    "TABLES",
     "CaseResult",
     "Check",
     "DataTables",
     "find_data_dir",
     "finding",
     "gate",
+    "reference_table",
     "skipped",
 ]
 
@@ -24,7 +29,8 @@ __all__ = [
 STATUSES = ("pass", "fail", "finding", "skipped")
 GATED = ("pass", "fail")
 
-_TABLES = ("mattiasson_cantilever.json", "princeton_beam.json", "rod_benchmarks.json")
+#: The reference tables shipped in ``softarm/validation/data`` (each with its provenance).
+TABLES = ("mattiasson_cantilever.json", "princeton_beam.json", "rod_benchmarks.json")
 
 
 @dataclass(frozen=True)
@@ -152,28 +158,40 @@ class CaseResult:
     markdown: list[str] = field(default_factory=list)
 
 
-def find_data_dir(start: Path | None = None) -> Path | None:
-    """The ``shared/data`` folder beside the repository, or None if it is not there.
+def find_data_dir() -> Any:
+    """The folder of reference tables shipped inside the package (``softarm/validation/data``).
 
-    Looked for next to each parent of this file (the repository sits beside ``shared/`` in an
-    editable install), then next to each parent of the working directory (a regular install
-    run from inside the checkout). A folder counts only if it holds at least one of the
-    reference tables.
+    Read with :mod:`importlib.resources`, so it works from a wheel, a zip or a checkout alike;
+    its ``README.md`` says where each table comes from.
     """
-    roots = [Path(__file__).resolve(), (start or Path.cwd()).resolve()]
-    for root in roots:
-        for parent in (root, *root.parents):
-            candidate = parent / "shared" / "data"
-            if any((candidate / name).is_file() for name in _TABLES):
-                return candidate
-    return None
+    return resources.files("softarm.validation") / "data"
+
+
+def reference_table(name: str) -> dict:
+    """One of the packaged reference tables (:data:`TABLES`), parsed.
+
+    Examples
+    --------
+    >>> reference_table("mattiasson_cantilever.json")["title"][:27]
+    'Large-deflection cantilever'
+    """
+    if name not in TABLES:
+        raise ValueError(f"name must be one of {TABLES}, got {name!r}")
+    return json.loads((find_data_dir() / name).read_text(encoding="utf-8"))
 
 
 class DataTables:
-    """The reference tables of ``../shared/data``, loaded lazily; None where missing."""
+    """Reference tables (JSON) from a folder, loaded lazily; None where missing.
 
-    def __init__(self, directory: Path | None):
-        self.directory = None if directory is None else Path(directory)
+    ``directory`` is a path, a :mod:`importlib.resources` folder (the packaged tables, the
+    default of :func:`softarm.validation.run`) or None (no tables: every table-based check is
+    skipped).
+    """
+
+    def __init__(self, directory):
+        if isinstance(directory, (str, os.PathLike)):
+            directory = Path(directory)
+        self.directory = directory
         self._cache: dict[str, dict | None] = {}
 
     def get(self, name: str) -> dict | None:
@@ -186,5 +204,5 @@ class DataTables:
 
     def missing_reason(self, name: str) -> str:
         if self.directory is None:
-            return "reference folder shared/data not found beside the repository"
+            return "run without reference tables (data_dir=None)"
         return f"reference table {name} not found in {self.directory}"

@@ -33,14 +33,14 @@ class Report:
     Attributes
     ----------
     cases : list of (Case, CaseResult, seconds)
-    data_dir : Path or None
-        The reference-table folder used (None if not found).
+    data_dir : Path, importlib.resources folder or None
+        The reference-table folder used (None: run without tables).
     seconds : float
         Wall time of the whole run (the case computations, not the output writing).
     """
 
     cases: list[tuple[Case, CaseResult, float]] = field(default_factory=list)
-    data_dir: Path | None = None
+    data_dir: object = None
     seconds: float = 0.0
 
     @property
@@ -59,9 +59,20 @@ class Report:
         """1 if any gated check failed, else 0 (findings and skipped checks never fail)."""
         return 1 if self.failed else 0
 
+    def strict_exit_code(self) -> int:
+        """1 if any gated check failed or any check was skipped, else 0 (``--strict``)."""
+        return 1 if self.failed or self.count("skipped") else 0
+
     def summary(self) -> str:
         counts = ", ".join(f"{self.count(s)} {s}" for s in ("pass", "fail", "finding", "skipped"))
         return f"{len(self.checks)} checks: {counts}"
+
+
+def _where(directory) -> str:
+    """A short name for a reference-table folder: the packaged one, or its last two parts."""
+    if str(directory) == str(find_data_dir()):
+        return "softarm/validation/data"
+    return "/".join(Path(str(directory)).parts[-2:])
 
 
 def _progress(stream: TextIO | None, done: int, total: int, text: str) -> None:
@@ -82,8 +93,9 @@ def run(cases: Sequence[str] | None = None, *, data_dir=_AUTO,
     cases : sequence of str, optional
         Case names (see :data:`softarm.validation.CASES`); all of them by default.
     data_dir : path or None, optional
-        Folder with the reference tables; by default ``shared/data`` beside the repository
-        (:func:`find_data_dir`). None runs without tables: their checks are skipped.
+        Folder with the reference tables; by default the tables shipped in the package
+        (:func:`find_data_dir`). None runs without tables: their checks are skipped (and
+        reported as such).
     progress : text stream, "stderr" or None
         Where the plain-text progress bar goes (``sys.stderr`` at call time by default; None
         for silence).
@@ -101,7 +113,7 @@ def run(cases: Sequence[str] | None = None, *, data_dir=_AUTO,
     tables = DataTables(directory)
     report = Report(data_dir=tables.directory)
     if progress is not None:
-        where = tables.directory if tables.directory is not None else "not found (skipping)"
+        where = _where(tables.directory) if tables.directory is not None else "none (skipping)"
         progress.write(f"reproduce: {len(selected)} cases; reference tables: {where}; the first "
                        "numerical solve compiles the solver (~20 s on a cold cache)\n")
     start = time.perf_counter()
@@ -238,8 +250,9 @@ def markdown(report: Report, figures: dict[str, str] | None = None) -> str:
         "",
         "softarm against the closed forms of Grazioso, Di Gironimo & Siciliano (RoboSoft 2018, "
         "\"the paper\"), against the classic large-deflection rod benchmarks and against the "
-        "reference tables of `../shared/data` (each row names its source, and says when a "
-        "reference was *computed* rather than published).",
+        "reference tables shipped with softarm in `softarm/validation/data` (each row names "
+        "its source, and says when a reference was *computed* rather than published; the "
+        "folder's README.md gives each table's provenance).",
         "",
         "- **pass / fail**: an exact route of softarm (a closed form where it is exact, or the "
         "numerical solver, `solve(method='numeric')`) against a reference, gated by a "
@@ -248,7 +261,8 @@ def markdown(report: Report, figures: dict[str, str] | None = None) -> str:
         "its constant-strain formula off a principal axis) against the exact answer. Reported, "
         "never gated: a large error there is a property of the approximation.",
         "- **skipped**: the reference table was not found (the command still runs every case "
-        "whose reference is a closed form).",
+        "whose reference is a closed form; `softarm reproduce --strict` exits with status 1 "
+        "on a skipped check too).",
         "",
         "Errors: `abs` = |softarm − reference| in the unit of the quantity (lengths divided by L "
         "where the quantity says /L); `angle` = the same for angles, compared modulo 2π (softarm's "
@@ -268,14 +282,13 @@ def markdown(report: Report, figures: dict[str, str] | None = None) -> str:
                      f"{n['pass']} | {n['fail']} | {n['finding']} | {n['skipped']} | "
                      f"{_worst(c)} |")
     lines += _findings_summary(report)
-    if report.data_dir is None or not Path(report.data_dir).is_dir():
-        missing = "shared/data" if report.data_dir is None else report.data_dir
+    if report.data_dir is None or not report.data_dir.is_dir():
+        missing = "(none)" if report.data_dir is None else _where(report.data_dir)
         lines += ["", f"Reference folder `{missing}` not found: table-based checks skipped "
                   "(see each case)."]
     else:
-        shown = "/".join(Path(report.data_dir).parts[-2:])
-        lines += ["", f"Reference tables read from `{shown}` (beside the repository by "
-                  "default; `--data DIR` for another folder)."]
+        lines += ["", f"Reference tables read from `{_where(report.data_dir)}` (the package's "
+                  "own by default; `--data DIR` for another folder)."]
     for case, result, _ in report.cases:
         lines += ["", f"<a id=\"{case.name.replace('_', '-')}\"></a>", "",
                   f"## {case.title}", "", case.description, ""]
