@@ -32,7 +32,7 @@ import numpy as np
 
 from ._validate import as_array, check_allocation
 from .equilibrium import Equilibrium
-from .loads import DistributedForce, Gravity, PointLoad, TipLoad, as_loads
+from .loads import LOAD_KINDS, as_loads
 from .model import Arm, Circle, Material, Rectangle, Rigidities, Section, SegmentedArm, Tube
 from .statics.solver import check_tol
 
@@ -92,16 +92,6 @@ class SolveOptions:
     tol: float = 1e-8
 
 
-_VECTOR_FIELDS = {
-    "tip": {"force": "N", "moment": "N m"},
-    "point": {"force": "N", "moment": "N m"},
-    "distributed": {"force": "N/m"},
-    "gravity": {"acceleration": "m/s²"},
-}
-_DEFAULT_FIELD = {"tip": "force", "point": "force", "distributed": "force",
-                  "gravity": "acceleration"}
-_KIND_OF = {TipLoad: "tip", PointLoad: "point", DistributedForce: "distributed",
-            Gravity: "gravity"}
 _COMPONENTS = ("magnitude", "x", "y", "z")
 
 
@@ -137,7 +127,7 @@ class Sweep:
     @property
     def unit(self) -> str:
         """Unit of the swept parameter, e.g. ``"N"``."""
-        return _VECTOR_FIELDS[self.kind][self.field]
+        return dict(LOAD_KINDS[self.kind].vectors)[self.field]
 
     @property
     def label(self) -> str:
@@ -148,7 +138,8 @@ class Sweep:
     @property
     def column(self) -> str:
         """Table column name with unit, e.g. ``"tip_force_magnitude_N"``."""
-        unit = {"N": "N", "N m": "Nm", "N/m": "N_per_m", "m/s²": "m_per_s2"}[self.unit]
+        unit = {"N": "N", "N m": "Nm", "N/m": "N_per_m", "N m/m": "Nm_per_m",
+                "m/s²": "m_per_s2"}[self.unit]
         name = self.name or f"{self.kind}_{self.field}_{self.component}"
         name = "".join(c if c.isalnum() else "_" for c in name).strip("_")
         return f"{name}_{unit}"
@@ -433,27 +424,32 @@ def _arm(table: _Table) -> Arm:
 
 
 def _load(table: _Table):
-    kind = table.string("kind", tuple(_VECTOR_FIELDS))
-    if kind == "tip":
-        force, moment = table.vector("force", "N"), table.vector("moment", "N m")
-        follower = table.boolean("follower", default=False)
-        build = partial(TipLoad, force, moment, follower)
-    elif kind == "point":
-        s = table.number("s", "m", positive=False)
-        if s < 0:
-            raise table.error("s", f"must be an arc length >= 0 in m, got {s!r}")
-        force, moment = table.vector("force", "N"), table.vector("moment", "N m")
-        build = partial(PointLoad, s, force, moment)
-    elif kind == "distributed":
-        if not table.has("force"):
-            raise table.missing("force", "a list of 3 numbers in N/m")
-        force = table.vector("force", "N/m")
-        build = partial(DistributedForce, force)
-    else:
-        acceleration = table.vector("acceleration", "m/s²", default=(0.0, 0.0, -9.81))
-        build = partial(Gravity, acceleration)
+    """A ``[[load]]`` table, read by the load class's own schema (:class:`softarm.loads.Key`)."""
+    kind = table.string("kind", tuple(LOAD_KINDS))
+    cls = LOAD_KINDS[kind]
+    values = {}
+    for key in cls.schema:
+        if not table.has(key.name):
+            if key.required:
+                raise table.missing(key.name, f"a {key.kind} in {key.unit}" if key.unit
+                                    else f"a {key.kind}")
+            continue
+        if key.kind == "vector":
+            values[key.name] = table.vector(key.name, key.unit)
+        elif key.kind == "number":
+            values[key.name] = table.number(key.name, key.unit, positive=False)
+        elif key.kind == "flag":
+            values[key.name] = table.boolean(key.name, default=False)
+        elif key.kind == "index":
+            values[key.name] = table.integer(key.name, minimum=0)
+        else:  # a span: two numbers in m
+            raw = table.raw(key.name)
+            if not (isinstance(raw, list) and len(raw) == 2 and not _has_bool(raw)
+                    and all(isinstance(v, Real) for v in raw)):
+                raise table.error(key.name, f"must be [s0, s1], two numbers in m, got {raw!r}")
+            values[key.name] = tuple(float(v) for v in raw)
     table.done()
-    return _model(table, build)
+    return _model(table, partial(cls, **values))
 
 
 def _stations(table: _Table) -> int:
@@ -480,9 +476,9 @@ def _sweep(table: _Table, loads: tuple, stations: int) -> Sweep:
     if index > len(loads):
         raise table.error("load", f"there are {len(loads)} [[load]] tables, got load = "
                           f"{index} (counted from 1)")
-    kind = _KIND_OF[type(loads[index - 1])]
-    fields = _VECTOR_FIELDS[kind]
-    field_name = table.string("field", tuple(fields), default=_DEFAULT_FIELD[kind])
+    kind = loads[index - 1].kind
+    fields = dict(loads[index - 1].vectors)
+    field_name = table.string("field", tuple(fields), default=next(iter(fields)))
     component = table.string("component", _COMPONENTS, default="magnitude")
     label = table.string("name", default="")
     if table.has("values"):
@@ -569,12 +565,10 @@ def _parse(data, source, *, name=None, batched=False) -> Case:
         arm = SegmentedArm(tuple(segments))
     loads = tuple(_load(t) for t in top.tables("load"))
     for i, load in enumerate(loads):
-        if isinstance(load, PointLoad) and load.s > arm.length:
-            raise CaseError(f"{where}: load[{i + 1}].s: must lie on the arm, in [0, "
-                            f"{arm.length!r}] m, got {load.s!r}")
-        if isinstance(load, Gravity) and any(a.linear_density is None for a in arm.segments):
-            raise CaseError(f"{where}: load[{i + 1}]: gravity needs the arm's mass: give "
-                            "material.density or mass_per_length")
+        try:
+            load.check(arm)  # the model's own rule, reported with the key path
+        except ValueError as error:
+            raise CaseError(f"{where}: load[{i + 1}]: {error}") from None
     options = _solve_options(top.table("solve")) if top.has("solve") else SolveOptions()
     sweep = _sweep(top.table("sweep"), loads, options.stations) if top.has("sweep") else None
     top.done()
@@ -666,18 +660,7 @@ def arm_to_dict(arm: Arm | SegmentedArm) -> dict:
 
 def loads_to_dict(loads) -> list[dict]:
     """The ``[[load]]`` tables describing ``loads`` (batched vectors become nested lists)."""
-    out = []
-    for load in as_loads(loads):
-        kind = _KIND_OF[type(load)]
-        item: dict = {"kind": kind}
-        if kind == "point":
-            item["s"] = load.s
-        for name in _VECTOR_FIELDS[kind]:
-            item[name] = np.asarray(getattr(load, name)).tolist()
-        if kind == "tip":
-            item["follower"] = bool(load.follower)
-        out.append(item)
-    return out
+    return [load.to_case() for load in as_loads(loads)]
 
 
 # --------------------------------------------------------------------------------------------
@@ -765,9 +748,8 @@ def _take(loads: tuple, start: int, stop: int) -> tuple:
     out = []
     for load in loads:
         if load.batch_shape:
-            kind = _KIND_OF[type(load)]
             load = replace(load, **{name: np.asarray(getattr(load, name))[start:stop]
-                                    for name in _VECTOR_FIELDS[kind]
+                                    for name, _ in load.vectors
                                     if np.ndim(getattr(load, name)) > 1})
         out.append(load)
     return tuple(out)

@@ -23,9 +23,11 @@ import numpy as np
 from ._validate import as_array, as_vectors
 
 __all__ = [
+    "LOAD_KINDS",
     "DistributedForce",
     "DistributedMoment",
     "Gravity",
+    "Key",
     "Load",
     "LoadTarget",
     "PointLoad",
@@ -98,6 +100,35 @@ class LoadTarget(Protocol):
         """A wrench at the tip, dead or follower."""
 
 
+@dataclass(frozen=True)
+class Key:
+    """One key of a load's case-file table (``[[load]]``), read and written alike.
+
+    ``kind``: "vector" (3 numbers in ``unit``), "number" (in ``unit``), "flag" (a bool),
+    "span" ((s0, s1) in m) or "index" (an integer >= 0). An absent optional key takes the
+    load class's default.
+    """
+
+    name: str
+    kind: str
+    unit: str = ""
+    required: bool = False
+
+    def to_case(self, value):
+        """``value`` as a TOML-ready value (lists and plain numbers), or None to omit it."""
+        if value is None:
+            return None
+        if self.kind == "vector":
+            return np.asarray(value).tolist()
+        if self.kind == "span":
+            return [float(v) for v in value]
+        return {"number": float, "flag": bool, "index": int}[self.kind](value)
+
+
+#: Every load kind by its case-file name, filled as the classes are defined.
+LOAD_KINDS: dict[str, type] = {}
+
+
 class Load(abc.ABC):
     """Base of every load kind.
 
@@ -115,8 +146,26 @@ class Load(abc.ABC):
     """
 
     kind: ClassVar[str]
-    #: The vector fields of the load: (name, unit), in the order of the case file.
-    vectors: ClassVar[tuple[tuple[str, str], ...]]
+    #: The load's case-file keys, in file order.
+    schema: ClassVar[tuple[Key, ...]]
+    #: The vector fields of the load, (name, unit): derived from ``schema``.
+    vectors: ClassVar[tuple[tuple[str, str], ...]] = ()
+
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        if "schema" in cls.__dict__:
+            cls.vectors = tuple((k.name, k.unit) for k in cls.schema if k.kind == "vector")
+        if "kind" in cls.__dict__:
+            LOAD_KINDS[cls.kind] = cls
+
+    def to_case(self) -> dict:
+        """The load's ``[[load]]`` table (batched vectors become nested lists)."""
+        out = {"kind": self.kind}
+        for key in self.schema:
+            value = key.to_case(getattr(self, key.name))
+            if value is not None:
+                out[key.name] = value
+        return out
 
     @property
     @abc.abstractmethod
@@ -133,8 +182,22 @@ class Load(abc.ABC):
         re-expressed in the base frame (Rᵀ v), follower components unchanged."""
 
     @abc.abstractmethod
-    def describe(self) -> str:
-        """One line saying what the load is, with its frame and units."""
+    def describe(self, swept: tuple[str, str] | None = None) -> str:
+        """One line saying what the load is, with its frame and units. ``swept`` = (field
+        name, text): that field is described by the text (a sweep's range) instead."""
+
+    def _fields_text(self, swept) -> str:
+        """"force (0, 0, -1) N, moment ..." for the non-zero (or batched, or swept) vectors."""
+        items = []
+        for name, unit in self.vectors:
+            value = np.asarray(getattr(self, name))
+            if swept is not None and swept[0] == name:
+                items.append(f"{name} {swept[1]}")
+            elif value.ndim > 1:
+                items.append(f"{name} (batch of {value.shape[:-1]})")
+            elif np.any(value != 0):
+                items.append(f"{name} {_fmt(value, unit)}")
+        return ", ".join(items) if items else "zero"
 
     def cuts(self, arm) -> tuple[float, ...]:
         """Arc lengths (m) where the arm must be cut for this load (default: none)."""
@@ -180,7 +243,8 @@ class TipLoad(Load):
     """
 
     kind: ClassVar[str] = "tip"
-    vectors: ClassVar = (("force", "N"), ("moment", "N m"))
+    schema: ClassVar = (Key("force", "vector", "N"), Key("moment", "vector", "N m"),
+                        Key("follower", "flag"))
 
     force: np.ndarray = (0.0, 0.0, 0.0)
     moment: np.ndarray = (0.0, 0.0, 0.0)
@@ -204,10 +268,8 @@ class TipLoad(Load):
             return self
         return TipLoad(_rotated(R, self.force), _rotated(R, self.moment))
 
-    def describe(self) -> str:
-        frame = "follower (tip material frame)" if self.follower else "dead (spatial)"
-        return (f"tip load, {frame}: force {_fmt(self.force, 'N')}, "
-                f"moment {_fmt(self.moment, 'N m')}")
+    def describe(self, swept=None) -> str:
+        return ("follower tip " if self.follower else "tip ") + self._fields_text(swept)
 
 
 @dataclass(frozen=True, eq=False)
@@ -221,7 +283,7 @@ class Gravity(Load):
     """
 
     kind: ClassVar[str] = "gravity"
-    vectors: ClassVar = (("acceleration", "m/s²"),)
+    schema: ClassVar = (Key("acceleration", "vector", "m/s²"),)
 
     acceleration: np.ndarray = (0.0, 0.0, -9.81)
 
@@ -245,8 +307,11 @@ class Gravity(Load):
     def in_base_frame(self, R) -> Gravity:
         return Gravity(_rotated(R, self.acceleration))
 
-    def describe(self) -> str:
-        return f"gravity {_fmt(self.acceleration, 'm/s²')}"
+    def describe(self, swept=None) -> str:
+        default = self.acceleration.ndim == 1 and np.array_equal(self.acceleration,
+                                                                 (0.0, 0.0, -9.81))
+        return "gravity" if default and swept is None else (
+            "gravity " + self._fields_text(swept).removeprefix("acceleration "))
 
 
 def _check_span(obj) -> None:
@@ -328,12 +393,9 @@ class _Distributed(Load):
         name, _ = self.vectors[0]
         return self.replace(**{name: _rotated(R, getattr(self, name))})
 
-    def describe(self) -> str:
-        name, unit = self.vectors[0]
-        frame = "follower (material)" if self.follower else "dead (spatial)"
-        what = "force" if name == "force" else "moment"
-        return (f"distributed {what}, {frame}: {_fmt(getattr(self, name), unit)}"
-                + _span_text(self))
+    def describe(self, swept=None) -> str:
+        return (("follower distributed " if self.follower else "distributed ")
+                + self._fields_text(swept) + _span_text(self))
 
 
 @dataclass(frozen=True, eq=False)
@@ -353,7 +415,8 @@ class DistributedForce(_Distributed):
     """
 
     kind: ClassVar[str] = "distributed"
-    vectors: ClassVar = (("force", "N/m"),)
+    schema: ClassVar = (Key("force", "vector", "N/m", required=True), Key("follower", "flag"),
+                        Key("span", "span", "m"), Key("segment", "index"))
 
     force: np.ndarray = (0.0, 0.0, 0.0)
 
@@ -372,7 +435,9 @@ class DistributedMoment(_Distributed):
     """
 
     kind: ClassVar[str] = "distributed_moment"
-    vectors: ClassVar = (("moment", "N m/m"),)
+    schema: ClassVar = (Key("moment", "vector", "N m/m", required=True),
+                        Key("follower", "flag"), Key("span", "span", "m"),
+                        Key("segment", "index"))
 
     moment: np.ndarray = (0.0, 0.0, 0.0)
 
@@ -392,7 +457,8 @@ class PointLoad(Load):
     """
 
     kind: ClassVar[str] = "point"
-    vectors: ClassVar = (("force", "N"), ("moment", "N m"))
+    schema: ClassVar = (Key("s", "number", "m", required=True), Key("force", "vector", "N"),
+                        Key("moment", "vector", "N m"))
 
     s: float
     force: np.ndarray = (0.0, 0.0, 0.0)
@@ -427,9 +493,8 @@ class PointLoad(Load):
     def in_base_frame(self, R) -> PointLoad:
         return PointLoad(self.s, _rotated(R, self.force), _rotated(R, self.moment))
 
-    def describe(self) -> str:
-        return (f"point load at s = {self.s:.4g} m, dead (spatial): force "
-                f"{_fmt(self.force, 'N')}, moment {_fmt(self.moment, 'N m')}")
+    def describe(self, swept=None) -> str:
+        return f"point load at s = {self.s:.4g} m: " + self._fields_text(swept)
 
 
 def as_loads(loads) -> tuple[Load, ...]:

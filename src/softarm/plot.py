@@ -51,41 +51,14 @@ def describe_loads(loads, sweep=None) -> str:
 
     A swept field is described by its range (``sweep`` as a :class:`softarm.case.Sweep`).
     """
-    from .loads import DistributedForce, Gravity, PointLoad, TipLoad, as_loads
+    from .loads import as_loads
 
     parts = []
     for i, load in enumerate(as_loads(loads)):
-        swept = sweep.field if sweep is not None and sweep.load == i else None
-        if isinstance(load, Gravity):
-            text = "gravity"
-            if swept:
-                text += f" {sweep.component} {_range(sweep)}"
-            elif not np.allclose(load.acceleration, [0.0, 0.0, -9.81]):
-                text += " " + _fmt(load.acceleration, "m/s²")
-            parts.append(text)
-            continue
-        if isinstance(load, TipLoad):
-            prefix = "follower tip" if load.follower else "tip"
-        elif isinstance(load, PointLoad):
-            prefix = f"point load at s = {load.s:.4g} m:"
-        elif isinstance(load, DistributedForce):
-            prefix = "distributed"
-        else:  # pragma: no cover
-            prefix = type(load).__name__
-        vectors = [("force", "N/m" if isinstance(load, DistributedForce) else "N")]
-        if not isinstance(load, DistributedForce):
-            vectors.append(("moment", "N m"))
-        items = []
-        for name, unit in vectors:
-            value = np.asarray(getattr(load, name))
-            if swept == name:
-                items.append(f"{name} {sweep.component} {_range(sweep)}")
-            elif value.ndim == 1 and np.any(value != 0):
-                items.append(f"{name} {_fmt(value, unit)}")
-            elif value.ndim > 1:
-                items.append(f"{name} (batch of {value.shape[:-1]})")
-        if items:
-            parts.append(f"{prefix} " + ", ".join(items))
+        swept = None
+        if sweep is not None and sweep.load == i:
+            swept = (sweep.field, f"{sweep.component} {_range(sweep)}")
+        parts.append(load.describe(swept))
     return " + ".join(parts) if parts else "no load"
 
 

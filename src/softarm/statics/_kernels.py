@@ -975,7 +975,7 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, out):
             if not path:
                 _copy(J, J_c)
         info[b, 1] = estimate
-        info[b, 2] = reached[0] if status[b] == PATH_FAILED else 1.0
+        info[b, 2] = 1.0 if status[b] == OK else reached[0]
         info[b, 4] = N
         if status[b] != OK:
             info[b, 0] = _norm_scaled(r, scale)
