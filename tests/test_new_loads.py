@@ -255,40 +255,43 @@ M_SEGMENT = np.array([0.0, 0.02, 0.01])
 STATIONS = np.linspace(0.0, ARM.length, 41)
 
 
+def _inside(a, b, span):
+    return span[0] <= a and b <= span[1]
+
+
+#: The solve_bvp references by name (built on first use, once per module).
+REFERENCE_RECIPES = {
+    "dead_force": lambda: BvpReference(pieces_of(
+        ARM, [], lambda a, b, k: dict(force_dead=F_DEAD))),
+    "dead_force_cut": lambda: BvpReference(pieces_of(  # extra cuts that change nothing
+        ARM, [0.07, 0.31], lambda a, b, k: dict(force_dead=F_DEAD))),
+    "follower_tip": lambda: BvpReference(pieces_of(ARM, [], lambda a, b, k: {}),
+                                         tip_follower=[0.0, 0.02, -0.03, 0.002, 0.0, 0.0]),
+    "follower_force": lambda: BvpReference(pieces_of(
+        ARM, [], lambda a, b, k: dict(force_follower=F_FOLLOWER))),
+    "follower_moment": lambda: BvpReference(pieces_of(
+        ARM, [], lambda a, b, k: dict(moment_follower=M_FOLLOWER))),
+    # a dead force on SPAN and a follower moment on segment 1
+    "span_dead_force_segment_follower_moment": lambda: BvpReference(pieces_of(
+        ARM, SPAN, lambda a, b, k: dict(
+            force_dead=F_SPAN if _inside(a, b, SPAN) else np.zeros(3),
+            moment_follower=M_SEGMENT if k == 1 else np.zeros(3)))),
+    # a follower force on SPAN and a dead moment on segment 0
+    "span_follower_force_segment_dead_moment": lambda: BvpReference(pieces_of(
+        ARM, SPAN, lambda a, b, k: dict(
+            force_follower=F_FOLLOWER if _inside(a, b, SPAN) else np.zeros(3),
+            moment_dead=M_SEGMENT if k == 0 else np.zeros(3)))),
+}
+
+
 @pytest.fixture(scope="module")
 def references():
-    """solve_bvp references, each computed once per module on first use."""
+    """``references(name)``: the solve_bvp reference, computed once per module."""
     cache = {}
-
-    def inside(a, b, span):
-        return span[0] <= a and b <= span[1]
-
-    recipes = {
-        "dead_force": lambda: BvpReference(pieces_of(
-            ARM, [], lambda a, b, k: dict(force_dead=F_DEAD))),
-        "dead_force_cut": lambda: BvpReference(pieces_of(  # cuts that change nothing
-            ARM, [0.07, 0.31], lambda a, b, k: dict(force_dead=F_DEAD))),
-        "follower_tip": lambda: BvpReference(pieces_of(ARM, [], lambda a, b, k: {}),
-                                             tip_follower=[0.0, 0.02, -0.03, 0.002, 0.0, 0.0]),
-        "follower_force": lambda: BvpReference(pieces_of(
-            ARM, [], lambda a, b, k: dict(force_follower=F_FOLLOWER))),
-        "follower_moment": lambda: BvpReference(pieces_of(
-            ARM, [], lambda a, b, k: dict(moment_follower=M_FOLLOWER))),
-        # a dead force on SPAN and a follower moment on segment 1
-        "span_dead_force_segment_follower_moment": lambda: BvpReference(pieces_of(
-            ARM, SPAN, lambda a, b, k: dict(
-                force_dead=F_SPAN if inside(a, b, SPAN) else np.zeros(3),
-                moment_follower=M_SEGMENT if k == 1 else np.zeros(3)))),
-        # a follower force on SPAN and a dead moment on segment 0
-        "span_follower_force_segment_dead_moment": lambda: BvpReference(pieces_of(
-            ARM, SPAN, lambda a, b, k: dict(
-                force_follower=F_FOLLOWER if inside(a, b, SPAN) else np.zeros(3),
-                moment_dead=M_SEGMENT if k == 0 else np.zeros(3)))),
-    }
 
     def get(name):
         if name not in cache:
-            cache[name] = recipes[name]()
+            cache[name] = REFERENCE_RECIPES[name]()
         return cache[name]
 
     return get
@@ -635,6 +638,31 @@ def test_descriptions_tell_the_kinds_apart():
     texts = [kind.build({k: fields[k] for k in kind.sample(np.random.default_rng(0), ())})
              .describe() for kind in LOAD_KINDS]
     assert len(set(texts)) == len(texts), texts
+
+
+def test_an_undeclared_load_kind_fails_closed():
+    # Issue 13: a kind registered without its kernel contribution was silently dropped. A
+    # subclass of Load that declares nothing must be refused (at construction or at solve),
+    # never solved as if it were absent.
+    class Probe(softarm.Load):
+        pass
+
+    arm = Arm(0.3, Circle(0.01), SOFT)
+    with pytest.raises((TypeError, NotImplementedError)):
+        softarm.solve(arm, [Gravity(), Probe()])
+    with pytest.raises((TypeError, NotImplementedError)):
+        loads_to_dict([Probe()])
+
+
+@pytest.mark.parametrize("make", [
+    lambda: TipLoad([0.0, 0.0, 1.0], [0.0, 0.0, 0.0], True),
+    lambda: DistributedForce([0.0, 0.0, 1.0], True),
+    lambda: distributed_moment([0.0, 0.0, 1.0], True),
+], ids=["TipLoad", "DistributedForce", "DistributedMoment"])
+def test_follower_is_keyword_only(make):
+    # issue 13 §4: ``follower`` is keyword-only everywhere
+    with pytest.raises(TypeError):
+        make()
 
 
 @pytest.mark.parametrize("bad", [object(), "gravity", {"kind": "tip"}, 3.0],
