@@ -18,10 +18,12 @@ by adding one entry.
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import sys
 from collections.abc import Callable
 from dataclasses import dataclass
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -395,13 +397,22 @@ def rebuilt_wrench(eq, terms):
         n(s) = Σ F_j + ∫ₛᴸ f,   m(s) = Σ (M_j + (p_j - p(s)) × F_j) + ∫ₛᴸ (l + (p - p(s)) × f),
 
     material densities turned by the returned R(t); integrals by cumulative Simpson over the
-    stations of each smooth interval (which must fall on stations). A station at an interior
-    point load holds the side towards the tip (the load not included).
+    stations of each smooth interval: a term is split at the joints, where R and p have kinks
+    (the ends and the joints must fall on stations). A station at an interior point load holds
+    the side towards the tip (the load not included).
     """
     s, P, R = eq.s, eq.positions, eq.rotations
     n, m = np.zeros_like(P), np.zeros_like(P)
     L = eq.arm.length
+    joints = eq.arm.boundaries[1:-1]
+    smooth = []
     for term in terms:
+        if isinstance(term, Point):
+            smooth.append(term)
+            continue
+        cuts = [term.a, *[j for j in joints if term.a < j < term.b], term.b]
+        smooth += [dataclasses.replace(term, a=a, b=b) for a, b in itertools.pairwise(cuts)]
+    for term in smooth:
         if isinstance(term, Point):
             (j,) = np.flatnonzero(np.isclose(s, term.s, rtol=0, atol=1e-12))
             F = R[j] @ term.force if term.material else np.asarray(term.force)
@@ -430,6 +441,7 @@ def rebuilt_wrench(eq, terms):
 
 def assert_balanced(eq, terms, rtol=1e-8):
     n, m = rebuilt_wrench(eq, terms)
+    assert eq.forces_spatial.shape == n.shape
     n_scale = max(np.max(np.abs(n)), 1e-300)
     m_scale = max(np.max(np.abs(m)), 1e-300)
     np.testing.assert_allclose(eq.forces_spatial, n, rtol=0, atol=rtol * n_scale)
@@ -593,6 +605,25 @@ def test_global_balance_of_every_kind_together(rng):
         terms += kind.terms(fields)
     eq = numeric(ARM, loads, s=DENSE, tol=1e-10)
     assert_balanced(eq, terms)
+
+
+@pytest.mark.parametrize(("name", "terms"), [
+    ("follower_force", [Distributed(0.0, L_ARM, F_FOLLOWER, _zero(), True)]),
+    ("follower_moment", [Distributed(0.0, L_ARM, _zero(), M_FOLLOWER, True)]),
+    ("span_dead_force_segment_follower_moment",
+     [Distributed(*SPAN, F_SPAN, _zero(), False),
+      Distributed(*_segment_span(1), _zero(), M_SEGMENT, True)]),
+    ("span_follower_force_segment_dead_moment",
+     [Distributed(*SPAN, F_FOLLOWER, _zero(), True),
+      Distributed(*_segment_span(0), _zero(), M_SEGMENT, False)]),
+])
+def test_balance_reference_reproduces_the_bvp_solutions(references, name, terms):
+    # The two references check each other on today's code: the wrench rebuilt from the loads
+    # on [s, L] and the solve_bvp poses equals the solve_bvp wrench (to its accuracy).
+    p, R, n, m = references(name).at(DENSE)
+    state = SimpleNamespace(s=DENSE, positions=p, rotations=R, arm=ARM, forces_spatial=n,
+                            moments_spatial=m)
+    assert_balanced(state, terms)
 
 
 def _toml_value(value):
