@@ -4,7 +4,7 @@ dead or follower, on the whole arm, a span [s0, s1] or one segment.
 References, none of them the library's solver:
 
 - a uniform distributed moment about a principal axis of a straight arm: the planar closed
-  form m(s) = μ (L - s), κ = m/EI, θ(s) = ∫ κ, positions by adaptive quadrature;
+  form m(s) = μ (L - s), κ = m/EI, θ(s) = ∫ κ, positions by Gauss–Legendre quadrature;
 - ``scipy.integrate.solve_bvp`` on the Cosserat rod equations written here (one state per
   uniformly loaded piece, joined by continuity conditions), continued in load steps from the
   unloaded arm; it is first checked against today's solver on loads both support;
@@ -27,7 +27,7 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
-from scipy.integrate import cumulative_simpson, quad, solve_bvp, solve_ivp
+from scipy.integrate import cumulative_simpson, solve_bvp, solve_ivp
 from scipy.linalg import expm
 
 import softarm
@@ -66,7 +66,6 @@ SOFT = Material(1.0e6, poisson_ratio=0.45, density=1100.0)
 #: A curved, twisted two-segment arm (L = 0.4 m, joint at 0.25 m) for the general cases.
 ARM = SegmentedArm([Arm(0.25, Circle(0.012), SOFT, curvature=(0.5, 0.0, 2.0)),
                     Arm(0.15, Circle(0.008), SOFT, curvature=(0.0, -1.0, 0.0))])
-JOINT = 0.25
 SPAN = (0.1, 0.3)  # crosses the joint
 #: Stations 1 mm apart: the joint, the span ends and the point load all fall on them.
 DENSE = np.linspace(0.0, ARM.length, 401)
@@ -82,19 +81,21 @@ def planar_distributed_moment(L, mu, stiffness, axis, s):
 
     n = 0 everywhere (no force: no extension, no shear whatever EA, GA), so
     m(s) = μ (L - s) e_axis, κ = m/EI, θ(s) = μ (L s - s²/2)/EI and R(s) = exp(θ(s) ê_axis);
-    p(s) = ∫₀ˢ R e1 dt by adaptive Gauss–Kronrod quadrature (scipy.integrate.quad).
-    Returns positions (S, 3), rotations (S, 3, 3), curvatures (S, 3).
+    p(s) = ∫₀ˢ R e1 dt by 40-point Gauss–Legendre quadrature on [0, s] (the integrand is
+    entire: exact to round-off), with R e1 = cos θ e1 + sin θ e × e1 + (1 - cos θ)(e·e1) e
+    (Rodrigues). Returns positions (S, 3), rotations (S, 3, 3), curvatures (S, 3).
     """
-    e = np.eye(3)[axis]
+    e, e1 = np.eye(3)[axis], np.eye(3)[0]
+    nodes, weights = np.polynomial.legendre.leggauss(40)
 
     def theta(t):
         return mu * (L * t - t**2 / 2) / stiffness
 
-    def tangent(t, i):
-        return (expm(theta(t) * hat(e)) @ [1.0, 0.0, 0.0])[i]
+    def tangent(t):
+        c, sn = np.cos(theta(t))[:, None], np.sin(theta(t))[:, None]
+        return c * e1 + sn * np.cross(e, e1) + (1 - c) * (e @ e1) * e
 
-    positions = np.array([[quad(tangent, 0.0, si, args=(i,), epsabs=1e-15, epsrel=1e-13)[0]
-                           for i in range(3)] for si in s])
+    positions = np.array([0.5 * si * weights @ tangent(0.5 * si * (nodes + 1)) for si in s])
     rotations = np.array([expm(theta(si) * hat(e)) for si in s])
     curvatures = np.outer(mu * (L - s) / stiffness, e)
     return positions, rotations, curvatures
