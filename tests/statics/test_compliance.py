@@ -160,20 +160,30 @@ def _cases():
     direction = np.array([0.3, -0.5, 1.0]) / np.linalg.norm([0.3, -0.5, 1.0])
     curved = SegmentedArm([Arm(0.25, Circle(0.012), SOFT, curvature=(0.5, 0.0, 2.0)),
                            Arm(0.15, Circle(0.008), SOFT, curvature=(0.0, -1.0, 0.0))])
+    # name: (arm, loads (a function: the new load kinds are built only when a test runs),
+    #        base pose, conservative)
     return {
-        # name: (arm, loads, base, conservative)
-        "unloaded": (Arm(0.3, Rectangle(0.02, 0.012), SOFT), [], None, True),
-        "dead_tip_force_k2_3d": (stiff, [TipLoad(force=2.0 * direction)], None, True),
-        "gravity_and_tip_force_soft": (soft, [Gravity(), TipLoad(force=[0.0, 0.01, -0.02])],
-                                       None, True),
-        "follower_tip_force": (stiff, [TipLoad(force=[0.2, 0.9, -0.6], follower=True)], None,
-                               False),
-        "precurved_two_segments": (curved, [Gravity([0.0, -3.0, -9.81]),
-                                            TipLoad(force=[0.02, -0.01, 0.03])], None, True),
-        "base_pose": (soft, [Gravity(), TipLoad(force=[0.01, 0.0, -0.015])], _base_pose(),
-                      True),
-        "dead_tip_moment": (stiff, [TipLoad(force=[0.3, 0.0, 0.5], moment=[0.3, -0.8, 0.5])],
-                            None, False),
+        "unloaded": (Arm(0.3, Rectangle(0.02, 0.012), SOFT), lambda: [], None, True),
+        "dead_tip_force_k2_3d": (stiff, lambda: [TipLoad(force=2.0 * direction)], None, True),
+        "gravity_and_tip_force_soft": (
+            soft, lambda: [Gravity(), TipLoad(force=[0.0, 0.01, -0.02])], None, True),
+        "follower_tip_force": (
+            stiff, lambda: [TipLoad(force=[0.2, 0.9, -0.6], follower=True)], None, False),
+        "precurved_two_segments": (
+            curved, lambda: [Gravity([0.0, -3.0, -9.81]), TipLoad(force=[0.02, -0.01, 0.03])],
+            None, True),
+        "base_pose": (soft, lambda: [Gravity(), TipLoad(force=[0.01, 0.0, -0.015])],
+                      _base_pose(), True),
+        "dead_tip_moment": (
+            stiff, lambda: [TipLoad(force=[0.3, 0.0, 0.5], moment=[0.3, -0.8, 0.5])], None,
+            False),
+        # state-dependent loads: δn is not constant along the arm (the 12-component tangents)
+        "follower_distributed_force": (
+            curved, lambda: [softarm.DistributedForce([0.0, 0.3, -0.5], follower=True)], None,
+            False),
+        "follower_distributed_moment_on_a_span": (
+            curved, lambda: [softarm.DistributedMoment([0.005, 0.02, -0.015], follower=True,
+                                                       span=(0.1, 0.3))], None, False),
     }
 
 
@@ -185,7 +195,8 @@ CONSERVATIVE = [name for name, case in CASES.items() if case[3]]
 
 @pytest.mark.parametrize("name", list(CASES))
 def test_tip_compliance_equals_finite_differences(name):
-    arm, loads, base, _ = CASES[name]
+    arm, make_loads, base, _ = CASES[name]
+    loads = make_loads()
     s = np.linspace(0.0, arm.length, 5)
     eq = solve_jac(arm, loads, base=base, s=s, steps=STEPS)
     fd = fd_compliance(arm, loads, base=base, s=s)
@@ -229,7 +240,8 @@ def test_compliance_is_symmetric_for_conservative_loads(name):
     # discrete compliance is symmetric to its discretisation error. Measured by finite
     # differences of today's solver at the step count that meets tol = 1e-8: |C - Cᵀ| up to
     # 5.5× the error estimate (relative to max |C| in the arm's units), so 10·tol holds.
-    arm, loads, base, _ = CASES[name]
+    arm, make_loads, base, _ = CASES[name]
+    loads = make_loads()
     tol = 1e-8
     C = _nondimensional(arm, solve_jac(arm, loads, base=base, tol=tol).tip_compliance)
     np.testing.assert_allclose(C.T, C, rtol=0, atol=10 * tol * np.max(np.abs(C)))
@@ -251,7 +263,8 @@ def _nondimensional_stiffness(arm, C):
 
 
 def test_dead_tip_moment_stiffness_skew_part_is_minus_half_M_hat():
-    arm, loads, _, _ = CASES["dead_tip_moment"]
+    arm, make_loads, _, _ = CASES["dead_tip_moment"]
+    loads = make_loads()
     tol = 1e-10
     C = solve_jac(arm, loads, tol=tol).tip_compliance
     K = _nondimensional_stiffness(arm, C)
@@ -298,7 +311,8 @@ def test_skew_part_derivation_against_finite_differences():
 # --- per station -----------------------------------------------------------------------------
 
 def test_station_compliance_at_the_ends():
-    arm, loads, _, _ = CASES["precurved_two_segments"]
+    arm, make_loads, _, _ = CASES["precurved_two_segments"]
+    loads = make_loads()
     eq = solve_jac(arm, loads, s=11)
     np.testing.assert_allclose(eq.compliance[-1], eq.tip_compliance, rtol=1e-14, atol=0)
     scale = np.max(np.abs(eq.tip_compliance))
@@ -308,7 +322,8 @@ def test_station_compliance_at_the_ends():
 def test_base_pose_rotates_the_compliance():
     # Clamped at H = (R0, p0): the solution is H times the identity-base solution under the
     # loads rotated by R0ᵀ; a spatial perturbation then maps as blkdiag(R0, R0) C blkdiag(R0ᵀ)².
-    arm, loads, H, _ = CASES["base_pose"]
+    arm, make_loads, H, _ = CASES["base_pose"]
+    loads = make_loads()
     R0 = H[:3, :3]
     local = [Gravity(R0.T @ loads[0].acceleration), TipLoad(force=R0.T @ loads[1].force)]
     Q = np.kron(np.eye(2), R0)
