@@ -161,7 +161,25 @@ def random_loads(rng, arm, batch=(), conservative=False):
             if not conservative and rng.random() < 0.3:
                 moment = unit(rng, batch) * log_uniform(rng, 0.05, 2.0, batch)[..., None] * EI / L
             loads.append(softarm.PointLoad(s, force=force, moment=moment))
+    if rng.random() < 0.15:
+        # issue 12, reproducer 4: tiny loads (down to 1e-12 of the above) are not dropped
+        factor = 10.0 ** -rng.uniform(3.0, 12.0)
+        loads = [scaled(load, factor) for load in loads]
     return loads
+
+
+def scaled(load, factor):
+    """``load`` with every vector multiplied by ``factor``."""
+    if isinstance(load, softarm.Gravity):
+        return softarm.Gravity(load.acceleration * factor)
+    if isinstance(load, softarm.TipLoad):
+        return softarm.TipLoad(force=load.force * factor, moment=load.moment * factor,
+                               follower=load.follower)
+    if isinstance(load, softarm.DistributedForce):
+        if getattr(load, "follower", False):
+            return softarm.DistributedForce(load.force * factor, follower=True)
+        return softarm.DistributedForce(load.force * factor)
+    return softarm.PointLoad(load.s, force=load.force * factor, moment=load.moment * factor)
 
 
 STREAMS = {"balance": 1, "ladder": 5, "energy": 6}
@@ -228,8 +246,16 @@ def test_balance_at_every_station(index):
     force_err, moment_err, force_scale, moment_scale = balance_errors(eq)
     assert force_err <= BALANCE_RTOL * force_scale, (force_err, force_scale)
     assert moment_err <= BALANCE_RTOL * moment_scale, (moment_err, moment_scale)
-    # the tip boundary condition on its own (the station s = L holds the tip state)
-    assert eq.s[-1] == arm.length
+    # every station holds its own state: the default 101 stations (s = L among them) agree
+    # with the same stations solved among the fine ones
+    default = softarm.solve(arm, loads, tol=TOL)
+    assert default.s[-1] == arm.length
+    both = softarm.solve(arm, loads, s=np.union1d(default.s, eq.s), tol=TOL)
+    rows = np.searchsorted(both.s, default.s)
+    np.testing.assert_allclose(default.positions, both.positions[rows], rtol=0,
+                               atol=SAME * arm.length)
+    np.testing.assert_allclose(both.positions[np.searchsorted(both.s, eq.s)], eq.positions,
+                               rtol=0, atol=SAME * arm.length)
 
 
 # ---------------------------------------------------------------------------------------------
