@@ -3,7 +3,7 @@ independent solve_bvp continuation (tests/_reference_rod.py) stops there too.
 
 Run from the repository root (SOFTARM_INVARIANTS_LARGE=1 for the large run's cases):
 
-    PYTHONPATH=tests:tests/statics python tests/reference_scripts/invariant_folds.py
+    PYTHONPATH=tests python tests/reference_scripts/invariant_folds.py
 
 Prints one line per ConvergenceError (the solver's load factor, the reference's λ reached) and
 a count per family of cases.
@@ -11,12 +11,16 @@ a count per family of cases.
 
 from __future__ import annotations
 
-import test_invariants as inv
+import sys
+from pathlib import Path
 
 import softarm
 
 
 def main():
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "statics"))
+    import test_invariants as inv
+
     groups = {
         "balance": [inv.case("balance", i) for i in range(inv.N_BALANCE)],
         "ladder": [inv.case("ladder", i) for i in range(inv.N_LADDER)],
