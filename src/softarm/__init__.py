@@ -11,7 +11,7 @@ from .case import Case, CaseError, load_case
 from .dispatch import solve
 from .equilibrium import Equilibrium
 from .errors import ApproximationWarning, ConvergenceError
-from .loads import DistributedForce, Gravity, PointLoad, TipLoad
+from .loads import DistributedForce, DistributedMoment, Gravity, Load, PointLoad, TipLoad
 from .model import Arm, Circle, Material, Rectangle, Rigidities, Section, SegmentedArm, Tube
 
 __all__ = [
@@ -22,8 +22,10 @@ __all__ = [
     "Circle",
     "ConvergenceError",
     "DistributedForce",
+    "DistributedMoment",
     "Equilibrium",
     "Gravity",
+    "Load",
     "Material",
     "PointLoad",
     "Rectangle",
