@@ -58,8 +58,8 @@ UNIT = Arm.from_stiffness(1.0, EA=1e9, GAy=1e9, GAz=1e9, GJ=1.0, EIy=1.0, EIz=1.
     (lambda: Material(1e6, poisson_ratio="0.3"), "Material.poisson_ratio"),
     (lambda: Material("1e6", poisson_ratio=0.3), "Material.youngs_modulus"),
     (lambda: softarm.solve(UNIT, TipLoad(moment=[0, 1, 0]), tol="1e-8"), "tol"),
-    (lambda: softarm.solve(UNIT, TipLoad(moment=[0, 1, 0]), max_step="2"), "max_step"),
-    (lambda: softarm.solve(UNIT, TipLoad(moment=[0, 1, 0]), max_step=True), "max_step"),
+    (lambda: softarm.solve(UNIT, TipLoad(moment=[0, 1, 0]), max_load_step="2"), "max_load_step"),
+    (lambda: softarm.solve(UNIT, TipLoad(moment=[0, 1, 0]), max_load_step=True), "max_load_step"),
     (lambda: softarm.solve(UNIT, TipLoad(moment=[0, 1, 0]), max_iterations=30.0),
      "max_iterations"),
     (lambda: softarm.solve(UNIT, TipLoad(moment=[0, 1, 0]), s=["0", "1"]), "s"),
@@ -117,8 +117,8 @@ def test_poisson_ratio_float32_is_the_float32_value():
 
 def test_max_step_float32_through_solve():
     loads = [Gravity(), TipLoad(force=[0.0, 0.0, -0.2])]  # no closed form: the solver
-    a = softarm.solve(ARM, loads, max_step=np.float32(2))
-    b = softarm.solve(ARM, loads, max_step=2.0)
+    a = softarm.solve(ARM, loads, max_load_step=np.float32(0.5))
+    b = softarm.solve(ARM, loads, max_load_step=0.5)
     assert a.method == "numeric.shooting"
     np.testing.assert_array_equal(a.poses, b.poses)
     c = softarm.solve(ARM, loads, max_iterations=np.int16(30), tol=np.float32(1e-8))
@@ -213,7 +213,7 @@ def test_empty_batch_gives_an_empty_result_on_every_route(shape):
 def test_solver_direct_accepts_numpy_scalars_and_nearly_rigid_base(rng):
     from softarm.statics import Solver
 
-    solver = Solver(ARM, max_step=np.float32(2), base=_nearly_rigid(rng, 1e-7))
+    solver = Solver(ARM, max_load_step=np.float32(0.5), base=_nearly_rigid(rng, 1e-7))
     R = solver.base[:3, :3]
     np.testing.assert_allclose(R.T @ R, np.eye(3), rtol=0, atol=1e-15)
 

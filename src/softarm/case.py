@@ -151,7 +151,8 @@ class Sweep:
         base = np.asarray(getattr(target, self.field), dtype=np.float64)
         values = np.asarray(self.values, dtype=np.float64)
         if self.component == "magnitude":
-            stack = values[:, None] * (base / np.linalg.norm(base))
+            direction = base / np.max(np.abs(base))  # scaled first: its norm cannot overflow
+            stack = values[:, None] * (direction / np.linalg.norm(direction))
         else:
             stack = np.repeat(base[None, :], values.size, axis=0)
             stack[:, "xyz".index(self.component)] = values
@@ -503,7 +504,7 @@ def _sweep(table: _Table, loads: tuple, stations: int) -> Sweep:
         values = tuple(np.linspace(start, stop, steps).tolist())
     table.done()
     vector = getattr(loads[index - 1], field_name)
-    if component == "magnitude" and not np.linalg.norm(vector) > 0:
+    if component == "magnitude" and not np.max(np.abs(vector)) > 0:
         raise table.error("component", f"'magnitude' needs a nonzero {field_name} in load "
                           f"{index} to give the direction, got (0, 0, 0)")
     return Sweep(index - 1, kind, field_name, component, values, label)
@@ -568,7 +569,12 @@ def _parse(data, source, *, name=None, batched=False) -> Case:
         try:
             load.check(arm)  # the model's own rule, reported with the key path
         except ValueError as error:
-            raise CaseError(f"{where}: load[{i + 1}]: {error}") from None
+            text, key = str(error), ""
+            prefix = f"{type(load).__name__}."
+            if text.startswith(prefix):  # "PointLoad.s must ..." -> load[i].s: must ...
+                key, _, text = text[len(prefix):].partition(" ")
+                key = "." + key
+            raise CaseError(f"{where}: load[{i + 1}]{key}: {text}") from None
     options = _solve_options(top.table("solve")) if top.has("solve") else SolveOptions()
     sweep = _sweep(top.table("sweep"), loads, options.stations) if top.has("sweep") else None
     top.done()

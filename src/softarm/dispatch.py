@@ -12,7 +12,6 @@ import numpy as np
 
 from . import analytic
 from .equilibrium import Equilibrium
-from .loads import as_loads, batch_shape
 from .statics import Solver
 
 __all__ = ["METHODS", "solve", "solve_prepared"]
@@ -134,8 +133,7 @@ def solve_prepared(solver: Solver, loads, method="auto") -> Equilibrium:
     """
     _check_method(method)
     if method != "numeric":  # the solver validates the loads itself
-        loads = as_loads(loads)
-        batch_shape(loads)
+        loads, _ = solver.check_loads(loads)
         result = _closed_form(solver.arm, loads, solver.s, solver.base)
         if result is not None:
             return result

@@ -54,10 +54,9 @@ def _broadcast(obj, *names: str) -> tuple[int, ...]:
     except ValueError:
         kind = type(obj).__name__
         fields_ = " and ".join(f"{kind}.{name}" for name in names)
-        raise ValueError(
-            f"{fields_} must have batch shapes that broadcast, got shapes "
-            f"{[getattr(obj, name).shape for name in names]}"
-        ) from None
+        got = " and ".join(str(getattr(obj, name).shape) for name in names)
+        raise ValueError(f"{fields_} must have batch shapes that broadcast, got shapes {got}"
+                         ) from None
 
 
 def _check_follower(obj) -> None:
@@ -502,7 +501,7 @@ def as_loads(loads) -> tuple[Load, ...]:
     if isinstance(loads, Load):
         return (loads,)
     try:
-        items = tuple(loads)
+        items = None if isinstance(loads, (str, bytes, dict)) else tuple(loads)
     except TypeError:
         items = None
     if items is None:

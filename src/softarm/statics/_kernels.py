@@ -687,13 +687,18 @@ def _fill_steps(length, piece_len, N, factor, out):
 def _load_size(arm, scale, start, end, tip_start, tip_end):
     """(w, turning): the case's largest load in units of the bending scale (EI/L² for
     forces, EI/L for moments; distributed loads times the piece length, at either end of
-    the homotopy) and an estimate of the total turning of the arm (rad) for the first
-    step count."""
-    piece_len = arm[1]
+    the homotopy) and an upper estimate of the total turning of the arm (rad), the largest
+    load moment about the base times ∫ ds/EI with each piece's softest bending
+    compliance (bending; the pieces of a very soft segment need as many steps as its
+    turning)."""
+    piece_len, C = arm[1], arm[2]
     L = arm[6]
     fs, ms = scale[0], scale[3]
+    flexibility = 0.0  # ∫ ds / EI, with each piece's largest rotational compliance
+    for j in range(piece_len.size):
+        flexibility += piece_len[j] * max(C[j, 4, 4], C[j, 5, 5])
     w = 0.0
-    turning = 0.0
+    moment = 0.0
     for which in range(2):
         loads = start if which == 0 else end
         tip = tip_start if which == 0 else tip_end
@@ -702,7 +707,7 @@ def _load_size(arm, scale, start, end, tip_start, tip_end):
             f_tip += abs(tip[_TD + i]) + abs(tip[_TF + i])
             m_tip += abs(tip[_TD + 3 + i]) + abs(tip[_TF + 3 + i])
         w = max(w, f_tip / fs, m_tip / ms)
-        bend = f_tip * L / ms + m_tip / ms
+        total = f_tip * L + m_tip
         f_along = 0.0
         for j in range(piece_len.size):
             f, m, jf, jm = 0.0, 0.0, 0.0, 0.0
@@ -713,10 +718,10 @@ def _load_size(arm, scale, start, end, tip_start, tip_end):
                 jm += abs(loads[j, _JD + 3 + i]) + abs(loads[j, _JF + 3 + i])
             f_along += f * piece_len[j] + jf
             w = max(w, f_along / fs, m * piece_len[j] / ms, jm / ms)
-            bend += (f * piece_len[j] * 0.5 * L + jf * L + m * piece_len[j] + jm) / ms
+            total += f * piece_len[j] * 0.5 * L + jf * L + m * piece_len[j] + jm
         w = max(w, f_along / fs)
-        turning = max(turning, bend)
-    return w, turning
+        moment = max(moment, total)
+    return w, moment * flexibility
 
 
 @_jit
@@ -879,7 +884,8 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, out):
         status[b] = OK
         estimate = np.inf
         path = True  # the coarse solution must come from the path
-        retried = False
+        failures = 0
+        failed_at = -1.0
         fine_path = False
         recorded = False
         resume = False
@@ -904,9 +910,12 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, out):
                     if n_path < N:
                         fine_path = True
                         continue
-                    if not retried and 2 * N <= n_max // 2 and n_fixed == 0:
-                        # a fold of the discrete path only? the same path, finer
-                        retried = True
+                    # a fold persists under refinement at about the same load factor; a
+                    # failure of an under-resolved path moves or disappears
+                    if (n_fixed == 0 and 2 * N <= n_max // 2 and failures < 4
+                            and abs(reached[0] - failed_at) > 0.02):
+                        failures += 1
+                        failed_at = reached[0]
                         N = 2 * N
                         continue
                     status[b] = PATH_FAILED

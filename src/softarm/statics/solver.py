@@ -100,8 +100,8 @@ class _ArmData:
         mu = [seg.linear_density for seg in segments]
         self.mu = np.array([np.nan if m is None else m for m in mu], dtype=np.float64)
         if not np.all(np.isnan(self.mu) | (np.isfinite(self.mu) & (self.mu >= 0.0))):
-            raise ValueError(f"the arm's linear densities must be finite and >= 0 kg/m, got "
-                             f"{self.mu.tolist()!r}")
+            raise ValueError(f"the arm's linear density (mass per length, density × area) must "
+                             f"be finite and >= 0 kg/m, got {self.mu.tolist()!r}")
         bending = float(np.max(self.K[:, [3, 4, 5], [3, 4, 5]]))
         self.force_scale = bending / self.length**2
         _normal_positive([self.force_scale, bending / self.length],
@@ -302,18 +302,24 @@ class Solver:
 
     # ---------------------------------------------------------------- preparation
 
-    def _prepare(self, loads, extra_cuts=()):
-        """(loads, batch shape, count, the kernel's arm tuple, load channels)."""
+    def check_loads(self, loads) -> tuple[tuple, tuple[int, ...]]:
+        """(loads as a tuple, their batch shape), after checking that every load fits the arm
+        and that the batch's outputs fit in memory (ValueError before any allocation)."""
         loads = as_loads(loads)
         shape = batch_shape(loads)
-        count = math.prod(shape)
-        data = self._data
         for load in loads:
             load.check(self.arm)
+        check_allocation(math.prod(shape), self.s.size, "loads")
+        return loads, shape
+
+    def _prepare(self, loads, extra_cuts=()):
+        """(loads, batch shape, count, the kernel's arm tuple, load channels)."""
+        loads, shape = self.check_loads(loads)
+        count = math.prod(shape)
+        data = self._data
         cuts = tuple(sorted({float(c) for load in loads for c in load.cuts(self.arm)}
                             | {float(c) for c in extra_cuts}))
         pieces = data.pieces(cuts)
-        check_allocation(count, self.s.size, "loads")
         channels = _Channels(data, pieces, shape, count)
         for load in loads:
             load.apply(channels)
@@ -334,12 +340,13 @@ class Solver:
                 tip[..., [0, 1, 2, 6, 7, 8]].sum(-1).ravel() / fs,
                 tip[..., [3, 4, 5, 9, 10, 11]].sum(-1).ravel() / ms])
         if sizes.size and not np.max(sizes) <= _LOAD_LIMIT:
-            worst = max(loads, key=_largest)
+            load, name = max(((load, name) for load in loads for name, _ in load.vectors),
+                             key=lambda pair: _largest(getattr(*pair)))
             raise ValueError(
-                f"{type(worst).__name__}: a load of {_largest(worst):.3g} (SI units) is not "
-                f"representable on this arm: it exceeds {_LOAD_LIMIT:.0e} times the bending "
-                f"scale (EI/L² = {fs:.3g} N, EI/L = {ms:.3g} N m), where double precision "
-                "cannot follow the shape")
+                f"{type(load).__name__}.{name}: a load of {_largest(getattr(load, name)):.3g} "
+                f"(SI units) is not representable on this arm: it exceeds {_LOAD_LIMIT:.0e} "
+                f"times the bending scale (EI/L² = {fs:.3g} N, EI/L = {ms:.3g} N m), where "
+                "double precision cannot follow the shape")
 
     def _options(self, chained: bool, jacobians: bool) -> np.ndarray:
         n_fixed = self.steps if self.steps is not None else 0
@@ -459,10 +466,8 @@ class Solver:
         return ShootResult(r, J[:, :6].copy(), J[:, 6].copy(), pose, motion)
 
 
-def _largest(load) -> float:
-    with np.errstate(over="ignore", invalid="ignore"):
-        return max(float(np.max(np.abs(getattr(load, name)), initial=0.0))
-                   for name, _ in load.vectors)
+def _largest(vector) -> float:
+    return float(np.max(np.abs(vector), initial=0.0))
 
 
 def _recut(old_starts, old_piece, new_starts) -> np.ndarray:
