@@ -21,6 +21,7 @@ from ..model import Arm, SegmentedArm
 
 __all__ = [
     "E1",
+    "ROUNDOFF",
     "THREADS_VARIABLE",
     "build",
     "check_arm",
@@ -38,12 +39,12 @@ E1 = np.array([1.0, 0.0, 0.0])
 
 #: Relative size under which a component is treated as zero (a few units of roundoff): a
 #: closed form that is exact for the zero value is then exact to double precision.
-_ROUNDOFF = 4.0 * np.finfo(np.float64).eps
+ROUNDOFF = 4.0 * np.finfo(np.float64).eps
 
 
 def negligible(x, scale) -> np.ndarray:
     """|x| is at roundoff level relative to ``scale`` (both broadcast), elementwise."""
-    return np.abs(x) <= _ROUNDOFF * np.abs(scale)
+    return np.abs(x) <= ROUNDOFF * np.abs(scale)
 
 
 def check_arm(arm, function: str) -> Arm:
@@ -323,8 +324,12 @@ def build(arm: Arm, s: np.ndarray, poses, strains, loads, method: str, exact: bo
     s = _owned(s)
     poses = _owned(poses)
     strains = _owned(strains)
-    stresses = _owned(strains * np.diagonal(arm.stiffness) if stresses is None else stresses)
-    batch = np.broadcast_shapes(poses.shape[:-3], strains.shape[:-2], stresses.shape[:-2])
+    if stresses is None:
+        r = arm.rigidities
+        stresses = strains * np.array([r.EA, r.GAy, r.GAz, r.GJ, r.EIy, r.EIz])  # K ε
+    stresses = _owned(stresses)
+    shapes = (poses.shape[:-3], strains.shape[:-2], stresses.shape[:-2])
+    batch = shapes[0] if shapes[0] == shapes[1] == shapes[2] else np.broadcast_shapes(*shapes)
     poses = _broadcast(poses, (*batch, n, 4, 4))
     strains = _broadcast(strains, (*batch, n, 6))
     stresses = _broadcast(stresses, (*batch, n, 6))

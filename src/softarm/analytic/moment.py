@@ -76,7 +76,7 @@ def _constant_strain(arm, moment, s):
     return poses, np.broadcast_to(strain, shape), np.broadcast_to(stress, shape)
 
 
-def tip_moment(arm, moment, follower=False, s=None):
+def tip_moment(arm, moment, s=None, *, follower=False):
     """Equilibrium of an arm under a pure end moment (Grazioso et al. 2018, eqs. 30-34).
 
     Model: a uniform Cosserat rod clamped at the base with f⁰ = (1, 0, 0, κ⁰), loaded at the
@@ -105,11 +105,11 @@ def tip_moment(arm, moment, follower=False, s=None):
     moment : array_like, shape (..., 3)
         Tip moment in N m: spatial components for a dead moment, tip material components for a
         follower moment. Leading axes are a batch of load cases.
-    follower : bool
-        False: dead moment (fixed in space); True: follower moment (fixed in the tip frame).
     s : array_like, shape (N,), or int, optional
         Stations in m, strictly increasing in [0, L]; an int N gives N uniform stations;
         default 101 uniform stations.
+    follower : bool, keyword-only
+        False: dead moment (fixed in space); True: follower moment (fixed in the tip frame).
 
     Returns
     -------

@@ -26,17 +26,17 @@ import sys
 from pathlib import Path
 
 from ._checks import CaseResult, Check, DataTables, find_data_dir
-from .cases import CASES, Case
+from .cases import CASES, ValidationCase
 from .report import COMMAND, Report, markdown, run, write_outputs
 
 __all__ = [
     "CASES",
     "COMMAND",
-    "Case",
     "CaseResult",
     "Check",
     "DataTables",
     "Report",
+    "ValidationCase",
     "add_parser",
     "find_data_dir",
     "main",
