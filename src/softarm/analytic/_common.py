@@ -15,7 +15,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from .._validate import as_vectors
+from .._validate import as_vectors, stations
 from ..equilibrium import Equilibrium
 from ..model import Arm, SegmentedArm
 
@@ -26,6 +26,7 @@ __all__ = [
     "build",
     "check_arm",
     "check_follower",
+    "checked_stations",
     "constant_strain_poses",
     "moment_is_principal",
     "negligible",
@@ -40,6 +41,19 @@ E1 = np.array([1.0, 0.0, 0.0])
 #: Relative size under which a component is treated as zero (a few units of roundoff): a
 #: closed form that is exact for the zero value is then exact to double precision.
 ROUNDOFF = 4.0 * np.finfo(np.float64).eps
+
+
+def checked_stations(s, length: float) -> np.ndarray:
+    """``_validate.stations(s, length)``: a fresh array of stations in m.
+
+    An increasing float64 array inside [0, L] (the common case: the solver's own stations) is
+    accepted by a few comparisons and copied; anything else goes through ``stations``, which
+    builds the default grid, clips roundoff at the ends or raises.
+    """
+    if (type(s) is np.ndarray and s.dtype == np.float64 and s.ndim == 1 and s.size >= 1
+            and s[0] >= 0.0 and s[-1] <= length and (s[1:] > s[:-1]).all()):
+        return s.copy()  # NaN and ±inf fail one of the comparisons
+    return stations(s, length)
 
 
 def negligible(x, scale) -> np.ndarray:

@@ -6,9 +6,8 @@ import math
 
 import numpy as np
 
-from .._validate import stations
 from ..loads import TipLoad
-from ._common import ROUNDOFF, build, check_arm, negligible, vectors
+from ._common import ROUNDOFF, build, check_arm, checked_stations, negligible, vectors
 from ._elastica_math import K_MAX, _lone, planar_elastica
 
 __all__ = ["elastica", "elastica_plane", "solve_elastica"]
@@ -112,7 +111,7 @@ def elastica(arm, force, s=None, *, extensible=True):
     force = vectors(force, "force", function)
     if not isinstance(extensible, (bool, np.bool_)):
         raise TypeError(f"{function}: extensible must be True or False, got {extensible!r}")
-    return solve_elastica(arm, force, stations(s, arm.length), bool(extensible),
+    return solve_elastica(arm, force, checked_stations(s, arm.length), bool(extensible),
                           (TipLoad(force=force),), function)
 
 
@@ -215,7 +214,7 @@ def _fields(sol, by, bz, L):
     are floats for one load, arrays (B...) for a batch.
     """
     half = np.sin(0.5 * sol.theta)
-    columns = [np.ones_like(half), np.sin(sol.theta), 2.0 * half * half, sol.x, sol.z,
+    columns = [np.ones(half.shape), np.sin(sol.theta), 2.0 * half * half, sol.x, sol.z,
                sol.axial_strain, sol.shear_strain, sol.curvature]
     # a~ = [[0, -b_y, -b_z], [b_y, 0, 0], [b_z, 0, 0]] and a aᵀ - I = [[-1, 0, 0],
     # [0, -b_y², -b_y b_z], [0, -b_y b_z, -b_z²]] (|b| = 1), at flat indices 4 i + j

@@ -6,10 +6,9 @@ import dataclasses
 
 import numpy as np
 
-from .._validate import stations
 from ..loads import TipLoad, as_loads, batch_shape
 from ..model import SegmentedArm
-from ._common import check_arm, moment_is_principal
+from ._common import check_arm, checked_stations, moment_is_principal
 from .elastica import solve_elastica
 from .force import axial_force
 from .moment import helix_applies, tip_moment
@@ -74,7 +73,7 @@ def exact_closed_form(arm, loads, s=None):
         return None
     arm = check_arm(arm, "exact_closed_form")
     loads = as_loads(loads)
-    s = stations(s, arm.length)
+    s = checked_stations(s, arm.length)
     if not loads or not all(isinstance(load, TipLoad) for load in loads):
         return None
     if len({bool(load.follower) for load in loads}) != 1:
