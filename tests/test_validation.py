@@ -118,7 +118,8 @@ def test_a_wrong_reference_fails(tmp_path):
 
 
 def test_shear_finding_shows_the_flapwise_failure_of_the_small_displacement_solution():
-    """NOTES.md: at the flapwise stiffness (k up to 1.9) eq. 58 is off by tens of percent."""
+    """C9 (docs/closed-forms.md): at the flapwise stiffness (k up to 1.9) eq. 58 is off by tens of
+    percent."""
     if not SHARED_DATA.is_dir():
         pytest.fail(f"reference folder {SHARED_DATA} not found: shared/ must sit beside the repo")
     report = run(["fig3_shear_load"], data_dir=SHARED_DATA, progress=None)

@@ -5,7 +5,7 @@ s (N,); :func:`build` broadcasts them to one batch shape, forms the stresses σ 
 given, and returns the :class:`~softarm.Equilibrium` without copying the arrays.
 
 :func:`screw_poses` is the fast kernel of the constant-strain and helix closed forms,
-H(s) = exp_SE3(s (u; ω)) · exp_SE3(s (0; τ e1)) (NOTES.md note 4, eq. 32 for τ = 0).
+H(s) = exp_SE3(s (u; ω)) · exp_SE3(s (0; τ e1)) (docs/closed-forms.md, C4; eq. 32 for τ = 0).
 """
 
 from __future__ import annotations
@@ -94,8 +94,8 @@ def moment_is_principal(arm: Arm, moment: np.ndarray) -> np.ndarray:
 
     True when the moment is an eigenvector of K_ωω (its non-zero components share one
     stiffness) and the initial curvature κ⁰ is parallel to it (or zero): then m' = -κ × m
-    vanishes, σ is constant and H = exp(s (f⁰ + ε)) is exact (NOTES.md note 2), for a dead or
-    a follower moment alike (the tip turns about the moment axis).
+    vanishes, σ is constant and H = exp(s (f⁰ + ε)) is exact (C2 of docs/closed-forms.md),
+    for a dead or a follower moment alike (the tip turns about the moment axis).
     """
     k = rotational_stiffness(arm)
     size = np.linalg.norm(moment, axis=-1)[..., None]

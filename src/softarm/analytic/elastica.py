@@ -64,7 +64,7 @@ def elastica(arm, force, s=None, *, extensible=True):
       constraint forces), so σ ≠ K ε in their linear part.
 
     Not in the paper, which has only the small-deflection version (eqs. 56-59, see
-    :func:`shear_force`); this is the closed form beyond it that NOTES.md note 8 points to.
+    :func:`shear_force`); this is the closed form beyond it (docs/closed-forms.md, C8).
     Mattiasson (1981, Table 1) is reproduced to 1e-7 L for k = P L²/EI from 0.1 to 20.
 
     Parameters
@@ -83,7 +83,7 @@ def elastica(arm, force, s=None, *, extensible=True):
     Equilibrium
         ``method="analytic.elastica"``. With θ the turn of the section from +x towards the
         force side b of the plane, R(s) = exp_SO3(θ(s) e1 × b) and κ = θ' e1 × b: in the x-z
-        plane a +z force gives κ_y = -θ' < 0 (NOTES.md sign checks).
+        plane a +z force gives κ_y = -θ' < 0 (the signs of docs/closed-forms.md, eqs. 50 and 58).
 
     References
     ----------

@@ -16,7 +16,7 @@ def transported_wrench(arm, wrench_tip: np.ndarray, s: np.ndarray) -> np.ndarray
     """σ(s) = Ad(exp((s - L) f⁰))ᵀ σ(L): the tip wrench carried along the undeformed curve.
 
     This solves σ' = hat(f⁰)ᵀ σ (eq. 22 with the transpose restored) with σ(L) given; it is
-    eq. 27's F(s) F(L)⁻¹ g with the corrected lower-left block of F (NOTES.md note 3).
+    eq. 27's F(s) F(L)⁻¹ g with the corrected lower-left block of F (docs/closed-forms.md, C3).
     ``wrench_tip`` (B..., 6) in the undeformed tip's material frame, s (N,) → (B..., N, 6).
     """
     f0 = arm.reference_strain
@@ -50,7 +50,7 @@ def linear(arm, force=(0.0, 0.0, 0.0), moment=(0.0, 0.0, 0.0), s=None, *, follow
     σ' = hat(f⁰)ᵀ σ (eq. 22 with the transpose the printed equation lacks), whose solution
     carries the tip wrench along the *undeformed* reference curve,
     σ(s) = Ad(exp((s - L) f⁰))ᵀ σ(L) (eq. 27 with F(α) corrected: the lower-left block of
-    eq. 24 is -(T_SO3(α f⁰_ω) α f⁰_u)~ Lᵀ, NOTES.md note 3). The strain is ε(s) = K⁻¹ σ(s);
+    eq. 24 is -(T_SO3(α f⁰_ω) α f⁰_u)~ Lᵀ, C3). The strain is ε(s) = K⁻¹ σ(s);
     the pose integrates H' = H (f⁰ + ε)~ exactly for the strain held at its midpoint value
     between consecutive stations (one SE(3) exponential per interval), an error O(h²) in the
     station spacing h on top of the model error O(load²).

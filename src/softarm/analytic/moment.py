@@ -27,7 +27,8 @@ __all__ = ["helix_applies", "tip_moment"]
 def helix_applies(arm) -> bool:
     """Equal bending stiffnesses and an initially straight (possibly twisted) axis.
 
-    Then the helix solution of NOTES.md note 4 is exact for every end moment, dead or follower.
+    Then the helix solution (docs/closed-forms.md, C4) is exact for every end moment, dead or
+    follower.
     """
     _, EIy, EIz = rotational_stiffness(arm)
     _, ky, kz = arm.curvature
@@ -35,7 +36,7 @@ def helix_applies(arm) -> bool:
 
 
 def _helix(arm, moment, follower, s):
-    """Poses, strains and stresses of the exact pure-moment solution for EIy = EIz = B (note 4).
+    """Poses, strains and stresses of the exact pure-moment solution for EIy = EIz = B (C4).
 
     With n = 0 the spatial moment M is constant. The material moment m = Rᵀ M gives the
     curvature κ⁰ + K⁻¹ m = m/B + c e1 with c = κ⁰₁ + M₁ (1/GJ - 1/B) constant (m₁' = 0), so
@@ -90,13 +91,13 @@ def tip_moment(arm, moment, s=None, *, follower=False):
       eqs. 37-38 of radius EIy/τ, bent towards -z.
     * **Equal bending stiffnesses** EIy = EIz = B (circle, tube, square) and an initially
       straight, possibly twisted arm (κ⁰ = (κ⁰₁, 0, 0)): exact for *any* moment direction,
-      dead or follower, by the helix of NOTES.md note 4 (not in the paper):
+      dead or follower, by the helix of correction C4 (not in the paper):
       H(s) = exp_SE3(s (e1; M/B)) · exp_SE3(s (0; c e1)), c = κ⁰₁ + M₁ (1/GJ - 1/B), with M
       the spatial moment: M = moment (dead) or M = exp(L c e1) · moment (follower).
     * **Elsewhere** the paper's constant-strain formula (eqs. 30-34 with the moment taken as
       the tip's material components) is returned with ``exact=False`` and an
       :class:`~softarm.ApproximationWarning`: eq. 22 drops the term -κ × K_ωω κ, which does
-      not vanish there (NOTES.md note 2), so the result is not an equilibrium.
+      not vanish there (C2 in docs/closed-forms.md), so the result is not an equilibrium.
 
     Parameters
     ----------
@@ -141,7 +142,7 @@ def tip_moment(arm, moment, s=None, *, follower=False):
     >>> eq.exact, bool(np.allclose(eq.tip_position, [np.sin(1.0), 0.0, np.cos(1.0) - 1.0]))
     (True, True)
 
-    The helix of NOTES.md note 4 (equal bending stiffnesses, a moment off the principal axes):
+    The helix of C4 (equal bending stiffnesses, a moment off the principal axes):
 
     >>> arm = Arm.from_stiffness(1.0, EA=1e6, GAy=1e6, GAz=1e6, GJ=1 / 1.3, EIy=1.0, EIz=1.0)
     >>> np.round(tip_moment(arm, [1.0, 1.0, 0.0]).tip_position, 4)

@@ -250,7 +250,7 @@ def fig3_shear_load(tables: DataTables) -> CaseResult:
             item = f"{key}: P = {P:g} N (k = {P * L**2 / EI:.3g})"
             force = (0.0, 0.0, P)
             z_eq58, _ = ref.small_displacement_shear(s, P, L, EI, GA)
-            kappa_eq50 = P * L / EI * (s / L - 1.0)  # eq. 50, sign corrected (NOTES.md note 6)
+            kappa_eq50 = P * L / EI * (s / L - 1.0)  # eq. 50, sign corrected (C6)
             small, note_small = attempt(closed_form, "shear_force", arm, force, s=s)
             exact, note_exact = attempt(numeric, arm, TipLoad(force=force), s)
             balance = "global equilibrium: the base reaction balances the tip force"
@@ -261,7 +261,7 @@ def fig3_shear_load(tables: DataTables) -> CaseResult:
                      f"{PAPER}, eq. 58", note=note_small),
                 gate(case, item, "analytic.shear_force", "max_s |κ_y(s) - eq. 50| · L", 0.0,
                      value(small, _max_abs, _kappa_y, kappa_eq50, L), TOL_CLOSED,
-                     f"{PAPER}, eq. 50 (sign corrected, NOTES.md note 6)", note=note_small),
+                     f"{PAPER}, eq. 50 (sign corrected, C6)", note=note_small),
                 gate(case, item, "analytic.shear_force", "γ_z", P / GA,
                      value(small, _gamma_z_tip), TOL_CLOSED * P / GA, f"{PAPER}, eq. 49",
                      note=note_small),
@@ -304,7 +304,7 @@ def _table1_markdown(rows) -> str:
         "**Table I analogue.** Relative error of the small-displacement z-displacement "
         "(eq. 58) against the exact solution at the same arc-length station s = r, in %: "
         "e = 100 |z_small - z_exact| / |z_exact|. (The paper's eq. 60 divides a difference of "
-        "lengths by r/L, which is not a relative error: NOTES.md note 7.) The paper's own "
+        "lengths by r/L, which is not a relative error: C7.) The paper's own "
         "Table I compares eq. 58 with the *measured* Dowell-Traybar deflections, which are "
         "neither printed in the paper nor available here (princeton_beam.json: "
         "`experimental_data.status` = NOT FOUND), so Table I itself cannot be recomputed.",
@@ -618,9 +618,9 @@ def _tip_distance(eq, point, scale):
 
 
 # ------------------------------------------------------------------------------------------
-# End moment off the principal axes: helices (NOTES.md note 4)
+# End moment off the principal axes: helices (C4)
 # ------------------------------------------------------------------------------------------
-#: Exact tips of NOTES.md note 4, to 4 decimals: dead and follower moment (1, 1, 0) N m.
+#: Exact tips of C4 (docs/closed-forms.md), to 4 decimals: dead and follower moment (1, 1, 0) N m.
 _NOTE4 = {False: (0.8492, 0.1508, -0.4220), True: (0.8492, 0.2688, -0.3586)}
 
 
@@ -629,8 +629,8 @@ def helix(tables: DataTables) -> CaseResult:
     arm = _stiff_arm(L, B, GJ=GJ)
     moment = (1.0, 1.0, 0.0)
     result = CaseResult()
-    note4 = "NOTES.md note 4 (exact tips, 4 decimals)"
-    formula = "NOTES.md note 4 closed form (helix about M), evaluated with scipy.linalg.expm"
+    note4 = "C4 of docs/closed-forms.md (exact tips, 4 decimals)"
+    formula = "C4 closed form (helix about M), evaluated with scipy.linalg.expm"
     axes = ("tip x [m]", "tip y [m]", "tip z [m]")
     for follower in (False, True):
         item = f"{'follower' if follower else 'dead'} moment (1, 1, 0) N m"
@@ -654,7 +654,7 @@ def helix(tables: DataTables) -> CaseResult:
                         note="tolerance: 4-decimal rounding + 1e-6"))
     # Unequal bending stiffnesses (EI_z = 2 EI_y): no helix; softarm's tip_moment falls back to
     # the paper's constant-strain formula (eqs. 30-34), which is not an equilibrium off a
-    # principal axis (NOTES.md notes 2 and 4). Reported against the exact solver: a finding.
+    # principal axis (C2 and C4). Reported against the exact solver: a finding.
     arm2 = _stiff_arm(L, B, GJ=GJ, EIz=2.0 * B)
     for follower in (False, True):
         item = f"EI_z = 2 EI_y, {'follower' if follower else 'dead'} moment (1, 1, 0) N m"
@@ -685,7 +685,7 @@ CASES: tuple[ValidationCase, ...] = (
         "solution (`solve(method='numeric')`) as a *finding*: the paper's printed Princeton "
         "parameters (EI_y = 36.28 N m², GA_z = 0.9039e6 N, L = 0.508 m) are the beam's stiff "
         "chordwise pair, where the approximation is good; the same loads on the beam's real "
-        "flapwise stiffness (EI = 2.42873 N m², the 0° load of the experiment, NOTES.md) "
+        "flapwise stiffness (EI = 2.42873 N m², the 0° load of the experiment, C9) "
         "reach k = PL²/EI = 1.9 and the approximation fails. The paper does not print EA, "
         "GA_y, GJ or EI_z: for the printed pair they are set to EA = GA_y = GA_z and "
         "GJ = EI_z = EI_y, which do not enter this planar problem. The flapwise pair is the "
@@ -717,12 +717,12 @@ CASES: tuple[ValidationCase, ...] = (
         "A tip torque T about the axis twists the arm by φ = TL/GJ and leaves it straight.",
         pure_torsion),
     ValidationCase(
-        "helix_end_moment", "End moment off the principal axes: helices (NOTES.md note 4)",
+        "helix_end_moment", "End moment off the principal axes: helices (C4)",
         "L = 1 m, EI_y = EI_z = 1 N m², GJ = 1/1.3 N m², tip moment with components "
         "(1, 1, 0) N m, dead and follower. The exact shape is a helix about the (constant) "
         "spatial moment, which `analytic.tip_moment` uses for equal bending stiffnesses. "
         "With EI_z = 2 EI_y there is no helix and `analytic.tip_moment` falls back to the "
         "paper's constant-strain formula (eqs. 30-34, with an ApproximationWarning), exact "
-        "only for a moment about a principal axis (NOTES.md notes 2 and 4): its tip against "
+        "only for a moment about a principal axis (C2 and C4): its tip against "
         "the exact solver is reported as a finding.", helix),
 )
