@@ -178,11 +178,10 @@ def solve_elastica(arm, force: np.ndarray, s: np.ndarray, extensible: bool, load
     else:  # a batch, or a load planar_elastica refuses (with its message)
         sol = planar_elastica(k, phi, s / L, axial_ratio=axial_ratio, shear_ratio=shear_ratio)
     by, bz = (b[1], b[2]) if lone else (b[..., 1], b[..., 2])
-    fields = _fields(sol, by, bz, L)
-    fields.setflags(write=False)  # fresh: poses and strains are views the result keeps
+    fields = _fields(sol, by, bz, L, r)
+    fields.setflags(write=False)  # fresh: poses, strains and stresses are views of it
     poses = fields[..., :16].reshape(*fields.shape[:-1], 4, 4)
-    strains = fields[..., 16:]
-    stresses = None
+    strains, stresses = fields[..., 16:22], fields[..., 22:]
     if not extensible:  # γ = 0, and n = Rᵀ F, the constraint force
         strains = np.concatenate([np.zeros_like(strains[..., :3]), strains[..., 3:]], axis=-1)
         n = np.einsum("...ji,...j->...i", poses[..., :3, :3], force[..., None, :])
@@ -192,26 +191,29 @@ def solve_elastica(arm, force: np.ndarray, s: np.ndarray, extensible: bool, load
                  stresses=stresses)
 
 
-#: Row and column of every entry of C (see :func:`_fields`) that depends on the plane or L.
+#: Row and column of every entry of C (see :func:`_fields`) that depends on the plane, L or
+#: the stiffnesses.
 _ENTRIES = ((1, 1), (1, 2), (1, 4), (1, 8), (2, 5), (2, 10), (2, 6), (2, 9), (3, 3), (4, 7),
-            (4, 11), (6, 17), (6, 18), (7, 20), (7, 21))
+            (4, 11), (6, 17), (6, 18), (7, 20), (7, 21), (5, 22), (6, 23), (6, 24), (7, 26),
+            (7, 27))
 _ROWS, _COLUMNS = (np.array(index) for index in zip(*_ENTRIES, strict=True))
 #: C without those entries: I and the pose's 1 (row 0), -1 of a aᵀ - I (row 2), e1 (row 5).
-_CONSTANT = np.zeros((8, 22))
+_CONSTANT = np.zeros((8, 28))
 _CONSTANT[0, [0, 5, 10, 15]] = 1.0
 _CONSTANT[2, 0] = -1.0
 _CONSTANT[5, 16] = 1.0
 
 
-def _fields(sol, by, bz, L):
-    """Poses (flattened, 16 columns) and strains (6) of the planar solution, (B..., N, 22).
+def _fields(sol, by, bz, L, r):
+    """Poses (flattened, 16 columns), strains (6) and stresses (6) of the planar solution.
 
     The section turns by θ about the unit axis a = e1 × b = (0, -b_z, b_y) (b = (0, b_y, b_z)
     the in-plane normal on the force side), so R = I + sin θ a~ + 2 sin²(θ/2) (a aᵀ - I)
-    (Rodrigues, eqs. 70-71), p = L (x e1 + z b), γ = N/EA e1 + Q/GA b, κ = (θ'/L) a. Every
-    entry is linear in c = (1, sin θ, 2 sin²(θ/2), x, z, N/EA, Q/GA, θ'): one matrix product
-    c @ C per arm, C of shape (B..., 8, 22), as in ``_common.screw_poses``. ``by``, ``bz``
-    are floats for one load, arrays (B...) for a batch.
+    (Rodrigues, eqs. 70-71), p = L (x e1 + z b), γ = N/EA e1 + Q/GA b, κ = (θ'/L) a and
+    σ = K ε (``r`` the arm's rigidities). Every entry is linear in c = (1, sin θ,
+    2 sin²(θ/2), x, z, N/EA, Q/GA, θ'): one matrix product c @ C per arm, C of shape
+    (B..., 8, 28), as in ``_common.screw_poses``; the result has shape (B..., N, 28).
+    ``by``, ``bz`` are floats for one load, arrays (B...) for a batch.
     """
     half = np.sin(0.5 * sol.theta)
     columns = [np.ones(half.shape), np.sin(sol.theta), 2.0 * half * half, sol.x, sol.z,
@@ -219,12 +221,13 @@ def _fields(sol, by, bz, L):
     # a~ = [[0, -b_y, -b_z], [b_y, 0, 0], [b_z, 0, 0]] and a aᵀ - I = [[-1, 0, 0],
     # [0, -b_y², -b_y b_z], [0, -b_y b_z, -b_z²]] (|b| = 1), at flat indices 4 i + j
     entries = (-by, -bz, by, bz, -(by * by), -(bz * bz), -(by * bz), -(by * bz), L, L * by,
-               L * bz, by, bz, -bz / L, by / L)
-    if isinstance(by, float):  # one load: a (N, 8) by (8, 22) product
+               L * bz, by, bz, -bz / L, by / L, r.EA, r.GAy * by, r.GAz * bz,
+               -bz / L * r.EIy, by / L * r.EIz)
+    if isinstance(by, float):  # one load: a (N, 8) by (8, 28) product
         C = _CONSTANT.copy()
         C[_ROWS, _COLUMNS] = entries
         return np.array(columns).T @ C
-    C = np.zeros((*np.shape(by), 8, 22))
+    C = np.zeros((*np.shape(by), 8, 28))
     C[...] = _CONSTANT
     for (row, column), value in zip(_ENTRIES, entries, strict=True):
         C[..., row, column] = value
