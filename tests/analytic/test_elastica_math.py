@@ -183,9 +183,12 @@ def test_cumulative_chebyshev_quadrature():
     assert nodes[0] == 1.0 and nodes[-1] == 0.0
     s = np.linspace(0.0, 1.0, 13)
     values = np.exp(nodes) + np.cos(7 * nodes) * np.array([[1.0], [2.0]])
-    got = _elastica_math._cumulative_chebyshev(values, s)
     want = np.exp(s) - 1 + np.sin(7 * s) / 7 * np.array([[1.0], [2.0]])
-    np.testing.assert_allclose(got, want, rtol=0, atol=1e-15)
+    # the DCT route, and the kept weights (first call fills them, the second reuses them)
+    for _ in range(2):
+        for rule in (_elastica_math._cumulative_chebyshev_direct,
+                     _elastica_math._cumulative_chebyshev):
+            np.testing.assert_allclose(rule(values, s), want, rtol=0, atol=1e-15)
 
 
 # --------------------------------------------------------------------------------------------

@@ -97,6 +97,7 @@ B. C. Carlson, "Numerical computation of real or complex elliptic integrals", Nu
 
 from __future__ import annotations
 
+import functools
 import math
 from typing import NamedTuple
 
@@ -539,7 +540,35 @@ def _chebyshev_points(n):
     return np.sin(0.5 * np.pi * np.arange(n - 1, -1, -1) / (n - 1)) ** 2
 
 
+#: Largest (Chebyshev points × stations) whose quadrature weights are kept (2 MiB each).
+_CACHED_WEIGHTS = 2**18
+
+
 def _cumulative_chebyshev(values, s):
+    """∫_0^s f for f sampled at ``_chebyshev_points(n)`` on the last axis (Clenshaw-Curtis).
+
+    The rule is linear in the samples: ``values @ W`` with the weights W (n, N) of
+    :func:`_chebyshev_weights`, kept for the last few (n, s) (the same stations come back call
+    after call); very large grids run :func:`_cumulative_chebyshev_direct` instead.
+    """
+    n = values.shape[-1]
+    if n * s.size > _CACHED_WEIGHTS:
+        return _cumulative_chebyshev_direct(values, s)
+    return values @ _chebyshev_weights(n, s.tobytes())
+
+
+@functools.lru_cache(maxsize=16)
+def _chebyshev_weights(n, stations):
+    """W with ``_cumulative_chebyshev_direct(values, s) = values @ W``, shape (n, N), read-only.
+
+    Row i is the rule applied to the i-th unit sample; ``stations`` is ``s.tobytes()``.
+    """
+    weights = _cumulative_chebyshev_direct(np.eye(n), np.frombuffer(stations))
+    weights.setflags(write=False)
+    return weights
+
+
+def _cumulative_chebyshev_direct(values, s):
     """∫_0^s f for f sampled at ``_chebyshev_points(n)`` on the last axis (Clenshaw-Curtis).
 
     f ≈ Σ c_j T_j(2s − 1) with c from a DCT-I of the samples; the series is integrated term by
@@ -725,20 +754,37 @@ def _stations_1(s, sqrt_k, rho_tip, s_dl, c_dl, e, s_chi, c_chi):
     Jacobi's amplitude am(√(k f_L)(1 − s) | m') from scipy's ``ellipj``: sn to 4.4e-16
     relative and cn to 6e-16 absolute (checked against mpmath for m' up to 1 − 1e-16 and
     u ≤ 12). Where every station has cos χ_s ≥ cos χ_0 ≥ ``_CN_DIRECT`` that is within 6e-15
-    relative of the root, and the batch's Newton polish (one ``elliprf`` per station) is
-    skipped; otherwise, and for loads whose stations may need the asymptotic start
-    (√(k f_L) > 12), the batch's :func:`_solve_stations` runs.
+    relative of the root and is returned as it is. Below, one Newton step in ρ = log tan χ
+    (tan χ ← tan χ e^(−δ)) polishes it; when every step has δ² ≤ 4 ε (the bound
+    :func:`_newton` stops at, with |R''/R'| ≤ 2) that is the batch's answer. Otherwise, and for
+    loads whose stations may need the asymptotic start (√(k f_L) > 12), the batch's
+    :func:`_solve_stations` runs.
     """
     f_l, mc = _modulus(s_dl, c_dl, e)
     u0 = sqrt_k * math.sqrt(f_l)
-    if u0 > 12.0 or c_chi < _CN_DIRECT:
+    if u0 > 12.0:  # 2 e^(−u) ≥ 1.2e-5 below: the asymptotic start is never used there
         s_ch, c_ch, _ = _solve_stations(s, sqrt_k, rho_tip, s_dl, c_dl, e)
         return s_ch, c_ch
-    sn, cn, _, _ = ellipj(u0 * (1.0 - s), 1.0 - mc)
+    target = u0 * (1.0 - s)
+    sn, cn, _, _ = ellipj(target, 1.0 - mc)
     h = np.hypot(sn, cn)
     sn /= h
     cn /= h
     at_clamp, at_tip = s == 0.0, s == 1.0
+    if c_chi < _CN_DIRECT:
+        cc = cn * cn
+        delta2 = cc + mc * sn * sn
+        with np.errstate(divide="ignore", invalid="ignore"):  # 0/0 at the tip (s = 1)
+            step = (sn * elliprf(cc, delta2, 1.0) - target) / (sn * cn / np.sqrt(delta2))
+        if not ((step * step <= 4.0 * _EPS) | at_clamp | at_tip).all():
+            s_ch, c_ch, _ = _solve_stations(s, sqrt_k, rho_tip, s_dl, c_dl, e)
+            return s_ch, c_ch
+        q = np.exp(-0.5 * step)
+        sn *= q
+        cn /= q
+        h = np.hypot(sn, cn)
+        sn /= h
+        cn /= h
     sn[at_clamp], cn[at_clamp] = s_chi, c_chi
     sn[at_tip], cn[at_tip] = 0.0, 1.0
     return sn, cn
