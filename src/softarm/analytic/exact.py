@@ -11,7 +11,7 @@ from ..model import SegmentedArm
 from ._common import check_arm, checked_stations, moment_is_principal
 from .elastica import solve_elastica
 from .force import axial_force
-from .moment import helix_applies, tip_moment
+from .moment import helix_applies, solve_tip_moment
 
 __all__ = ["exact_closed_form"]
 
@@ -93,7 +93,7 @@ def _dispatch(arm, force, moment, follower, s, loads):
     straight_axis = arm.curvature[1] == 0.0 and arm.curvature[2] == 0.0
     if not force.any():
         if helix_applies(arm) or np.all(moment_is_principal(arm, moment)):
-            return tip_moment(arm, moment, follower=follower, s=s)
+            return solve_tip_moment(arm, moment, s, follower, loads)
         return None
     if moment.any():
         return None

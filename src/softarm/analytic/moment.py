@@ -6,7 +6,6 @@ import warnings
 
 import numpy as np
 
-from .._validate import stations
 from ..errors import ApproximationWarning
 from ..loads import TipLoad
 from ._common import (
@@ -14,6 +13,7 @@ from ._common import (
     build,
     check_arm,
     check_follower,
+    checked_stations,
     moment_is_principal,
     negligible,
     rotational_stiffness,
@@ -21,7 +21,7 @@ from ._common import (
     vectors,
 )
 
-__all__ = ["helix_applies", "tip_moment"]
+__all__ = ["helix_applies", "solve_tip_moment", "tip_moment"]
 
 
 def helix_applies(arm) -> bool:
@@ -154,8 +154,13 @@ def tip_moment(arm, moment, s=None, *, follower=False):
     arm = check_arm(arm, function)
     moment = vectors(moment, "moment", function)
     follower = check_follower(follower, function)
-    s = stations(s, arm.length)
-    loads = (TipLoad(moment=moment, follower=follower),)
+    return solve_tip_moment(arm, moment, checked_stations(s, arm.length), follower,
+                            (TipLoad(moment=moment, follower=follower),))
+
+
+def solve_tip_moment(arm, moment, s, follower, loads):
+    """:func:`tip_moment` for checked arguments; the result carries ``loads`` as given
+    (exact_closed_form passes the caller's)."""
     if helix_applies(arm):
         poses, strains, stresses = _helix(arm, moment, follower, s)
         return build(arm, s, poses, strains, loads, "analytic.tip_moment.helix", True,
@@ -170,7 +175,7 @@ def tip_moment(arm, moment, s=None, *, follower=False):
             "the constant-strain formula (eqs. 30-34) is only an approximation, not an "
             "equilibrium; use softarm.solve for the exact one",
             ApproximationWarning,
-            stacklevel=2,
+            stacklevel=3,  # the caller of tip_moment
         )
         method = "analytic.tip_moment.constant_strain"
     else:
