@@ -10,6 +10,7 @@ H(s) = exp_SE3(s (u; ω)) · exp_SE3(s (0; τ e1)) (docs/closed-forms.md, C4; eq
 
 from __future__ import annotations
 
+import math
 import os
 from concurrent.futures import ThreadPoolExecutor
 
@@ -130,6 +131,8 @@ _PER_THREAD = 4 * _BLOCK
 THREADS_VARIABLE = "SOFTARM_NUM_THREADS"
 
 _EYE3 = np.eye(3)
+#: Component orders of the cross product: (a × u)_i = a_{i+1} u_{i+2} - a_{i+2} u_{i+1}.
+_NEXT, _LAST = np.array([1, 2, 0]), np.array([2, 0, 1])
 
 
 def thread_count(elements: int) -> int:
@@ -239,10 +242,10 @@ def screw_poses(u, omega, s, twist=None, fields=None):
         Read-only views of one fresh (B..., N, 16 + C) buffer (so ``poses`` is contiguous
         only without ``fields``).
     """
-    batch = np.broadcast_shapes(u.shape[:-1], omega.shape[:-1],
-                                () if twist is None else np.shape(twist),
-                                () if fields is None else fields.shape[:-2])
-    size, n = int(np.prod(batch)), s.shape[0]
+    shapes = (u.shape[:-1], omega.shape[:-1], () if twist is None else np.shape(twist),
+              () if fields is None else fields.shape[:-2])
+    batch = shapes[0] if shapes.count(shapes[0]) == 4 else np.broadcast_shapes(*shapes)
+    size, n = math.prod(batch), s.shape[0]
     u = _broadcast(u, (*batch, 3)).reshape(size, 3)
     omega = _broadcast(omega, (*batch, 3)).reshape(size, 3)
     theta = np.sqrt(np.einsum("bi,bi->b", omega, omega))
@@ -256,11 +259,13 @@ def screw_poses(u, omega, s, twist=None, fields=None):
     position = np.empty((size, 3, 3))
     position[:, 0] = along_a
     position[still, 0] = u[still]
-    position[:, 1] = np.cross(a, u)
+    position[:, 1] = a[:, _NEXT] * u[:, _LAST] - a[:, _LAST] * u[:, _NEXT]  # a × u
     np.subtract(u, along_a, out=position[:, 2])
     position[:, 1:] /= theta_safe[:, None, None]
-    rates = (0.5 * theta)[:, None] if twist is None else \
-        np.stack([0.5 * theta, 0.5 * _broadcast(twist, batch).reshape(size)], axis=-1)
+    rates = np.empty((size, 1 if twist is None else 2))
+    np.multiply(0.5, theta, out=rates[:, 0])
+    if twist is not None:
+        np.multiply(0.5, _broadcast(twist, batch).reshape(size), out=rates[:, 1])
     twisted = twist is not None
     k, r = (10, 2) if twisted else (4, 1)
     columns = 16 + (0 if fields is None else fields.shape[-1])
