@@ -33,6 +33,7 @@ __all__ = [
     "negligible",
     "rotational_stiffness",
     "screw_poses",
+    "stiffness_diagonal",
     "thread_count",
     "vectors",
 ]
@@ -85,9 +86,16 @@ def vectors(value, name: str, function: str) -> np.ndarray:
     return as_vectors(value, f"{function}: {name}", 3)
 
 
+def stiffness_diagonal(arm: Arm) -> np.ndarray:
+    """diag K = (EA, GAy, GAz, GJ, EIy, EIz), shape (6,) (without forming the 6×6 matrix)."""
+    r = arm.rigidities
+    return np.array([r.EA, r.GAy, r.GAz, r.GJ, r.EIy, r.EIz])
+
+
 def rotational_stiffness(arm: Arm) -> np.ndarray:
     """diag K_ωω = (GJ, EIy, EIz), shape (3,)."""
-    return np.diagonal(arm.stiffness)[3:]
+    r = arm.rigidities
+    return np.array([r.GJ, r.EIy, r.EIz])
 
 
 def moment_is_principal(arm: Arm, moment: np.ndarray) -> np.ndarray:
@@ -344,8 +352,7 @@ def build(arm: Arm, s: np.ndarray, poses, strains, loads, method: str, exact: bo
     poses = _owned(poses)
     strains = _owned(strains)
     if stresses is None:
-        r = arm.rigidities
-        stresses = strains * np.array([r.EA, r.GAy, r.GAz, r.GJ, r.EIy, r.EIz])  # K ε
+        stresses = strains * stiffness_diagonal(arm)  # K ε
     stresses = _owned(stresses)
     shapes = (poses.shape[:-3], strains.shape[:-2], stresses.shape[:-2])
     batch = shapes[0] if shapes[0] == shapes[1] == shapes[2] else np.broadcast_shapes(*shapes)

@@ -7,7 +7,14 @@ import numpy as np
 from .._validate import stations
 from ..lie import se3, so3
 from ..loads import TipLoad
-from ._common import build, check_arm, check_follower, moment_is_principal, vectors
+from ._common import (
+    build,
+    check_arm,
+    check_follower,
+    moment_is_principal,
+    stiffness_diagonal,
+    vectors,
+)
 
 __all__ = ["linear", "transported_wrench"]
 
@@ -109,7 +116,7 @@ def linear(arm, force=(0.0, 0.0, 0.0), moment=(0.0, 0.0, 0.0), s=None, *, follow
         Rt = so3.exp(arm.length * np.asarray(arm.curvature)).T
         force, moment = force @ Rt.T, moment @ Rt.T
     wrench = np.concatenate([force, moment], axis=-1)
-    k = np.diagonal(arm.stiffness)
+    k = stiffness_diagonal(arm)
     strains = transported_wrench(arm, wrench, s) / k
     poses = _integrate(lambda t: arm.reference_strain + transported_wrench(arm, wrench, t) / k, s,
                        arm.length)

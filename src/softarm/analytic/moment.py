@@ -18,6 +18,7 @@ from ._common import (
     negligible,
     rotational_stiffness,
     screw_poses,
+    stiffness_diagonal,
     vectors,
 )
 
@@ -44,7 +45,7 @@ def _helix(arm, moment, follower, s):
     H(s) = exp_SE3(s (e1; M/B)) · exp_SE3(s (0; c e1)). Since exp(s M/B) fixes M,
     m(s) = exp(-s c e1) M = M + (1 - cos cs) (0, -M₂, -M₃) + sin(cs) (0, M₃, -M₂).
     """
-    k = np.diagonal(arm.stiffness)
+    k = stiffness_diagonal(arm)
     GJ, B = k[3], k[4]
     c = arm.curvature[0] + moment[..., 0] * (1.0 / GJ - 1.0 / B)
     if follower:  # the tip material components g = R(L)ᵀ M = exp(-L c e1) M are given
@@ -65,7 +66,7 @@ def _helix(arm, moment, follower, s):
 
 def _constant_strain(arm, moment, s):
     """Eqs. 30-34: ε = K⁻¹ (0; moment), constant, and H(s) = exp_SE3(s (f⁰ + ε))."""
-    k = np.diagonal(arm.stiffness)
+    k = stiffness_diagonal(arm)
     kappa = moment / k[3:]
     poses, _ = screw_poses(E1, np.asarray(arm.curvature) + kappa, s)
     strain = np.zeros((*moment.shape[:-1], 1, 6))
