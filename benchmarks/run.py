@@ -55,6 +55,9 @@ class Row:
     matched: bool  # error <= ACCURACY
     ratio: float = math.nan  # wall / softarm numeric wall
     note: str = ""
+    # softarm auto rows: softarm numeric at tol=1e-6, timed in alternation with auto
+    numeric_wall_ms: float = math.nan
+    numeric_cpu_ms: float = math.nan
 
 
 # --------------------------------------------------------------------------------------------
@@ -147,6 +150,23 @@ def timed(fn, repeats: int):
         walls.append(time.perf_counter() - w0)
         cpus.append(time.process_time() - c0)
     return out, statistics.median(walls), statistics.median(cpus)
+
+
+def timed_pair(first, second, repeats: int, block: int = 5):
+    """Median wall and CPU seconds per call of two functions timed in alternation.
+
+    Blocks of ``block`` calls of each take turns, so both see the same machine load (it
+    drifts on a shared machine). Returns ((wall, cpu) of ``first``, (wall, cpu) of ``second``).
+    """
+    times = ([], []), ([], [])
+    for _ in range(repeats):
+        for fn, (walls, cpus) in zip((first, second), times, strict=True):
+            w0, c0 = time.perf_counter(), time.process_time()
+            for _ in range(block):
+                fn()
+            walls.append((time.perf_counter() - w0) / block)
+            cpus.append((time.process_time() - c0) / block)
+    return tuple((statistics.median(w), statistics.median(c)) for w, c in times)
 
 
 def matched(run, tols, reference, length, repeats, scan_repeats=1):
@@ -244,11 +264,20 @@ def run_cases(all_cases, refs, repeats: int, peer_repeats: int, quick: bool) -> 
 
         auto = softarm.solve(arm, loads, method="auto")
         if auto.method != "numeric.shooting":
-            eq, wall, cpu = timed(lambda arm=arm, loads=loads: softarm.solve(arm, loads),
-                                  repeats)
-            err = float(np.linalg.norm(eq.tip_position - ref)) / L
-            rows.append(Row(name, "softarm auto", f"{eq.method}, 101 stations", wall * 1e3,
-                            cpu * 1e3, err, err <= ACCURACY, wall / wall0))
+            err = float(np.linalg.norm(auto.tip_position - ref)) / L
+            (wall, cpu), (n_wall, n_cpu) = timed_pair(
+                lambda arm=arm, loads=loads: softarm.solve(arm, loads, method="auto"),
+                lambda arm=arm, loads=loads: softarm.solve(arm, loads, method="numeric",
+                                                           tol=1e-6),
+                repeats)
+            rows.append(Row(name, "softarm auto", f"{auto.method}, 101 stations", wall * 1e3,
+                            cpu * 1e3, err, err <= ACCURACY, wall / wall0,
+                            f"numeric tol=1e-6 in alternation: {n_wall * 1e3:.3f} ms wall, "
+                            f"{n_cpu * 1e3:.3f} ms CPU; auto/numeric {wall / n_wall:.2f}× "
+                            f"wall, {cpu / n_cpu:.2f}× CPU", n_wall * 1e3, n_cpu * 1e3))
+            print(f"  {name}: softarm auto ({auto.method}) {wall * 1e3:.3f} ms "
+                  f"(CPU {cpu * 1e3:.3f}) vs numeric tol=1e-6 {n_wall * 1e3:.3f} ms "
+                  f"(CPU {n_cpu * 1e3:.3f})", flush=True)
 
         def run_bvp(tol, problem=problem):
             return peers.solve_bvp_cosserat(problem, tol=tol).tip_position
@@ -393,6 +422,15 @@ def verdicts(rows, closed, closed_serial, batch) -> list[str]:
         f"{overhead[1] / big['output_bytes']:.2f}× the outputs; rule: met if the excess at "
         f"the larger size ≤ max(1.5× the smaller's, the smaller's + 32 MiB))"
     )
+    autos = [x for x in rows if x.tool == "softarm auto"]
+    if autos:
+        ok = all(x.wall_ms <= x.numeric_wall_ms and x.cpu_ms <= x.numeric_cpu_ms for x in autos)
+        out.append(
+            f"method='auto' never slower than 'numeric' (tol=1e-6, timed in alternation): "
+            f"{'met' if ok else 'NOT met'}: auto/numeric wall (CPU) "
+            + ", ".join(f"{x.case} {x.wall_ms / x.numeric_wall_ms:.2f}× "
+                        f"({x.cpu_ms / x.numeric_cpu_ms:.2f}×)" for x in autos)
+        )
     sa = next((x for x in rows if x.case == "mattiasson_k5" and x.tool == "softarm numeric"),
               None)
     bvp = next((x for x in rows if x.case == "mattiasson_k5" and x.tool == "scipy solve_bvp"),
@@ -445,7 +483,8 @@ def report(env, comp, rows, ref_notes, pyel_note, closed_runs, batch, verdict,
         "Each tool's tolerance is scanned loose → tight on a fixed grid and the first setting "
         f"whose tip error is ≤ {ACCURACY:g}·L is timed (median over repeats); *no* means the "
         "grid's tightest setting still missed it. softarm is called with `method='numeric'`; "
-        "`softarm auto` rows show `method='auto'` where an exact closed form applies. "
+        "`softarm auto` rows show `method='auto'` where an exact closed form applies, with "
+        "`method='numeric', tol=1e-6` timed in alternation with it (same load) in the note. "
         "`time / softarm` is wall time over softarm numeric's on the same case. Grids: "
         f"softarm `tol` {SOFTARM_TOLS}; solve_bvp `tol` {BVP_TOLS}; shooting `tol` "
         f"{SHOOT_TOLS}.",

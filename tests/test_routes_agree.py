@@ -27,7 +27,7 @@ CASES = {
     "principal moment": (analytic.tip_moment, FLAT, dict(moment=[0.0, 0.004, 0.0])),
     "principal moment, precurved": (analytic.tip_moment, PRECURVED,
                                     dict(moment=[0.0, -0.003, 0.0])),
-    # docs/closed-forms.md: helix under any end moment, dead and follower
+    # C4 (docs/closed-forms.md): helix under any end moment, dead and follower
     "helix, dead": (analytic.tip_moment, ROUND, dict(moment=[0.01, 0.03, -0.015])),
     "helix, follower": (analytic.tip_moment, ROUND,
                         dict(moment=[0.01, 0.03, -0.015], follower=True)),

@@ -116,7 +116,8 @@ def test_a_wrong_reference_fails(tmp_path):
 
 
 def test_shear_finding_shows_the_flapwise_failure_of_the_small_displacement_solution():
-    """At the flapwise stiffness (k up to 1.9) eq. 58 is off by tens of percent."""
+    """C9 (docs/closed-forms.md): at the flapwise stiffness (k up to 1.9) eq. 58 is off by tens of
+    percent."""
     report = run(["fig3_shear_load"], progress=None)  # the packaged tables
     tips = {c.item.split(":")[0]: c for c in report.checks
             if c.status == "finding" and c.quantity.startswith("z at r/L = 1 ")

@@ -67,8 +67,8 @@ def _arm(L=1.0, EA=1e6, GAy=1e6, GAz=1e6, GJ=1.0, EIy=1.0, EIz=1.0, curvature=(0
 @pytest.mark.parametrize("follower", [False, True])
 @pytest.mark.parametrize("twist", [0.0, 0.7])
 def test_helix_matches_shooting(follower, twist):
-    # docs/closed-forms.md arm (GJ = 1/1.3, EI = 1), moment (1, 1, 0); twist 0.7 1/m checks the
-    # extension to an initially twisted straight arm (c = κ⁰₁ + M₁ (1/GJ - 1/B)).
+    # The arm of C4 in docs/closed-forms.md (GJ = 1/1.3, EI = 1), moment (1, 1, 0); twist 0.7 1/m
+    # checks the extension to an initially twisted straight arm (c = κ⁰₁ + M₁ (1/GJ - 1/B)).
     arm = _arm(GJ=1 / 1.3, curvature=(twist, 0.0, 0.0))
     s = np.linspace(0.0, 1.0, 11)
     eq = tip_moment(arm, [1.0, 1.0, 0.0], follower=follower, s=s)
@@ -80,7 +80,7 @@ def test_helix_matches_shooting(follower, twist):
 
 
 def test_principal_moment_on_curved_arm_matches_shooting():
-    # Initial curvature about y, moment about y (parallel): constant strain is exact (note 2).
+    # Initial curvature about y, moment about y (parallel): constant strain is exact (C2).
     arm = _arm(GJ=0.4, EIy=2.0, EIz=0.5, curvature=(0.0, 1.5, 0.0))
     s = np.linspace(0.0, 1.0, 7)
     eq = tip_moment(arm, [0.0, -1.0, 0.0], s=s)

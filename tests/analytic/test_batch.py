@@ -29,6 +29,7 @@ CASES = {
     "shear_force": lambda v: shear_force(ARM, v),
     "linear": lambda v: linear(CURVED, force=v, moment=v[..., ::-1], s=17),
     "elastica": lambda v: elastica(ARM, v * [1.0, 0.0, 1.0]),
+    "elastica inextensible": lambda v: elastica(ARM, v * [1.0, 1.0, 0.0], extensible=False),
     "exact_closed_form": lambda v: exact_closed_form(ARM, [TipLoad(force=v * Z)]),
 }
 

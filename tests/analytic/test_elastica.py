@@ -51,7 +51,7 @@ def test_fundamental_branch():
 
 
 def test_signs():
-    # docs/closed-forms.md sign checks: +z force -> +z deflection, κ_y < 0 (x-z plane, EIy);
+    # Sign checks of docs/closed-forms.md: +z force -> +z deflection, κ_y < 0 (x-z plane, EIy);
     # +y force -> +y deflection, κ_z > 0 (x-y plane, EIz).
     eq = elastica(_arm(), [0.0, 0.0, 0.5])
     assert np.all(eq.positions[1:, 2] > 0) and np.all(eq.strains[:-1, 4] < 0)

@@ -179,9 +179,12 @@ def test_cumulative_chebyshev_quadrature():
     assert nodes[0] == 1.0 and nodes[-1] == 0.0
     s = np.linspace(0.0, 1.0, 13)
     values = np.exp(nodes) + np.cos(7 * nodes) * np.array([[1.0], [2.0]])
-    got = _elastica_math._cumulative_chebyshev(values, s)
     want = np.exp(s) - 1 + np.sin(7 * s) / 7 * np.array([[1.0], [2.0]])
-    np.testing.assert_allclose(got, want, rtol=0, atol=1e-15)
+    # the DCT route, and the kept weights (first call fills them, the second reuses them)
+    for _ in range(2):
+        for rule in (_elastica_math._cumulative_chebyshev_direct,
+                     _elastica_math._cumulative_chebyshev):
+            np.testing.assert_allclose(rule(values, s), want, rtol=0, atol=1e-15)
 
 
 # --------------------------------------------------------------------------------------------
@@ -319,6 +322,35 @@ def test_batched_equals_looped(batch, rng):
             )
             for got, want in zip(sol, one, strict=True):
                 np.testing.assert_allclose(got[index], want, rtol=0, atol=1e-14)
+
+
+# One load is solved by _lone (float arithmetic for the load's unknowns, ellipj's amplitude
+# taken directly where cos χ_0 >= 0.1, product forms for the curvature), a batch by _batch (the
+# Newton-polished amplitude, arctangent forms): two evaluations of the closed form that must
+# agree. The loads cover every branch of both: straight, near tension (a < 1e-8), compression
+# below and above the Euler load, cos χ_0 above and below 0.1, √(k f_L) above 12 (asymptotic
+# starts), e ≠ 0 (Chebyshev quadrature) and tiny loads.
+_ROUTE_LOADS = [
+    (0.0, 1.0, (0.0, 0.0)), (2.0, 0.0, (0.01, 0.0)), (3.0, 3e-9, (0.0, 0.0)),
+    (2.0, np.pi, (0.0, 0.0)), (3.0, -np.pi, (0.0, 0.0)), (1e-9, np.pi / 2, (0.0, 0.0)),
+    (0.1, np.pi / 2, (0.0, 0.0)), (5.0, np.pi / 2, (1e-9, 1e-9)), (10.0, np.pi / 2, (0.0, 0.0)),
+    (20.0, 2.0, (0.0, 0.0)), (400.0, 1.0, (0.0, 0.0)), (1e4, 2.5, (0.0, 0.0)),
+    (8.0, 2.2, (0.06, 0.01)), (0.7, -0.5, (0.01, 0.87)), (86.0, -0.39, (0.0063, 0.001)),
+    (3.0, 7.5, (0.0, 0.05)),
+]
+
+
+@pytest.mark.parametrize(("k", "phi", "ratios"), _ROUTE_LOADS)
+def test_one_load_route_equals_batch_route(k, phi, ratios, rng):
+    s = np.concatenate([[0.0], np.sort(rng.uniform(0.0, 1.0, 40)), [1.0]])
+    lone = planar_elastica(k, phi, s, axial_ratio=ratios[0], shear_ratio=ratios[1])
+    batch = planar_elastica(np.array([k]), phi, s, axial_ratio=ratios[0],
+                            shear_ratio=ratios[1])
+    for name, got, want in zip(lone._fields, lone, batch, strict=True):
+        want = want[0]
+        scale = max(1.0, float(np.max(np.abs(want))))
+        np.testing.assert_allclose(got, want, rtol=0, atol=2e-14 * scale, err_msg=name)
+    assert lone.theta[-1] == lone.tip_angle
 
 
 def test_broadcasting_k_against_phi():

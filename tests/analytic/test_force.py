@@ -71,7 +71,8 @@ def test_shear_force_princeton_timoshenko(P):
 
 
 def test_shear_force_signs():
-    # docs/closed-forms.md sign check (eqs. 50, 58): +z tip force -> +z deflection, negative κ_y.
+    # Sign check of docs/closed-forms.md (eqs. 50 with C6, and 58): +z tip force -> +z
+    # deflection, negative κ_y.
     eq = shear_force(_arm(), [0.0, 0.0, 0.01])
     assert np.all(eq.positions[1:, 2] > 0)
     assert np.all(eq.strains[:-1, 4] < 0)

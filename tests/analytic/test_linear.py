@@ -1,4 +1,4 @@
-"""linear: eq. 27 with F(α) corrected (docs/closed-forms.md), against the other closed forms."""
+"""linear: eq. 27 with F(α) corrected (docs/closed-forms.md, C3), against the other closed forms."""
 
 from __future__ import annotations
 
@@ -27,7 +27,7 @@ def _skew(v):
 
 def test_wrench_is_tip_wrench_transported_along_undeformed_curve(rng):
     # σ(s) = Ad(G(L)⁻¹ G(s))ᵀ σ(L) with G(s) = expm(s f⁰~) the undeformed pose, built here
-    # from scipy.linalg.expm and Ad(H) = [[R, p~R], [0, R]] (docs/closed-forms.md).
+    # from scipy.linalg.expm and Ad(H) = [[R, p~R], [0, R]] (docs/closed-forms.md, C3).
     arm = _arm(curvature=(0.3, -0.8, 0.5))
     f0 = np.array([1.0, 0, 0, 0.3, -0.8, 0.5])
     force, moment = rng.normal(size=3), rng.normal(size=3)
@@ -39,7 +39,7 @@ def test_wrench_is_tip_wrench_transported_along_undeformed_curve(rng):
         Ad = np.block([[R, _skew(p) @ R], [np.zeros((3, 3)), R]])
         np.testing.assert_allclose(eq.stresses[i], Ad.T @ np.concatenate([force, moment]),
                                    atol=1e-13)
-    # straight arm, tip force P e3: m(s) = -(L - s) P e2 (docs/closed-forms.md)
+    # straight arm, tip force P e3: m(s) = -(L - s) P e2 (docs/closed-forms.md, C3)
     eq = linear(_arm(), force=[0.0, 0.0, 2.0], s=s)
     np.testing.assert_allclose(eq.stresses[:, 4], -(1.5 - s) * 2.0, atol=1e-14)
     # dead loads on a curved arm are spatial: the undeformed tip frame turns them

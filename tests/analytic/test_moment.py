@@ -1,4 +1,4 @@
-"""tip_moment: eqs. 30-38 (principal axes), the helix of docs/closed-forms.md, the approximation."""
+"""tip_moment: eqs. 30-38 (principal axes), the helix of C4 (closed-forms.md), the approximation."""
 
 from __future__ import annotations
 
@@ -19,7 +19,7 @@ def _arm(GJ=1.0, EIy=1.0, EIz=1.0, curvature=(0.0, 0.0, 0.0), L=1.0):
 @pytest.mark.parametrize("tau", [1.0, 2.0, 3.0, 4.0, 5.0])
 def test_fig2_circle(tau, EIz):
     # Grazioso et al. 2018, Fig. 2: EIy = 1 N m², L = 1 m, τ = 1..5 N m about +y; positions
-    # eq. 37, rotations eq. 38 as corrected in docs/closed-forms.md, κ_y = τ/EIy (eq. 36).
+    # eq. 37, rotations eq. 38 as corrected in C5 (docs/closed-forms.md), κ_y = τ/EIy (eq. 36).
     s = np.linspace(0.0, 1.0, 41)
     eq = tip_moment(_arm(EIz=EIz), [0.0, tau, 0.0], s=s)
     assert eq.exact
@@ -36,27 +36,27 @@ def test_fig2_circle(tau, EIz):
 
 
 def test_sign_positive_moment_about_y_bends_towards_minus_z():
-    # docs/closed-forms.md sign check (eq. 37): +τ about +y on a straight arm bends towards -z.
+    # Sign check of docs/closed-forms.md (eq. 37): +τ about +y on a straight arm bends towards -z.
     eq = tip_moment(_arm(EIz=3.0), [0.0, 0.1, 0.0])
     assert np.all(eq.positions[1:, 2] < 0)
     assert eq.strains[0, 4] > 0
 
 
 @pytest.mark.parametrize(("follower", "tip"), [
-    (False, [0.8492, 0.1508, -0.4220]),  # docs/closed-forms.md, dead moment
-    (True, [0.8492, 0.2688, -0.3586]),  # docs/closed-forms.md, follower moment
+    (False, [0.8492, 0.1508, -0.4220]),  # C4 (docs/closed-forms.md), dead moment
+    (True, [0.8492, 0.2688, -0.3586]),  # C4, follower moment
 ])
 def test_helix_note4(follower, tip):
-    # docs/closed-forms.md: L = 1, EIy = EIz = 1, GJ = 1/1.3, moment (1, 1, 0).
+    # C4: L = 1, EIy = EIz = 1, GJ = 1/1.3, moment (1, 1, 0).
     eq = tip_moment(_arm(GJ=1 / 1.3), [1.0, 1.0, 0.0], follower=follower)
     assert eq.exact and eq.method == "analytic.tip_moment.helix"
     np.testing.assert_allclose(eq.tip_position, tip, atol=1e-4)
-    # The constant-strain formula gives neither (docs/closed-forms.md: (0.8544, 0.1893, -0.3975)).
+    # The constant-strain formula gives neither (C4: (0.8544, 0.1893, -0.3975)).
     assert np.max(np.abs(eq.tip_position - [0.8544, 0.1893, -0.3975])) > 0.02
 
 
 def test_constant_strain_value_note4():
-    # docs/closed-forms.md: the paper's constant-strain formula gives (0.8544, 0.1893, -0.3975).
+    # C4: the paper's constant-strain formula gives (0.8544, 0.1893, -0.3975).
     # The same arm with EIz nudged off EIy takes the constant-strain route.
     with pytest.warns(ApproximationWarning, match="principal axis"):
         eq = tip_moment(_arm(GJ=1 / 1.3, EIz=1.0 + 1e-9), [1.0, 1.0, 0.0])
@@ -101,7 +101,7 @@ def test_twist_moment_is_principal():
 
 
 def test_curved_arm_warns_unless_parallel():
-    # A moment about z on an arm curved about y is not a constant-strain case (note 2).
+    # A moment about z on an arm curved about y is not a constant-strain case (C2).
     arm = _arm(EIy=1.0, EIz=2.0, curvature=(0.0, 1.0, 0.0))
     with pytest.warns(ApproximationWarning):
         assert not tip_moment(arm, [0.0, 0.0, 0.1]).exact
@@ -142,7 +142,7 @@ def test_bad_inputs():
 
 
 def _slow_helix(arm, moment, follower, s):
-    """docs/closed-forms.md by the generic maps: exp_SE3(s (e1; M/B)) · exp_SE3(s (0; c e1))."""
+    """C4 by the generic maps: exp_SE3(s (e1; M/B)) · exp_SE3(s (0; c e1))."""
     GJ, B = arm.rigidities.GJ, arm.rigidities.EIy
     c = arm.curvature[0] + moment[..., 0] * (1.0 / GJ - 1.0 / B)
     if follower:

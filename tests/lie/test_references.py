@@ -151,7 +151,7 @@ def mp_so3_jac_right_inv(w):
 
 def mp_se3_jac_right(h):
     """T_SE3 = [[T_SO3, T_uω+], [0, T_SO3]] (eq. 72) with T_uω+ of eqs. 74-75 as corrected in
-    docs/closed-forms.md (α = sin θ/θ, β = 2(1 - cos θ)/θ²)."""
+    C1 of docs/closed-forms.md (α = sin θ/θ, β = 2(1 - cos θ)/θ²)."""
     u, w = mp_vector(h[:3]), mp_vector(h[3:])
     U, W = mp_hat(u), mp_hat(w)
     t2 = sum(c**2 for c in w)
@@ -212,7 +212,7 @@ def test_se3_jacobians_at_small_angle_against_mpmath(w):
 
 
 def test_se3_jacobian_mpmath_reference_matches_finite_differences():
-    # The mpmath T_SE3 (docs/closed-forms.md) satisfies the defining property too, at a large angle
+    # The mpmath T_SE3 (C1) satisfies the defining property too, at a large angle
     # where every term of T_uω+ matters: an independent check of the reference formula.
     h = np.array([0.3, -1.2, 0.7, 0.9, -1.1, 1.6])
     with mpmath.workdps(30):

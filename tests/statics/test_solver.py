@@ -112,8 +112,8 @@ def test_axial_force_stretches_by_F_over_EA():
 
 @pytest.mark.parametrize("follower", [False, True])
 def test_helix_under_any_end_moment(follower):
-    # docs/closed-forms.md: equal bending stiffnesses B, straight arm, any end moment: the spatial
-    # moment M is constant, R(s) = exp(s M/B) exp(s c e1), c = M₁(1/GJ - 1/B), centreline =
+    # C4 of docs/closed-forms.md: equal bending stiffnesses B, straight arm, any end moment: the
+    # spatial moment M is constant, R(s) = exp(s M/B) exp(s c e1), c = M₁(1/GJ - 1/B), centreline =
     # translation of exp_SE3(s [e1; M/B]); a follower moment g gives M = exp(L c e1) g.
     # Tips quoted in the note: dead (0.8492, 0.1508, -0.4220), follower (0.8492, 0.2688,
     # -0.3586). The reference is evaluated with scipy.linalg.expm.

@@ -5,31 +5,35 @@ s (N,); :func:`build` broadcasts them to one batch shape, forms the stresses σ 
 given, and returns the :class:`~softarm.Equilibrium` without copying the arrays.
 
 :func:`screw_poses` is the fast kernel of the constant-strain and helix closed forms,
-H(s) = exp_SE3(s (u; ω)) · exp_SE3(s (0; τ e1)) (docs/closed-forms.md, eq. 32 for τ = 0).
+H(s) = exp_SE3(s (u; ω)) · exp_SE3(s (0; τ e1)) (docs/closed-forms.md, C4; eq. 32 for τ = 0).
 """
 
 from __future__ import annotations
 
+import math
 import os
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from .._validate import as_vectors
+from .._validate import as_vectors, stations
 from ..equilibrium import Equilibrium
 from ..model import Arm, SegmentedArm
 
 __all__ = [
     "E1",
+    "ROUNDOFF",
     "THREADS_VARIABLE",
     "build",
     "check_arm",
     "check_follower",
+    "checked_stations",
     "constant_strain_poses",
     "moment_is_principal",
     "negligible",
     "rotational_stiffness",
     "screw_poses",
+    "stiffness_diagonal",
     "thread_count",
     "vectors",
 ]
@@ -38,12 +42,25 @@ E1 = np.array([1.0, 0.0, 0.0])
 
 #: Relative size under which a component is treated as zero (a few units of roundoff): a
 #: closed form that is exact for the zero value is then exact to double precision.
-_ROUNDOFF = 4.0 * np.finfo(np.float64).eps
+ROUNDOFF = 4.0 * np.finfo(np.float64).eps
+
+
+def checked_stations(s, length: float) -> np.ndarray:
+    """``_validate.stations(s, length)``: a fresh array of stations in m.
+
+    An increasing float64 array inside [0, L] (the common case: the solver's own stations) is
+    accepted by a few comparisons and copied; anything else goes through ``stations``, which
+    builds the default grid, clips roundoff at the ends or raises.
+    """
+    if (type(s) is np.ndarray and s.dtype == np.float64 and s.ndim == 1 and s.size >= 1
+            and s[0] >= 0.0 and s[-1] <= length and (s[1:] > s[:-1]).all()):
+        return s.copy()  # NaN and ±inf fail one of the comparisons
+    return stations(s, length)
 
 
 def negligible(x, scale) -> np.ndarray:
     """|x| is at roundoff level relative to ``scale`` (both broadcast), elementwise."""
-    return np.abs(x) <= _ROUNDOFF * np.abs(scale)
+    return np.abs(x) <= ROUNDOFF * np.abs(scale)
 
 
 def check_arm(arm, function: str) -> Arm:
@@ -69,9 +86,16 @@ def vectors(value, name: str, function: str) -> np.ndarray:
     return as_vectors(value, f"{function}: {name}", 3)
 
 
+def stiffness_diagonal(arm: Arm) -> np.ndarray:
+    """diag K = (EA, GAy, GAz, GJ, EIy, EIz), shape (6,) (without forming the 6×6 matrix)."""
+    r = arm.rigidities
+    return np.array([r.EA, r.GAy, r.GAz, r.GJ, r.EIy, r.EIz])
+
+
 def rotational_stiffness(arm: Arm) -> np.ndarray:
     """diag K_ωω = (GJ, EIy, EIz), shape (3,)."""
-    return np.diagonal(arm.stiffness)[3:]
+    r = arm.rigidities
+    return np.array([r.GJ, r.EIy, r.EIz])
 
 
 def moment_is_principal(arm: Arm, moment: np.ndarray) -> np.ndarray:
@@ -79,8 +103,8 @@ def moment_is_principal(arm: Arm, moment: np.ndarray) -> np.ndarray:
 
     True when the moment is an eigenvector of K_ωω (its non-zero components share one
     stiffness) and the initial curvature κ⁰ is parallel to it (or zero): then m' = -κ × m
-    vanishes, σ is constant and H = exp(s (f⁰ + ε)) is exact (docs/closed-forms.md), for a dead or
-    a follower moment alike (the tip turns about the moment axis).
+    vanishes, σ is constant and H = exp(s (f⁰ + ε)) is exact (C2 of docs/closed-forms.md),
+    for a dead or a follower moment alike (the tip turns about the moment axis).
     """
     k = rotational_stiffness(arm)
     size = np.linalg.norm(moment, axis=-1)[..., None]
@@ -115,6 +139,8 @@ _PER_THREAD = 4 * _BLOCK
 THREADS_VARIABLE = "SOFTARM_NUM_THREADS"
 
 _EYE3 = np.eye(3)
+#: Component orders of the cross product: (a × u)_i = a_{i+1} u_{i+2} - a_{i+2} u_{i+1}.
+_NEXT, _LAST = np.array([1, 2, 0]), np.array([2, 0, 1])
 
 
 def thread_count(elements: int) -> int:
@@ -224,10 +250,10 @@ def screw_poses(u, omega, s, twist=None, fields=None):
         Read-only views of one fresh (B..., N, 16 + C) buffer (so ``poses`` is contiguous
         only without ``fields``).
     """
-    batch = np.broadcast_shapes(u.shape[:-1], omega.shape[:-1],
-                                () if twist is None else np.shape(twist),
-                                () if fields is None else fields.shape[:-2])
-    size, n = int(np.prod(batch)), s.shape[0]
+    shapes = (u.shape[:-1], omega.shape[:-1], () if twist is None else np.shape(twist),
+              () if fields is None else fields.shape[:-2])
+    batch = shapes[0] if shapes.count(shapes[0]) == 4 else np.broadcast_shapes(*shapes)
+    size, n = math.prod(batch), s.shape[0]
     u = _broadcast(u, (*batch, 3)).reshape(size, 3)
     omega = _broadcast(omega, (*batch, 3)).reshape(size, 3)
     theta = np.sqrt(np.einsum("bi,bi->b", omega, omega))
@@ -241,11 +267,13 @@ def screw_poses(u, omega, s, twist=None, fields=None):
     position = np.empty((size, 3, 3))
     position[:, 0] = along_a
     position[still, 0] = u[still]
-    position[:, 1] = np.cross(a, u)
+    position[:, 1] = a[:, _NEXT] * u[:, _LAST] - a[:, _LAST] * u[:, _NEXT]  # a × u
     np.subtract(u, along_a, out=position[:, 2])
     position[:, 1:] /= theta_safe[:, None, None]
-    rates = (0.5 * theta)[:, None] if twist is None else \
-        np.stack([0.5 * theta, 0.5 * _broadcast(twist, batch).reshape(size)], axis=-1)
+    rates = np.empty((size, 1 if twist is None else 2))
+    np.multiply(0.5, theta, out=rates[:, 0])
+    if twist is not None:
+        np.multiply(0.5, _broadcast(twist, batch).reshape(size), out=rates[:, 1])
     twisted = twist is not None
     k, r = (10, 2) if twisted else (4, 1)
     columns = 16 + (0 if fields is None else fields.shape[-1])
@@ -323,8 +351,11 @@ def build(arm: Arm, s: np.ndarray, poses, strains, loads, method: str, exact: bo
     s = _owned(s)
     poses = _owned(poses)
     strains = _owned(strains)
-    stresses = _owned(strains * np.diagonal(arm.stiffness) if stresses is None else stresses)
-    batch = np.broadcast_shapes(poses.shape[:-3], strains.shape[:-2], stresses.shape[:-2])
+    if stresses is None:
+        stresses = strains * stiffness_diagonal(arm)  # K ε
+    stresses = _owned(stresses)
+    shapes = (poses.shape[:-3], strains.shape[:-2], stresses.shape[:-2])
+    batch = shapes[0] if shapes[0] == shapes[1] == shapes[2] else np.broadcast_shapes(*shapes)
     poses = _broadcast(poses, (*batch, n, 4, 4))
     strains = _broadcast(strains, (*batch, n, 6))
     stresses = _broadcast(stresses, (*batch, n, 6))

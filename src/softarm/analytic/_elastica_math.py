@@ -72,6 +72,15 @@ asinh tan χ), exact for strongly aligned loads and for small ones. All half-ang
 are written as products of sines so that small loads keep full relative precision (no 1 − cos
 cancellation).
 
+Two routes evaluate this. A batch of loads (``_batch``) runs every step on arrays of shape
+(B..., N). One load (``_lone``, what ``softarm.solve`` meets most) does the tip condition in
+float arithmetic and only the station fields in numpy: a few dozen numpy calls instead of
+several hundred on tiny arrays. It takes ellipj's amplitude without the Newton polish where
+cos χ_0 ≥ 0.1 (sn is then within 4.4e-16 relative and cn within 6e-15 relative, checked against
+mpmath), uses the product form p² − w² = (sin(δ_L/2) cos(δ_L/2) sin χ_s/h)² for the curvature,
+and otherwise falls back on the batch's station solve; the two routes agree to a few units of
+1e-15 of each field's scale (tests/analytic/test_elastica_math.py).
+
 References
 ----------
 R. Frisch-Fay, *Flexible Bars*, Butterworths (1962), ch. 2 (cantilever with an inclined end load).
@@ -88,6 +97,8 @@ B. C. Carlson, "Numerical computation of real or complex elliptic integrals", Nu
 
 from __future__ import annotations
 
+import functools
+import math
 from typing import NamedTuple
 
 import numpy as np
@@ -108,6 +119,10 @@ _N_CHEB = 64
 _N_CHEB_PER_ROOT_K = 4
 #: Newton steps before giving up (bisection alone needs ~60 to resolve ρ ∈ ±700 to an ulp).
 _MAX_STEPS = 100
+#: cos χ_0 from which one load's stations take ellipj's amplitude as it is (``_stations_1``).
+_CN_DIRECT = 0.1
+#: Machine epsilon of float64.
+_EPS = float(np.finfo(np.float64).eps)
 
 
 class ElasticaSolution(NamedTuple):
@@ -409,6 +424,13 @@ def planar_elastica(k, phi, s_over_L, *, axial_ratio=None, shear_ratio=None):
             f"k*axial_ratio = {k * a_r!r}, k*(axial_ratio - shear_ratio) = {e!r}"
         )
 
+    if k.ndim == 0:  # one load: scalar arithmetic for its unknowns, numpy along the stations
+        return _lone(float(k), float(phi), s, float(a_r), float(g_r))
+    return _batch(k, phi, s, a_r, g_r, e)
+
+
+def _batch(k, phi, s, a_r, g_r, e):
+    """:func:`planar_elastica` for validated arrays broadcast to the batch shape B."""
     # Mirror to a = |φ| ∈ [0, π]; trivial cases (k = 0, pure tension) get safe values.
     wrapped = phi - 2.0 * np.pi * np.round(phi / (2.0 * np.pi))
     sign = np.where(wrapped < 0.0, -1.0, 1.0)
@@ -518,7 +540,35 @@ def _chebyshev_points(n):
     return np.sin(0.5 * np.pi * np.arange(n - 1, -1, -1) / (n - 1)) ** 2
 
 
+#: Largest (Chebyshev points × stations) whose quadrature weights are kept (2 MiB each).
+_CACHED_WEIGHTS = 2**18
+
+
 def _cumulative_chebyshev(values, s):
+    """∫_0^s f for f sampled at ``_chebyshev_points(n)`` on the last axis (Clenshaw-Curtis).
+
+    The rule is linear in the samples: ``values @ W`` with the weights W (n, N) of
+    :func:`_chebyshev_weights`, kept for the last few (n, s) (the same stations come back call
+    after call); very large grids run :func:`_cumulative_chebyshev_direct` instead.
+    """
+    n = values.shape[-1]
+    if n * s.size > _CACHED_WEIGHTS:
+        return _cumulative_chebyshev_direct(values, s)
+    return values @ _chebyshev_weights(n, s.tobytes())
+
+
+@functools.lru_cache(maxsize=16)
+def _chebyshev_weights(n, stations):
+    """W with ``_cumulative_chebyshev_direct(values, s) = values @ W``, shape (n, N), read-only.
+
+    Row i is the rule applied to the i-th unit sample; ``stations`` is ``s.tobytes()``.
+    """
+    weights = _cumulative_chebyshev_direct(np.eye(n), np.frombuffer(stations))
+    weights.setflags(write=False)
+    return weights
+
+
+def _cumulative_chebyshev_direct(values, s):
     """∫_0^s f for f sampled at ``_chebyshev_points(n)`` on the last axis (Clenshaw-Curtis).
 
     f ≈ Σ c_j T_j(2s − 1) with c from a DCT-I of the samples; the series is integrated term by
@@ -536,3 +586,205 @@ def _cumulative_chebyshev(values, s):
     angle = 2.0 * np.arctan2(np.sqrt(1.0 - s), np.sqrt(s))
     t_minus_clamp = np.cos(angle[:, None] * j) - np.where(j % 2 == 0, 1.0, -1.0)
     return 0.5 * (b @ t_minus_clamp.T)
+
+
+# --------------------------------------------------------------------------------------------
+# One load: the same algorithm with float arithmetic for the load's unknowns (the tip
+# condition, the half-angles) and numpy only along the stations. A lone case is then a few
+# dozen numpy calls instead of several hundred on 0-d arrays; _batch stays the route for
+# batches (tests/analytic/test_elastica_math.py checks that the two agree).
+# --------------------------------------------------------------------------------------------
+def _divide(numerator, denominator):
+    """numerator/denominator with IEEE semantics (±inf or NaN for a zero denominator)."""
+    try:
+        return numerator / denominator
+    except ZeroDivisionError:
+        if numerator != numerator or numerator == 0.0:
+            return math.nan
+        return math.copysign(math.inf, numerator) * math.copysign(1.0, denominator)
+
+
+def _sin_cos_from_rho_1(rho):
+    """:func:`_sin_cos_from_rho` for a float."""
+    t = math.exp(-abs(rho))
+    big = 1.0 / math.sqrt(1.0 + t * t)
+    small = t * big
+    return (big, small) if rho >= 0.0 else (small, big)
+
+
+def _tip_half_angle_1(ca, sa, c_chi):
+    """:func:`_tip_half_angle` for floats."""
+    h = math.hypot(ca, sa * c_chi)
+    return sa * c_chi / h, ca / h
+
+
+def _newton_1(residual_and_slope, x, lo, hi, curvature=None):
+    """:func:`_newton` for one float unknown: the same steps, safeguard and stopping rules."""
+    tol = 4.0 * _EPS
+    count = 0
+    while count < _MAX_STEPS:
+        count += 1
+        residual, slope = residual_and_slope(x)
+        if residual < 0.0:
+            lo = x
+        else:
+            hi = x
+        step = _divide(residual, slope)
+        newton = x - step
+        size, scale = abs(step), tol * max(1.0, abs(x))
+        last = size <= scale or (curvature is not None and 0.5 * curvature * size * size <= scale)
+        x = newton if last or lo < newton < hi else 0.5 * (lo + hi)
+        if last or hi - lo <= scale:
+            break
+    return x, count
+
+
+def _solve_tip_1(ca, sa, sqrt_k, e):
+    """:func:`_solve_tip` for one load, in floats (the helpers written out)."""
+
+    def residual_and_slope(rho):
+        t = math.exp(-abs(rho))  # _sin_cos_from_rho
+        big = 1.0 / math.sqrt(1.0 + t * t)
+        s_ch, c_ch = (big, t * big) if rho >= 0.0 else (t * big, big)
+        h = math.hypot(ca, sa * c_ch)  # _tip_half_angle
+        s_dl, c_dl = sa * c_ch / h, ca / h
+        m1 = s_dl * s_dl
+        f_l = 1.0 + e * (c_dl - s_dl) * (c_dl + s_dl)  # _modulus
+        mc = m1 * (1.0 - e * m1) / f_l
+        cc = c_ch * c_ch
+        ss = s_ch * s_ch
+        delta2 = cc + mc * ss
+        arc = s_ch * float(elliprf(cc, delta2, 1.0))
+        mm1 = (s_dl * c_dl) * (s_dl * c_dl)
+        dm_f = 2.0 * mm1 * ss / f_l
+        half_j = s_ch * ss * float(elliprd(cc, 1.0, delta2)) / 6.0
+        slope = _divide(s_ch * c_ch, math.sqrt(delta2)) + dm_f * (
+            half_j * (1.0 - 2.0 * e * e * mm1 / f_l) - e * arc
+        )
+        root_f = math.sqrt(f_l)
+        return arc / root_f - sqrt_k, slope / root_f
+
+    start = math.log(math.sinh(sqrt_k * math.sqrt(1.0 - abs(e))))
+    return _newton_1(residual_and_slope, start, -_RHO_MAX, _RHO_MAX)
+
+
+def _lone(k, phi, s, a_r, g_r):
+    """:func:`planar_elastica` for one validated load (floats) on the stations s (N,).
+
+    The same solution as :func:`_batch` (to a few ulps), with two product forms that need no
+    inverse trigonometric function: p² − w² = (sin(δ_L/2) cos(δ_L/2) sin χ_s / h)², h² =
+    sin²(δ_L/2) + cos²(δ_L/2) cos²χ_s (from tan(d/2) = tan(δ_L/2)/cos χ_s, so the curvature is
+    θ' = 2 √k sin(δ_L/2) cos(δ_L/2) (sin χ_s/h) √f), and, for χ_0 < 1,
+    cos χ_s − cos χ_0 = (sin χ_0 − sin χ_s)(sin χ_0 + sin χ_s)/(cos χ_s + cos χ_0).
+    """
+    n = s.shape[0]
+    e = k * (a_r - g_r)
+    ka, kg = k * a_r, k * g_r
+    wrapped = phi - 2.0 * math.pi * round(phi / (2.0 * math.pi))
+    sign = -1.0 if wrapped < 0.0 else 1.0
+    a = abs(wrapped)
+    if k == 0.0 or a == 0.0:  # straight: pure tension N = P (or no load)
+        return ElasticaSolution(np.zeros(n), s * (1.0 + ka), np.zeros(n), np.zeros(n),
+                                np.full(n, ka), np.zeros(n), np.float64(0.0))
+    if a < _A_LINEAR:  # nearly axial tension: the linearised closed form (see _batch)
+        theta, x, z, kappa, sin_d = _tension_linear(s, k, a, e, ka, kg)
+        tip = _tension_linear(1.0, k, a, e, ka, kg)[0]
+        return ElasticaSolution(sign * theta, x, sign * z, sign * kappa, np.full(n, ka),
+                                sign * kg * sin_d, np.float64(sign * tip))
+
+    sqrt_k = math.sqrt(k)
+    ca, sa = math.cos(0.5 * a), math.sin(0.5 * a)
+    rho_tip, _ = _solve_tip_1(ca, sa, sqrt_k, e)
+    s_chi, c_chi = _sin_cos_from_rho_1(rho_tip)
+    s_dl, c_dl = _tip_half_angle_1(ca, sa, c_chi)
+    half_tip = math.atan2(sa * ca * s_chi * s_chi / (1.0 + c_chi), ca * ca + sa * sa * c_chi)
+    tip = 2.0 * half_tip
+    m, m1 = c_dl * c_dl, s_dl * s_dl
+
+    quadrature = e != 0.0
+    if quadrature:
+        n_cheb = _N_CHEB + _N_CHEB_PER_ROOT_K * math.ceil(sqrt_k)
+        s_all = np.concatenate([s, _chebyshev_points(n_cheb)])
+    else:
+        s_all = s
+    s_chs, c_chs = _stations_1(s_all, sqrt_k, rho_tip, s_dl, c_dl, e, s_chi, c_chi)
+    if quadrature:
+        s_dn, c_dn = _station_half_angle(s_dl, c_dl, c_chs[n:])
+        integrand = (c_dn - s_dn) * (c_dn + s_dn) + ka - e * (2.0 * s_dn * c_dn) ** 2
+        xi = _cumulative_chebyshev(integrand, s)
+        s_chs, c_chs = s_chs[:n], c_chs[:n]
+    at_clamp, at_tip = s == 0.0, s == 1.0
+
+    cd = c_dl * c_chs
+    h = np.hypot(s_dl, cd)
+    s_d, c_d = s_dl / h, cd / h  # sin and cos of δ(s)/2
+    kappa = (2.0 * sqrt_k * s_dl * c_dl) * s_chs / h
+    h0 = math.hypot(s_dl, c_dl * c_chi)
+    kappa0 = 2.0 * sqrt_k * s_dl * c_dl * s_chi / h0
+    if quadrature:  # θ' carries √f(w²), f = 1 − e (sin²(δ_L/2) − cos²(d/2))
+        kappa *= np.sqrt(1.0 - e * (m1 - c_d * c_d))
+        kappa0 *= math.sqrt(1.0 - e * (m1 - ca * ca))
+    if math.atan2(s_chi, c_chi) < 1.0:
+        dcos = (s_chi - s_chs) * (s_chi + s_chs) / (c_chs + c_chi)
+    else:
+        dcos = c_chs - c_chi
+    theta = 2.0 * np.arctan2((sa * ca) * dcos, (ca * ca) * c_chs + sa * sa * c_chi)
+    theta[at_tip] = tip  # the same rounding as tip_angle
+    eta = (kappa - kappa0) / k
+    eta[at_clamp] = 0.0
+
+    cos_a, sin_a = math.cos(a), math.sin(a)
+    if not quadrature:
+        cc = c_chi * c_chi
+        j_tip = s_chi * s_chi * s_chi * float(elliprd(cc, 1.0, cc + m1 * s_chi * s_chi)) / 3.0
+        cos_dl = cos_a * math.cos(tip) + sin_a * math.sin(tip)  # cos(a − θ_L)
+        xi = s * (cos_dl + ka) - (2.0 / sqrt_k * m * m1) * (j_tip - _j_integral(s_chs, c_chs, m1))
+    x = xi * cos_a - eta * sin_a
+    z = xi * sin_a + eta * cos_a
+    axial = ka * ((c_d - s_d) * (c_d + s_d)) if ka else np.zeros(n)
+    shear = (sign * kg) * (2.0 * s_d * c_d) if kg else np.zeros(n)
+    if sign < 0.0:
+        theta, z, kappa = -theta, -z, -kappa
+    return ElasticaSolution(theta, x, z, kappa, axial, shear, np.float64(sign * tip))
+
+
+def _stations_1(s, sqrt_k, rho_tip, s_dl, c_dl, e, s_chi, c_chi):
+    """(sin χ_s, cos χ_s) of :func:`_solve_stations` for one load (floats), stations s (N,).
+
+    Jacobi's amplitude am(√(k f_L)(1 − s) | m') from scipy's ``ellipj``: sn to 4.4e-16
+    relative and cn to 6e-16 absolute (checked against mpmath for m' up to 1 − 1e-16 and
+    u ≤ 12). Where every station has cos χ_s ≥ cos χ_0 ≥ ``_CN_DIRECT`` that is within 6e-15
+    relative of the root and is returned as it is. Below, one Newton step in ρ = log tan χ
+    (tan χ ← tan χ e^(−δ)) polishes it; when every step has δ² ≤ 4 ε (the bound
+    :func:`_newton` stops at, with |R''/R'| ≤ 2) that is the batch's answer. Otherwise, and for
+    loads whose stations may need the asymptotic start (√(k f_L) > 12), the batch's
+    :func:`_solve_stations` runs.
+    """
+    f_l, mc = _modulus(s_dl, c_dl, e)
+    u0 = sqrt_k * math.sqrt(f_l)
+    if u0 > 12.0:  # 2 e^(−u) ≥ 1.2e-5 below: the asymptotic start is never used there
+        s_ch, c_ch, _ = _solve_stations(s, sqrt_k, rho_tip, s_dl, c_dl, e)
+        return s_ch, c_ch
+    target = u0 * (1.0 - s)
+    sn, cn, _, _ = ellipj(target, 1.0 - mc)
+    h = np.hypot(sn, cn)
+    sn /= h
+    cn /= h
+    at_clamp, at_tip = s == 0.0, s == 1.0
+    if c_chi < _CN_DIRECT:
+        cc = cn * cn
+        delta2 = cc + mc * sn * sn
+        with np.errstate(divide="ignore", invalid="ignore"):  # 0/0 at the tip (s = 1)
+            step = (sn * elliprf(cc, delta2, 1.0) - target) / (sn * cn / np.sqrt(delta2))
+        if not ((step * step <= 4.0 * _EPS) | at_clamp | at_tip).all():
+            s_ch, c_ch, _ = _solve_stations(s, sqrt_k, rho_tip, s_dl, c_dl, e)
+            return s_ch, c_ch
+        q = np.exp(-0.5 * step)
+        sn *= q
+        cn /= q
+        h = np.hypot(sn, cn)
+        sn /= h
+        cn /= h
+    sn[at_clamp], cn[at_clamp] = s_chi, c_chi
+    sn[at_tip], cn[at_tip] = 0.0, 1.0
+    return sn, cn

@@ -2,15 +2,15 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
-from .._validate import stations
-from ..lie import se3, so3
 from ..loads import TipLoad
-from ._common import E1, build, check_arm, negligible, vectors
-from ._elastica_math import K_MAX, planar_elastica
+from ._common import ROUNDOFF, build, check_arm, checked_stations, negligible, vectors
+from ._elastica_math import K_MAX, _lone, planar_elastica
 
-__all__ = ["elastica", "elastica_plane"]
+__all__ = ["elastica", "elastica_plane", "solve_elastica"]
 
 
 def elastica_plane(arm, force: np.ndarray, function: str = "elastica"):
@@ -64,7 +64,7 @@ def elastica(arm, force, s=None, *, extensible=True):
       constraint forces), so σ ≠ K ε in their linear part.
 
     Not in the paper, which has only the small-deflection version (eqs. 56-59, see
-    :func:`shear_force`); this is the closed form beyond it that docs/closed-forms.md points to.
+    :func:`shear_force`); this is the closed form beyond it (docs/closed-forms.md, C8).
     Mattiasson (1981, Table 1) is reproduced to 1e-7 L for k = P L²/EI from 0.1 to 20.
 
     Parameters
@@ -83,7 +83,7 @@ def elastica(arm, force, s=None, *, extensible=True):
     Equilibrium
         ``method="analytic.elastica"``. With θ the turn of the section from +x towards the
         force side b of the plane, R(s) = exp_SO3(θ(s) e1 × b) and κ = θ' e1 × b: in the x-z
-        plane a +z force gives κ_y = -θ' < 0 (docs/closed-forms.md sign checks).
+        plane a +z force gives κ_y = -θ' < 0 (the signs of docs/closed-forms.md, eqs. 50 and 58).
 
     References
     ----------
@@ -111,47 +111,124 @@ def elastica(arm, force, s=None, *, extensible=True):
     force = vectors(force, "force", function)
     if not isinstance(extensible, (bool, np.bool_)):
         raise TypeError(f"{function}: extensible must be True or False, got {extensible!r}")
+    return solve_elastica(arm, force, checked_stations(s, arm.length), bool(extensible),
+                          (TipLoad(force=force),), function)
+
+
+def _any(condition) -> bool:
+    """``condition.any()`` for an array, the bool itself for a scalar comparison."""
+    return bool(condition.any()) if isinstance(condition, np.ndarray) else bool(condition)
+
+
+def _plane_1(arm, force: np.ndarray, function: str):
+    """:func:`elastica_plane` for one force of shape (3,), in floats (b as a tuple)."""
+    r = arm.rigidities
+    fx, fy, fz = force.tolist()
+    size = math.sqrt(fy * fy + fz * fz)
+    if size > 0.0:
+        by, bz = fy / size, fz / size
+    else:
+        by, bz = (0.0, 1.0) if r.EIy <= r.EIz else (1.0, 0.0)
+    skew = abs(by) > ROUNDOFF and abs(bz) > ROUNDOFF
+    if skew and abs(r.EIy - r.EIz) > ROUNDOFF * max(r.EIy, r.EIz):
+        elastica_plane(arm, force, function)  # raises its ValueError
+    EI = r.EIy * (bz * bz) + r.EIz * (by * by)
+    GA = r.GAz * (bz * bz) + r.GAy * (by * by)
+    return (0.0, by, bz), math.atan2(size, fx), math.sqrt(fx * fx + fy * fy + fz * fz), EI, GA, \
+        skew
+
+
+def solve_elastica(arm, force: np.ndarray, s: np.ndarray, extensible: bool, loads,
+                   function: str = "elastica"):
+    """:func:`elastica` for checked arguments: ``force`` (B..., 3) finite, stations ``s`` (N,)
+    from ``_validate.stations``; the result carries ``loads`` as given (exact_closed_form
+    passes the caller's). A lone force (shape (3,)) takes the scalar route of
+    ``_elastica_math`` (a fraction of the time of the batch route for one case).
+    """
     if any(c != 0.0 for c in arm.curvature):
         raise ValueError(
             f"{function}: arm must be initially straight, curvature (0, 0, 0), got "
             f"{arm.curvature}; use softarm.solve for a curved arm"
         )
-    b, phi, P, EI, GA, skew = elastica_plane(arm, force, function)
+    lone = force.ndim == 1
+    b, phi, P, EI, GA, skew = (_plane_1 if lone else elastica_plane)(arm, force, function)
     r, L = arm.rigidities, arm.length
-    if extensible and np.any(skew) and not negligible(r.GAy - r.GAz, max(r.GAy, r.GAz)):
+    if extensible and _any(skew) and not negligible(r.GAy - r.GAz, max(r.GAy, r.GAz)):
         raise ValueError(
             f"{function}: a force outside the principal planes needs GAy = GAz for a planar "
             f"shearable solution, got GAy={r.GAy!r}, GAz={r.GAz!r} N and force {force!r}; "
             "pass extensible=False for the Euler elastica"
         )
-    k = P * L**2 / EI
-    if np.any(k > K_MAX):
+    k = P * (L * L) / EI
+    if _any(k > K_MAX):
         raise ValueError(
             f"{function}: force must have |F| L²/EI <= {K_MAX:g}, got max "
             f"{float(np.max(k))!r} (|F| up to {float(np.max(P))!r} N)"
         )
-    axial_ratio = EI / (r.EA * L**2) if extensible else 0.0
-    shear_ratio = EI / (GA * L**2) if extensible else 0.0
-    if extensible and (np.any(P >= r.EA) or np.any(np.abs(P / r.EA - P / GA) >= 1.0)):
+    axial_ratio = EI / (r.EA * (L * L)) if extensible else 0.0
+    shear_ratio = EI / (GA * (L * L)) if extensible else 0.0
+    if extensible and (_any(P >= r.EA) or _any(abs(P / r.EA - P / GA) >= 1.0)):
         raise ValueError(
             f"{function}: force must satisfy |F| < EA and ||F|/EA - |F|/GA| < 1 for the "
             f"extensible elastica, got |F| up to {float(np.max(P))!r} N with EA={r.EA!r} N; "
             "pass extensible=False or use softarm.solve"
         )
-    s = stations(s, L)
-    sol = planar_elastica(k, phi, s / L, axial_ratio=axial_ratio, shear_ratio=shear_ratio)
-    axis = np.cross(E1, b)[..., None, :]                                   # (B..., 1, 3)
-    R = so3.exp(sol.theta[..., None] * axis)
-    p = L * (sol.x[..., None] * E1 + sol.z[..., None] * b[..., None, :])
-    kappa = (sol.curvature / L)[..., None] * axis
-    if extensible:
-        gamma = sol.axial_strain[..., None] * E1 + sol.shear_strain[..., None] * b[..., None, :]
-        stresses = None
-    else:
-        gamma = np.zeros_like(kappa)
-        n = np.einsum("...ji,...j->...i", R, force[..., None, :])
-        stresses = np.concatenate([n, kappa * np.diagonal(arm.stiffness)[3:]], axis=-1)
-    strains = np.concatenate([gamma, kappa], axis=-1)
-    poses = se3.from_rotation_translation(R, p)
-    return build(arm, s, poses, strains, (TipLoad(force=force),), "analytic.elastica",
-                 bool(extensible), stresses=stresses)
+    if lone and k * (1.0 + abs(k * (axial_ratio - shear_ratio))) <= K_MAX:
+        sol = _lone(k, phi, s / L, axial_ratio, shear_ratio)
+    else:  # a batch, or a load planar_elastica refuses (with its message)
+        sol = planar_elastica(k, phi, s / L, axial_ratio=axial_ratio, shear_ratio=shear_ratio)
+    by, bz = (b[1], b[2]) if lone else (b[..., 1], b[..., 2])
+    fields = _fields(sol, by, bz, L, r)
+    fields.setflags(write=False)  # fresh: poses, strains and stresses are views of it
+    poses = fields[..., :16].reshape(*fields.shape[:-1], 4, 4)
+    strains, stresses = fields[..., 16:22], fields[..., 22:]
+    if not extensible:  # γ = 0, and n = Rᵀ F, the constraint force
+        strains = np.concatenate([np.zeros_like(strains[..., :3]), strains[..., 3:]], axis=-1)
+        n = np.einsum("...ji,...j->...i", poses[..., :3, :3], force[..., None, :])
+        stresses = np.concatenate([n, strains[..., 3:] * np.diagonal(arm.stiffness)[3:]],
+                                  axis=-1)
+    return build(arm, s, poses, strains, loads, "analytic.elastica", extensible,
+                 stresses=stresses)
+
+
+#: Row and column of every entry of C (see :func:`_fields`) that depends on the plane, L or
+#: the stiffnesses.
+_ENTRIES = ((1, 1), (1, 2), (1, 4), (1, 8), (2, 5), (2, 10), (2, 6), (2, 9), (3, 3), (4, 7),
+            (4, 11), (6, 17), (6, 18), (7, 20), (7, 21), (5, 22), (6, 23), (6, 24), (7, 26),
+            (7, 27))
+_ROWS, _COLUMNS = (np.array(index) for index in zip(*_ENTRIES, strict=True))
+#: C without those entries: I and the pose's 1 (row 0), -1 of a aᵀ - I (row 2), e1 (row 5).
+_CONSTANT = np.zeros((8, 28))
+_CONSTANT[0, [0, 5, 10, 15]] = 1.0
+_CONSTANT[2, 0] = -1.0
+_CONSTANT[5, 16] = 1.0
+
+
+def _fields(sol, by, bz, L, r):
+    """Poses (flattened, 16 columns), strains (6) and stresses (6) of the planar solution.
+
+    The section turns by θ about the unit axis a = e1 × b = (0, -b_z, b_y) (b = (0, b_y, b_z)
+    the in-plane normal on the force side), so R = I + sin θ a~ + 2 sin²(θ/2) (a aᵀ - I)
+    (Rodrigues, eqs. 70-71), p = L (x e1 + z b), γ = N/EA e1 + Q/GA b, κ = (θ'/L) a and
+    σ = K ε (``r`` the arm's rigidities). Every entry is linear in c = (1, sin θ,
+    2 sin²(θ/2), x, z, N/EA, Q/GA, θ'): one matrix product c @ C per arm, C of shape
+    (B..., 8, 28), as in ``_common.screw_poses``; the result has shape (B..., N, 28).
+    ``by``, ``bz`` are floats for one load, arrays (B...) for a batch.
+    """
+    half = np.sin(0.5 * sol.theta)
+    columns = [np.ones(half.shape), np.sin(sol.theta), 2.0 * half * half, sol.x, sol.z,
+               sol.axial_strain, sol.shear_strain, sol.curvature]
+    # a~ = [[0, -b_y, -b_z], [b_y, 0, 0], [b_z, 0, 0]] and a aᵀ - I = [[-1, 0, 0],
+    # [0, -b_y², -b_y b_z], [0, -b_y b_z, -b_z²]] (|b| = 1), at flat indices 4 i + j
+    entries = (-by, -bz, by, bz, -(by * by), -(bz * bz), -(by * bz), -(by * bz), L, L * by,
+               L * bz, by, bz, -bz / L, by / L, r.EA, r.GAy * by, r.GAz * bz,
+               -bz / L * r.EIy, by / L * r.EIz)
+    if isinstance(by, float):  # one load: a (N, 8) by (8, 28) product
+        C = _CONSTANT.copy()
+        C[_ROWS, _COLUMNS] = entries
+        return np.array(columns).T @ C
+    C = np.zeros((*np.shape(by), 8, 28))
+    C[...] = _CONSTANT
+    for (row, column), value in zip(_ENTRIES, entries, strict=True):
+        C[..., row, column] = value
+    return np.stack(columns, axis=-1) @ C

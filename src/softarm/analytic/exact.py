@@ -6,13 +6,12 @@ import dataclasses
 
 import numpy as np
 
-from .._validate import stations
 from ..loads import TipLoad, as_loads, batch_shape
 from ..model import SegmentedArm
-from ._common import check_arm, moment_is_principal
-from .elastica import elastica
+from ._common import check_arm, checked_stations, moment_is_principal
+from .elastica import solve_elastica
 from .force import axial_force
-from .moment import helix_applies, tip_moment
+from .moment import helix_applies, solve_tip_moment
 
 __all__ = ["exact_closed_form"]
 
@@ -74,34 +73,37 @@ def exact_closed_form(arm, loads, s=None):
         return None
     arm = check_arm(arm, "exact_closed_form")
     loads = as_loads(loads)
-    s = stations(s, arm.length)
+    s = checked_stations(s, arm.length)
     if not loads or not all(isinstance(load, TipLoad) for load in loads):
         return None
     if len({bool(load.follower) for load in loads}) != 1:
         return None
     follower = bool(loads[0].follower)
-    force, moment = _tip_wrench(loads, batch_shape(loads))
-    result = _dispatch(arm, force, moment, follower, s)
+    if len(loads) == 1 and loads[0].force.shape == loads[0].moment.shape == (3,):
+        force, moment = loads[0].force, loads[0].moment  # one unbatched load: no summing
+    else:
+        force, moment = _tip_wrench(loads, batch_shape(loads))
+    result = _dispatch(arm, force, moment, follower, s, loads)
     if result is None or not result.exact:
         return None
-    return dataclasses.replace(result, loads=loads)
+    return result if result.loads is loads else dataclasses.replace(result, loads=loads)
 
 
-def _dispatch(arm, force, moment, follower, s):
+def _dispatch(arm, force, moment, follower, s, loads):
     straight_axis = arm.curvature[1] == 0.0 and arm.curvature[2] == 0.0
-    if np.all(force == 0.0):
+    if not force.any():
         if helix_applies(arm) or np.all(moment_is_principal(arm, moment)):
-            return tip_moment(arm, moment, follower, s)
+            return solve_tip_moment(arm, moment, s, follower, loads)
         return None
-    if not np.all(moment == 0.0):
+    if moment.any():
         return None
-    if straight_axis and np.all(force[..., 1:] == 0.0):
+    if straight_axis and not force[..., 1:].any():
         if np.all(force[..., 0] > -arm.rigidities.EA):
             return axial_force(arm, force, s)
         return None
     if follower or any(c != 0.0 for c in arm.curvature):
         return None
     try:
-        return elastica(arm, force, s)
+        return solve_elastica(arm, force, s, True, loads, "elastica")
     except ValueError:  # outside its domain: not a principal plane, or too large a load
         return None

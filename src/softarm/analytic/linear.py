@@ -7,7 +7,14 @@ import numpy as np
 from .._validate import stations
 from ..lie import se3, so3
 from ..loads import TipLoad
-from ._common import build, check_arm, check_follower, moment_is_principal, vectors
+from ._common import (
+    build,
+    check_arm,
+    check_follower,
+    moment_is_principal,
+    stiffness_diagonal,
+    vectors,
+)
 
 __all__ = ["linear", "transported_wrench"]
 
@@ -16,7 +23,7 @@ def transported_wrench(arm, wrench_tip: np.ndarray, s: np.ndarray) -> np.ndarray
     """σ(s) = Ad(exp((s - L) f⁰))ᵀ σ(L): the tip wrench carried along the undeformed curve.
 
     This solves σ' = hat(f⁰)ᵀ σ (eq. 22 with the transpose restored) with σ(L) given; it is
-    eq. 27's F(s) F(L)⁻¹ g with the corrected lower-left block of F (docs/closed-forms.md).
+    eq. 27's F(s) F(L)⁻¹ g with the corrected lower-left block of F (docs/closed-forms.md, C3).
     ``wrench_tip`` (B..., 6) in the undeformed tip's material frame, s (N,) → (B..., N, 6).
     """
     f0 = arm.reference_strain
@@ -50,7 +57,7 @@ def linear(arm, force=(0.0, 0.0, 0.0), moment=(0.0, 0.0, 0.0), s=None, *, follow
     σ' = hat(f⁰)ᵀ σ (eq. 22 with the transpose the printed equation lacks), whose solution
     carries the tip wrench along the *undeformed* reference curve,
     σ(s) = Ad(exp((s - L) f⁰))ᵀ σ(L) (eq. 27 with F(α) corrected: the lower-left block of
-    eq. 24 is -(T_SO3(α f⁰_ω) α f⁰_u)~ Lᵀ, docs/closed-forms.md). The strain is ε(s) = K⁻¹ σ(s);
+    eq. 24 is -(T_SO3(α f⁰_ω) α f⁰_u)~ Lᵀ, C3). The strain is ε(s) = K⁻¹ σ(s);
     the pose integrates H' = H (f⁰ + ε)~ exactly for the strain held at its midpoint value
     between consecutive stations (one SE(3) exponential per interval), an error O(h²) in the
     station spacing h on top of the model error O(load²).
@@ -109,7 +116,7 @@ def linear(arm, force=(0.0, 0.0, 0.0), moment=(0.0, 0.0, 0.0), s=None, *, follow
         Rt = so3.exp(arm.length * np.asarray(arm.curvature)).T
         force, moment = force @ Rt.T, moment @ Rt.T
     wrench = np.concatenate([force, moment], axis=-1)
-    k = np.diagonal(arm.stiffness)
+    k = stiffness_diagonal(arm)
     strains = transported_wrench(arm, wrench, s) / k
     poses = _integrate(lambda t: arm.reference_strain + transported_wrench(arm, wrench, t) / k, s,
                        arm.length)

@@ -6,7 +6,6 @@ import warnings
 
 import numpy as np
 
-from .._validate import stations
 from ..errors import ApproximationWarning
 from ..loads import TipLoad
 from ._common import (
@@ -14,20 +13,23 @@ from ._common import (
     build,
     check_arm,
     check_follower,
+    checked_stations,
     moment_is_principal,
     negligible,
     rotational_stiffness,
     screw_poses,
+    stiffness_diagonal,
     vectors,
 )
 
-__all__ = ["helix_applies", "tip_moment"]
+__all__ = ["helix_applies", "solve_tip_moment", "tip_moment"]
 
 
 def helix_applies(arm) -> bool:
     """Equal bending stiffnesses and an initially straight (possibly twisted) axis.
 
-    Then the helix solution of docs/closed-forms.md is exact for every end moment, dead or follower.
+    Then the helix solution (docs/closed-forms.md, C4) is exact for every end moment, dead or
+    follower.
     """
     _, EIy, EIz = rotational_stiffness(arm)
     _, ky, kz = arm.curvature
@@ -35,7 +37,7 @@ def helix_applies(arm) -> bool:
 
 
 def _helix(arm, moment, follower, s):
-    """Poses, strains and stresses of the exact pure-moment solution for EIy = EIz = B (note 4).
+    """Poses, strains and stresses of the exact pure-moment solution for EIy = EIz = B (C4).
 
     With n = 0 the spatial moment M is constant. The material moment m = Rᵀ M gives the
     curvature κ⁰ + K⁻¹ m = m/B + c e1 with c = κ⁰₁ + M₁ (1/GJ - 1/B) constant (m₁' = 0), so
@@ -43,7 +45,7 @@ def _helix(arm, moment, follower, s):
     H(s) = exp_SE3(s (e1; M/B)) · exp_SE3(s (0; c e1)). Since exp(s M/B) fixes M,
     m(s) = exp(-s c e1) M = M + (1 - cos cs) (0, -M₂, -M₃) + sin(cs) (0, M₃, -M₂).
     """
-    k = np.diagonal(arm.stiffness)
+    k = stiffness_diagonal(arm)
     GJ, B = k[3], k[4]
     c = arm.curvature[0] + moment[..., 0] * (1.0 / GJ - 1.0 / B)
     if follower:  # the tip material components g = R(L)ᵀ M = exp(-L c e1) M are given
@@ -64,7 +66,7 @@ def _helix(arm, moment, follower, s):
 
 def _constant_strain(arm, moment, s):
     """Eqs. 30-34: ε = K⁻¹ (0; moment), constant, and H(s) = exp_SE3(s (f⁰ + ε))."""
-    k = np.diagonal(arm.stiffness)
+    k = stiffness_diagonal(arm)
     kappa = moment / k[3:]
     poses, _ = screw_poses(E1, np.asarray(arm.curvature) + kappa, s)
     strain = np.zeros((*moment.shape[:-1], 1, 6))
@@ -76,7 +78,7 @@ def _constant_strain(arm, moment, s):
     return poses, np.broadcast_to(strain, shape), np.broadcast_to(stress, shape)
 
 
-def tip_moment(arm, moment, follower=False, s=None):
+def tip_moment(arm, moment, s=None, *, follower=False):
     """Equilibrium of an arm under a pure end moment (Grazioso et al. 2018, eqs. 30-34).
 
     Model: a uniform Cosserat rod clamped at the base with f⁰ = (1, 0, 0, κ⁰), loaded at the
@@ -90,13 +92,13 @@ def tip_moment(arm, moment, follower=False, s=None):
       eqs. 37-38 of radius EIy/τ, bent towards -z.
     * **Equal bending stiffnesses** EIy = EIz = B (circle, tube, square) and an initially
       straight, possibly twisted arm (κ⁰ = (κ⁰₁, 0, 0)): exact for *any* moment direction,
-      dead or follower, by the helix of docs/closed-forms.md (not in the paper):
+      dead or follower, by the helix of correction C4 (not in the paper):
       H(s) = exp_SE3(s (e1; M/B)) · exp_SE3(s (0; c e1)), c = κ⁰₁ + M₁ (1/GJ - 1/B), with M
       the spatial moment: M = moment (dead) or M = exp(L c e1) · moment (follower).
     * **Elsewhere** the paper's constant-strain formula (eqs. 30-34 with the moment taken as
       the tip's material components) is returned with ``exact=False`` and an
       :class:`~softarm.ApproximationWarning`: eq. 22 drops the term -κ × K_ωω κ, which does
-      not vanish there (docs/closed-forms.md), so the result is not an equilibrium.
+      not vanish there (C2 in docs/closed-forms.md), so the result is not an equilibrium.
 
     Parameters
     ----------
@@ -105,11 +107,11 @@ def tip_moment(arm, moment, follower=False, s=None):
     moment : array_like, shape (..., 3)
         Tip moment in N m: spatial components for a dead moment, tip material components for a
         follower moment. Leading axes are a batch of load cases.
-    follower : bool
-        False: dead moment (fixed in space); True: follower moment (fixed in the tip frame).
     s : array_like, shape (N,), or int, optional
         Stations in m, strictly increasing in [0, L]; an int N gives N uniform stations;
         default 101 uniform stations.
+    follower : bool, keyword-only
+        False: dead moment (fixed in space); True: follower moment (fixed in the tip frame).
 
     Returns
     -------
@@ -141,7 +143,7 @@ def tip_moment(arm, moment, follower=False, s=None):
     >>> eq.exact, bool(np.allclose(eq.tip_position, [np.sin(1.0), 0.0, np.cos(1.0) - 1.0]))
     (True, True)
 
-    The helix of docs/closed-forms.md (equal bending stiffnesses, a moment off the principal axes):
+    The helix of C4 (equal bending stiffnesses, a moment off the principal axes):
 
     >>> arm = Arm.from_stiffness(1.0, EA=1e6, GAy=1e6, GAz=1e6, GJ=1 / 1.3, EIy=1.0, EIz=1.0)
     >>> np.round(tip_moment(arm, [1.0, 1.0, 0.0]).tip_position, 4)
@@ -153,8 +155,13 @@ def tip_moment(arm, moment, follower=False, s=None):
     arm = check_arm(arm, function)
     moment = vectors(moment, "moment", function)
     follower = check_follower(follower, function)
-    s = stations(s, arm.length)
-    loads = (TipLoad(moment=moment, follower=follower),)
+    return solve_tip_moment(arm, moment, checked_stations(s, arm.length), follower,
+                            (TipLoad(moment=moment, follower=follower),))
+
+
+def solve_tip_moment(arm, moment, s, follower, loads):
+    """:func:`tip_moment` for checked arguments; the result carries ``loads`` as given
+    (exact_closed_form passes the caller's)."""
     if helix_applies(arm):
         poses, strains, stresses = _helix(arm, moment, follower, s)
         return build(arm, s, poses, strains, loads, "analytic.tip_moment.helix", True,
@@ -169,7 +176,7 @@ def tip_moment(arm, moment, follower=False, s=None):
             "the constant-strain formula (eqs. 30-34) is only an approximation, not an "
             "equilibrium; use softarm.solve for the exact one",
             ApproximationWarning,
-            stacklevel=2,
+            stacklevel=3,  # the caller of tip_moment
         )
         method = "analytic.tip_moment.constant_strain"
     else:

@@ -22,7 +22,8 @@ tuw4       (cosc - 3 sinc3) / θ²                   (-1)^(k+1) (2k+2) / (2k+5)!
 
 With the paper's α = sinθ/θ and β = 2(1 - cosθ)/θ² (Grazioso et al. 2018, eq. 71):
 α = ``sinc``, β/2 = ``cosc``, (1 - α)/θ² = ``sinc3``, (β - α)/θ² = ``tuw3`` and
-(β/2 - 3(1 - α)/θ²)/θ² = ``tuw4`` (the coefficients of T_uω+, eqs. 74-75, docs/closed-forms.md).
+(β/2 - 3(1 - α)/θ²)/θ² = ``tuw4`` (the coefficients of T_uω+, eqs. 74-75, corrected in C1 of
+docs/closed-forms.md).
 ``jinv`` is the ω~² coefficient of the inverse SO(3) Jacobian; it is singular at θ = 2π, where
 the exponential map itself is singular.
 """

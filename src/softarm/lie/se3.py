@@ -6,7 +6,7 @@ are (..., 6) vectors with the linear part first, as in Grazioso, Di Gironimo & S
 
 Jacobian convention: ``jac_right(h)`` is the paper's tangent operator T_SE3 (eqs. 72-75), the
 right Jacobian: exp(h)⁻¹ ∂/∂ε exp(h + εδ)|₀ = (T(h) δ)~. The printed T_uω+ (eqs. 74-75) is
-garbled by the text conversion; the form used here is the corrected one of docs/closed-forms.md,
+garbled by the text conversion; the form used here is the corrected one (docs/closed-forms.md, C1),
 checked by finite differences in the tests.
 """
 
@@ -181,7 +181,7 @@ def ad(h):
 
 
 def _t_uw(h: np.ndarray) -> np.ndarray:
-    """Upper-right block T_uω+ of the SE(3) right Jacobian (eqs. 74-75, docs/closed-forms.md)."""
+    """Upper-right block T_uω+ of the SE(3) right Jacobian (eqs. 74-75, C1 of closed-forms.md)."""
     u, w = h[..., :3], h[..., 3:]
     U = so3._hat(u)
     W, W2, t2 = so3._with_hats(w)

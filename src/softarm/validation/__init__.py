@@ -28,18 +28,18 @@ import sys
 from pathlib import Path
 
 from ._checks import TABLES, CaseResult, Check, DataTables, find_data_dir, reference_table
-from .cases import CASES, Case
+from .cases import CASES, ValidationCase
 from .report import COMMAND, Report, markdown, run, write_outputs
 
 __all__ = [
     "CASES",
     "COMMAND",
     "TABLES",
-    "Case",
     "CaseResult",
     "Check",
     "DataTables",
     "Report",
+    "ValidationCase",
     "add_parser",
     "find_data_dir",
     "main",

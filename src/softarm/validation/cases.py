@@ -31,7 +31,7 @@ from ._routes import (
     value,
 )
 
-__all__ = ["CASES", "Case"]
+__all__ = ["CASES", "ValidationCase"]
 
 PAPER = "Grazioso et al. 2018"
 #: Gate for a closed form against the formula it implements or a table of 8 significant
@@ -49,7 +49,7 @@ _RODS = "rod_benchmarks.json"
 
 
 @dataclass(frozen=True)
-class Case:
+class ValidationCase:
     """A validation case: identifier, title, what it checks and the function that runs it."""
 
     name: str
@@ -250,7 +250,7 @@ def fig3_shear_load(tables: DataTables) -> CaseResult:
             item = f"{key}: P = {P:g} N (k = {P * L**2 / EI:.3g})"
             force = (0.0, 0.0, P)
             z_eq58, _ = ref.small_displacement_shear(s, P, L, EI, GA)
-            kappa_eq50 = P * L / EI * (s / L - 1.0)  # eq. 50, sign corrected (docs/closed-forms.md)
+            kappa_eq50 = P * L / EI * (s / L - 1.0)  # eq. 50, sign corrected (C6)
             small, note_small = attempt(closed_form, "shear_force", arm, force, s=s)
             exact, note_exact = attempt(numeric, arm, TipLoad(force=force), s)
             balance = "global equilibrium: the base reaction balances the tip force"
@@ -261,7 +261,7 @@ def fig3_shear_load(tables: DataTables) -> CaseResult:
                      f"{PAPER}, eq. 58", note=note_small),
                 gate(case, item, "analytic.shear_force", "max_s |κ_y(s) - eq. 50| · L", 0.0,
                      value(small, _max_abs, _kappa_y, kappa_eq50, L), TOL_CLOSED,
-                     f"{PAPER}, eq. 50 (sign corrected, docs/closed-forms.md)", note=note_small),
+                     f"{PAPER}, eq. 50 (sign corrected, C6)", note=note_small),
                 gate(case, item, "analytic.shear_force", "γ_z", P / GA,
                      value(small, _gamma_z_tip), TOL_CLOSED * P / GA, f"{PAPER}, eq. 49",
                      note=note_small),
@@ -304,7 +304,7 @@ def _table1_markdown(rows) -> str:
         "**Table I analogue.** Relative error of the small-displacement z-displacement "
         "(eq. 58) against the exact solution at the same arc-length station s = r, in %: "
         "e = 100 |z_small - z_exact| / |z_exact|. (The paper's eq. 60 divides a difference of "
-        "lengths by r/L, which is not a relative error: docs/closed-forms.md.) The paper's own "
+        "lengths by r/L, which is not a relative error: C7.) The paper's own "
         "Table I compares eq. 58 with the *measured* Dowell-Traybar deflections, which are "
         "neither printed in the paper nor available here (princeton_beam.json: "
         "`experimental_data.status` = NOT FOUND), so Table I itself cannot be recomputed.",
@@ -618,9 +618,9 @@ def _tip_distance(eq, point, scale):
 
 
 # ------------------------------------------------------------------------------------------
-# End moment off the principal axes: helices (docs/closed-forms.md)
+# End moment off the principal axes: helices (C4)
 # ------------------------------------------------------------------------------------------
-#: Exact tips of docs/closed-forms.md, to 4 decimals: dead and follower moment (1, 1, 0) N m.
+#: Exact tips of C4 (docs/closed-forms.md), to 4 decimals: dead and follower moment (1, 1, 0) N m.
 _NOTE4 = {False: (0.8492, 0.1508, -0.4220), True: (0.8492, 0.2688, -0.3586)}
 
 
@@ -629,8 +629,8 @@ def helix(tables: DataTables) -> CaseResult:
     arm = _stiff_arm(L, B, GJ=GJ)
     moment = (1.0, 1.0, 0.0)
     result = CaseResult()
-    note4 = "docs/closed-forms.md (exact tips, 4 decimals)"
-    formula = "docs/closed-forms.md closed form (helix about M), evaluated with scipy.linalg.expm"
+    note4 = "C4 of docs/closed-forms.md (exact tips, 4 decimals)"
+    formula = "C4 closed form (helix about M), evaluated with scipy.linalg.expm"
     axes = ("tip x [m]", "tip y [m]", "tip z [m]")
     for follower in (False, True):
         item = f"{'follower' if follower else 'dead'} moment (1, 1, 0) N m"
@@ -639,7 +639,7 @@ def helix(tables: DataTables) -> CaseResult:
         for method, (eq, note), tol in (
             (NUMERIC, attempt(numeric, arm, load), TOL_NUMERIC),
             ("analytic.tip_moment",
-             attempt(closed_form, "tip_moment", arm, moment, follower), TOL_CLOSED),
+             attempt(closed_form, "tip_moment", arm, moment, follower=follower), TOL_CLOSED),
             ("analytic.exact_closed_form",
              attempt(closed_form, "exact_closed_form", arm, [load]), TOL_CLOSED),
         ):
@@ -654,12 +654,12 @@ def helix(tables: DataTables) -> CaseResult:
                         note="tolerance: 4-decimal rounding + 1e-6"))
     # Unequal bending stiffnesses (EI_z = 2 EI_y): no helix; softarm's tip_moment falls back to
     # the paper's constant-strain formula (eqs. 30-34), which is not an equilibrium off a
-    # principal axis (docs/closed-forms.md). Reported against the exact solver: a finding.
+    # principal axis (C2 and C4). Reported against the exact solver: a finding.
     arm2 = _stiff_arm(L, B, GJ=GJ, EIz=2.0 * B)
     for follower in (False, True):
         item = f"EI_z = 2 EI_y, {'follower' if follower else 'dead'} moment (1, 1, 0) N m"
         exact, note_exact = attempt(numeric, arm2, TipLoad(moment=moment, follower=follower))
-        approx, note_approx = attempt(closed_form, "tip_moment", arm2, moment, follower)
+        approx, note_approx = attempt(closed_form, "tip_moment", arm2, moment, follower=follower)
         for axis, name in enumerate(axes):
             result.checks.append(finding(
                 case, item, "analytic.tip_moment (constant strain, eqs. 30-34)", name,
@@ -668,52 +668,61 @@ def helix(tables: DataTables) -> CaseResult:
     return result
 
 
-CASES: tuple[Case, ...] = (
-    Case("fig2_pure_bending", "Paper Fig. 2: pure bending",
-         "Tip moments τ = 1..5 N m about +y on an arm with EI = 1 N m², L = 1 m. The exact shape "
-         "is a circle of radius EI/τ (eq. 37). Both softarm routes are compared with the "
-         "formula along the whole arm.", fig2_pure_bending),
-    Case("axial_force", "Paper Sec. IV-B: axial tip force",
-         "A tip force along the axis stretches (or compresses) the arm uniformly: γ = F/EA.",
-         axial_force),
-    Case("fig3_shear_load", "Paper Fig. 3 and a Table I analogue: shear tip force",
-         "The paper's small-displacement solution (eqs. 49-59, `analytic.shear_force`) is "
-         "checked against its own equations (gated), and then compared with the exact "
-         "solution (`solve(method='numeric')`) as a *finding*: the paper's printed Princeton "
-         "parameters (EI_y = 36.28 N m², GA_z = 0.9039e6 N, L = 0.508 m) are the beam's stiff "
-         "chordwise pair, where the approximation is good; the same loads on the beam's real "
-         "flapwise stiffness (EI = 2.42873 N m², the 0° load of the experiment) "
-         "reach k = PL²/EI = 1.9 and the approximation fails. The paper does not print EA, "
-         "GA_y, GJ or EI_z: for the printed pair they are set to EA = GA_y = GA_z and "
-         "GJ = EI_z = EI_y, which do not enter this planar problem. The flapwise pair is the "
-         "MBDyn set of princeton_beam.json (EI_Z = 2.42873 N m² with GA_Y = 6.40131e5 N, per "
-         "its pairing note), mapped to softarm's (EI_y, GA_z) because the load is along +z. "
-         "Both solutions are compared at the same arc-length station s = r.",
-         fig3_shear_load),
-    Case("mattiasson_cantilever", "Mattiasson cantilever: dead tip force, large deflection",
-         "Euler elastica under a dead tip force P along +z, k = PL²/EI = 0.1..20. The "
-         "reference is inextensible and unshearable; softarm uses EA = GA = 1e9 EI/L², whose "
-         "strains change the tip by < 2e-8 L.", mattiasson_cantilever),
-    Case("rollup", "Roll-up into a circle: end moment",
-         "An end moment M = λ 2π EI/L about +z bends the arm into a circular arc of curvature "
-         "M/EI; λ = 1 closes the circle, the tip returning to the root.", rollup),
-    Case("follower_tip_force", "Follower tip force (planar)",
-         "A tip force that stays perpendicular to the deformed tip (material e2), magnitude "
-         "k EI/L², k = 0.5..10, fundamental branch; inextensible reference, softarm with "
-         "EA = GA = 1e9 EI/L².", follower_tip_force),
-    Case("shear_deformable_tip_force", "Shear-deformable cantilever: dead tip force",
-         "L = 1 m, EI = 10 N m², EA = 1e8 N, tip force 10 N along +z (k = 1) with GA = 500 N "
-         "and GA = 10 N (strong shear), and the unshearable limit.",
-         shear_deformable_tip_force),
-    Case("pure_torsion", "Pure torsion",
-         "A tip torque T about the axis twists the arm by φ = TL/GJ and leaves it straight.",
-         pure_torsion),
-    Case("helix_end_moment", "End moment off the principal axes: helices (docs/closed-forms.md)",
-         "L = 1 m, EI_y = EI_z = 1 N m², GJ = 1/1.3 N m², tip moment with components "
-         "(1, 1, 0) N m, dead and follower. The exact shape is a helix about the (constant) "
-         "spatial moment, which `analytic.tip_moment` uses for equal bending stiffnesses. "
-         "With EI_z = 2 EI_y there is no helix and `analytic.tip_moment` falls back to the "
-         "paper's constant-strain formula (eqs. 30-34, with an ApproximationWarning), exact "
-         "only for a moment about a principal axis (docs/closed-forms.md): its tip against "
-         "the exact solver is reported as a finding.", helix),
+CASES: tuple[ValidationCase, ...] = (
+    ValidationCase(
+        "fig2_pure_bending", "Paper Fig. 2: pure bending",
+        "Tip moments τ = 1..5 N m about +y on an arm with EI = 1 N m², L = 1 m. The exact shape "
+        "is a circle of radius EI/τ (eq. 37). Both softarm routes are compared with the "
+        "formula along the whole arm.", fig2_pure_bending),
+    ValidationCase(
+        "axial_force", "Paper Sec. IV-B: axial tip force",
+        "A tip force along the axis stretches (or compresses) the arm uniformly: γ = F/EA.",
+        axial_force),
+    ValidationCase(
+        "fig3_shear_load", "Paper Fig. 3 and a Table I analogue: shear tip force",
+        "The paper's small-displacement solution (eqs. 49-59, `analytic.shear_force`) is "
+        "checked against its own equations (gated), and then compared with the exact "
+        "solution (`solve(method='numeric')`) as a *finding*: the paper's printed Princeton "
+        "parameters (EI_y = 36.28 N m², GA_z = 0.9039e6 N, L = 0.508 m) are the beam's stiff "
+        "chordwise pair, where the approximation is good; the same loads on the beam's real "
+        "flapwise stiffness (EI = 2.42873 N m², the 0° load of the experiment, C9) "
+        "reach k = PL²/EI = 1.9 and the approximation fails. The paper does not print EA, "
+        "GA_y, GJ or EI_z: for the printed pair they are set to EA = GA_y = GA_z and "
+        "GJ = EI_z = EI_y, which do not enter this planar problem. The flapwise pair is the "
+        "MBDyn set of princeton_beam.json (EI_Z = 2.42873 N m² with GA_Y = 6.40131e5 N, per "
+        "its pairing note), mapped to softarm's (EI_y, GA_z) because the load is along +z. "
+        "Both solutions are compared at the same arc-length station s = r.",
+        fig3_shear_load),
+    ValidationCase(
+        "mattiasson_cantilever", "Mattiasson cantilever: dead tip force, large deflection",
+        "Euler elastica under a dead tip force P along +z, k = PL²/EI = 0.1..20. The "
+        "reference is inextensible and unshearable; softarm uses EA = GA = 1e9 EI/L², whose "
+        "strains change the tip by < 2e-8 L.", mattiasson_cantilever),
+    ValidationCase(
+        "rollup", "Roll-up into a circle: end moment",
+        "An end moment M = λ 2π EI/L about +z bends the arm into a circular arc of curvature "
+        "M/EI; λ = 1 closes the circle, the tip returning to the root.", rollup),
+    ValidationCase(
+        "follower_tip_force", "Follower tip force (planar)",
+        "A tip force that stays perpendicular to the deformed tip (material e2), magnitude "
+        "k EI/L², k = 0.5..10, fundamental branch; inextensible reference, softarm with "
+        "EA = GA = 1e9 EI/L².", follower_tip_force),
+    ValidationCase(
+        "shear_deformable_tip_force", "Shear-deformable cantilever: dead tip force",
+        "L = 1 m, EI = 10 N m², EA = 1e8 N, tip force 10 N along +z (k = 1) with GA = 500 N "
+        "and GA = 10 N (strong shear), and the unshearable limit.",
+        shear_deformable_tip_force),
+    ValidationCase(
+        "pure_torsion", "Pure torsion",
+        "A tip torque T about the axis twists the arm by φ = TL/GJ and leaves it straight.",
+        pure_torsion),
+    ValidationCase(
+        "helix_end_moment", "End moment off the principal axes: helices (C4)",
+        "L = 1 m, EI_y = EI_z = 1 N m², GJ = 1/1.3 N m², tip moment with components "
+        "(1, 1, 0) N m, dead and follower. The exact shape is a helix about the (constant) "
+        "spatial moment, which `analytic.tip_moment` uses for equal bending stiffnesses. "
+        "With EI_z = 2 EI_y there is no helix and `analytic.tip_moment` falls back to the "
+        "paper's constant-strain formula (eqs. 30-34, with an ApproximationWarning), exact "
+        "only for a moment about a principal axis (C2 and C4): its tip against "
+        "the exact solver is reported as a finding.", helix),
 )

@@ -2,7 +2,7 @@
 
 Nothing here imports :mod:`softarm.analytic` or :mod:`softarm.statics`: these are the formulas
 the validation compares softarm *against* (the paper's equations as corrected in
-``docs/closed-forms.md``, and classical closed forms). Rotations use
+docs/closed-forms.md, C1-C9, and classical closed forms). Rotations use
 :func:`scipy.linalg.expm` rather than :mod:`softarm.lie`, so a bug there cannot hide here.
 
 Conventions: SI units, base clamped at the origin with R(0) = I, arm axis along +x.
@@ -30,7 +30,7 @@ def _skew(w) -> np.ndarray:
 def pure_bending(s, tau: float, EI: float) -> tuple[np.ndarray, np.ndarray]:
     """Circle of a tip moment τ about +y: positions (eq. 37) and section angles (eq. 38).
 
-    Grazioso et al. 2018, eqs. 37-38 (eq. 38 as re-assembled in docs/closed-forms.md): with
+    Grazioso et al. 2018, eqs. 37-38 (eq. 38 as re-assembled in C5): with
     κ = τ/EI, p(s) = (sin(sκ)/κ, 0, -(1 - cos(sκ))/κ) and R(s) is a rotation about +y by sκ.
 
     Returns
@@ -82,7 +82,7 @@ def torsion_angle(T: float, L: float, GJ: float) -> float:
 
 def helix_tip(moment, L: float, B: float, GJ: float, follower: bool) -> tuple[np.ndarray,
                                                                                np.ndarray]:
-    """Exact tip pose under an end moment for equal bending stiffnesses B (docs/closed-forms.md).
+    """Exact tip pose under an end moment for equal bending stiffnesses B (C4).
 
     With no force the spatial moment M is constant and
     R(s) = exp(s M/B) exp(s c e1), c = M₁(1/GJ - 1/B); the centreline is the translation part

@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import TextIO
 
 from ._checks import CaseResult, Check, DataTables, find_data_dir
-from .cases import CASES, Case
+from .cases import CASES, ValidationCase
 
 __all__ = ["COMMAND", "Report", "run", "write_outputs"]
 
@@ -32,14 +32,14 @@ class Report:
 
     Attributes
     ----------
-    cases : list of (Case, CaseResult, seconds)
+    cases : list of (ValidationCase, CaseResult, seconds)
     data_dir : Path, importlib.resources folder or None
         The reference-table folder used (None: run without tables).
     seconds : float
         Wall time of the whole run (the case computations, not the output writing).
     """
 
-    cases: list[tuple[Case, CaseResult, float]] = field(default_factory=list)
+    cases: list[tuple[ValidationCase, CaseResult, float]] = field(default_factory=list)
     data_dir: object = None
     seconds: float = 0.0
 
