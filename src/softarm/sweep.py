@@ -7,7 +7,7 @@ sweeps.
 
 Examples
 --------
->>> from softarm import Arm, TipLoad
+>>> from softarm import TipLoad
 >>> sweep = Sweep(load=0, kind="tip", field="moment", component="y", values=(0.0, 1.0, 2.0))
 >>> sweep.apply([TipLoad(moment=[0.0, 5.0, 0.0])])[0].moment
 array([[0., 0., 0.],
