@@ -146,7 +146,7 @@ STIFFNESS = Schema("", Rigidities, (
     Key("EIy", "number", "N m²", required=True), Key("EIz", "number", "N m²", required=True)))
 
 #: ``[arm]`` or one ``[[segment]]``: its own keys. Its sub-tables, ``stiffness`` or
-#: ``section`` and ``material``, are the schemas above (see :func:`softarm.case` ``_arm``).
+#: ``section`` and ``material`` (one or the other), are the schemas above.
 ARM = Schema("", Arm, (
     Key("length", "number", "m", required=True),
     Key("curvature", "vector", "1/m"),
@@ -173,14 +173,14 @@ SWEEP = {key.name: key for key in (
 
 
 def _arm_table(arm: Arm) -> dict:
-    out = ARM.write(arm)
-    length = {"length": out.pop("length")}
+    rest = ARM.write(arm)
+    out = {"length": rest.pop("length")}  # the file's order: length, the sub-tables, the rest
     if isinstance(arm.section, Rigidities):
-        length["stiffness"] = STIFFNESS.write(arm.section)
+        out["stiffness"] = STIFFNESS.write(arm.section)
     else:
-        length["section"] = _SECTION_OF[type(arm.section)].write(arm.section)
-        length["material"] = MATERIAL.write(arm.material)
-    return {**length, **out}
+        out["section"] = _SECTION_OF[type(arm.section)].write(arm.section)
+        out["material"] = MATERIAL.write(arm.material)
+    return {**out, **rest}
 
 
 def arm_to_dict(arm: Arm | SegmentedArm) -> dict:

@@ -173,8 +173,7 @@ def _build(table: Table, schema: _schema.Schema):
 def _load(table: Table):
     """A ``[[load]]`` table, read by the load class's own schema (:class:`softarm.loads.Key`)."""
     cls = LOAD_KINDS[table.string("kind", tuple(LOAD_KINDS))]
-    values = {key.name: table.read(key) for key in cls.schema if table.wants(key)}
-    return table.build(cls.schema, lambda: cls(**values))
+    return _build(table, _schema.Schema(cls.kind, cls, cls.schema))
 
 
 def _solve_options(table: Table) -> SolveOptions:
