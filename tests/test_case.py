@@ -128,7 +128,8 @@ BAD_CASES = {
                                 "solver", "unknown key"),
     "missing length": (f"[arm]\n{STIFF}\n", "arm.length", "missing"),
     "wrong type": (f"[arm]\nlength = 'long'\n{STIFF}\n", "arm.length", "must be a number"),
-    "negative length": (f"[arm]\nlength = -1.0\n{STIFF}\n", "arm.length", "must be positive"),
+    "negative length": (f"[arm]\nlength = -1.0\n{STIFF}\n", "arm.length",
+                        "must be a positive finite value in m, got -1.0"),
     "unknown section kind": (
         "[arm]\nlength = 1.0\nsection = { kind = 'hexagon', radius = 0.01 }\n"
         "material = { E = 1e6, nu = 0.3 }\n", "arm.section.kind", "unknown value 'hexagon'"),
@@ -136,7 +137,7 @@ BAD_CASES = {
                           "missing"),
     "both nu and G": ("[arm]\nlength = 1.0\nsection = { kind = 'circle', radius = 0.01 }\n"
                       "material = { E = 1e6, nu = 0.3, G = 1e5 }\n", "arm.material",
-                      "exactly one of 'nu'"),
+                      "exactly one of nu and G, got nu=0.3, G=100000.0"),
     "bad nu": ("[arm]\nlength = 1.0\nsection = { kind = 'circle', radius = 0.01 }\n"
                "material = { E = 1e6, nu = 0.7 }\n", "arm.material.nu", "(-1, 0.5]"),
     "tube radii": ("[arm]\nlength = 1.0\nsection = { kind = 'tube', outer_radius = 0.01, "

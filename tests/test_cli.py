@@ -119,7 +119,8 @@ BAD_INPUT = {
     "missing file": (None, ["{tmp}/nope.toml"], "nope.toml: no such file"),
     "misspelled key": ("[arm]\nlenght = 1.0\n", [], "arm.lenght: unknown key; did you mean"),
     "wrong type": ("[arm]\nlength = [1]\n", [], "arm.length: must be a number"),
-    "negative length": ("[arm]\nlength = -0.5\n", [], "arm.length: must be positive"),
+    "negative length": ("[arm]\nlength = -0.5\n", [],
+                        "arm.length: must be a positive finite value in m, got -0.5"),
     "unknown section kind": ("[arm]\nlength = 1.0\nsection = { kind = 'star' }\n", [],
                              "arm.section.kind: unknown value 'star'"),
     "unknown output format": (None, ["-o", "{tmp}/out.txt"], "unknown output format '.txt'"),
@@ -165,7 +166,7 @@ def test_convergence_failure_exit_1(tmp_path, capsys, monkeypatch):
     def failing(*args, **kwargs):
         raise softarm.ConvergenceError("did not converge", 3.5e-2, "30 iterations")
 
-    monkeypatch.setattr(softarm.case, "_solver", lambda: failing)
+    monkeypatch.setattr(softarm.sweep, "_solver", lambda: failing)
     out = tmp_path / "out.csv"
     code, _, stderr = run(capsys, "solve", FIG2, "-o", out)
     assert code == 1
@@ -198,7 +199,7 @@ def test_long_sweep_is_solved_in_chunks_with_progress(monkeypatch, method):
     import time
 
     case = load_case(SWEEP)
-    real = softarm.case._solver()
+    real = softarm.sweep._solver()
     calls = []
 
     def slow(arm, loads, **kwargs):

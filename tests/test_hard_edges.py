@@ -254,13 +254,13 @@ def test_extreme_length_in_a_case_file(tmp_path, capsys):
     path = tmp_path / "tiny.toml"
     path.write_text(MOMENT_CASE.replace("length = 1.0", "length = 1e-300"), encoding="utf-8")
     code, _, err = run(capsys, "solve", path)
-    assert code == 2 and "Arm.length must be a length in m" in one_line(err)
+    assert code == 2 and "tiny.toml: arm.length: must be a length in m" in one_line(err)
     path.write_text(MOMENT_CASE.replace(
         "stiffness = { EA = 1e6, GAy = 1e6, GAz = 1e6, GJ = 1.0, EIy = 1.0, EIz = 1.0 }",
         "section = { kind = 'circle', radius = 1e100 }\nmaterial = { E = 1e6, nu = 0.5 }"),
         encoding="utf-8")
     code, _, err = run(capsys, "solve", path)
-    assert code == 2 and "Circle.radius must be a length in m" in one_line(err)
+    assert code == 2 and "tiny.toml: arm.section.radius: must be a length in m" in one_line(err)
 
 
 # --- softarm plot on broken result files ------------------------------------------------------

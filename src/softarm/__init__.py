@@ -6,7 +6,7 @@ they exist (:mod:`softarm.analytic`) and a geometrically exact solver for any lo
 
 __version__ = "0.1.0"  # first, so that submodules may import it
 
-from . import analytic
+from . import analytic, sweep
 from .case import Case, CaseError, load_case
 from .dispatch import solve
 from .equilibrium import Equilibrium
@@ -38,4 +38,5 @@ __all__ = [
     "analytic",
     "load_case",
     "solve",
+    "sweep",
 ]

@@ -36,9 +36,10 @@ from pathlib import Path
 import numpy as np
 
 from . import __version__
-from .case import Case, CaseError, load_case, solve_case
+from .case import Case, CaseError, load_case
 from .errors import ConvergenceError
 from .io import FORMATS, load_saved, save_result
+from .sweep import solve_case
 
 __all__ = ["main"]
 

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-__all__ = ["ApproximationWarning", "ConvergenceError"]
+__all__ = ["ApproximationWarning", "CaseError", "CaseTypeError", "ConvergenceError"]
 
 
 class ConvergenceError(RuntimeError):
@@ -32,3 +32,12 @@ class ConvergenceError(RuntimeError):
 
 class ApproximationWarning(UserWarning):
     """A closed form was used outside the domain where it is exact."""
+
+
+class CaseError(ValueError):
+    """A case or result file that cannot be used: the message names the file, key and fault."""
+
+
+class CaseTypeError(CaseError, TypeError):
+    """A value of the wrong type in a case file (a string, bool or array where a number is
+    expected, ...): a :class:`CaseError` that is also a TypeError, as the library raises."""

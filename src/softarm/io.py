@@ -24,7 +24,8 @@ from pathlib import Path
 import numpy as np
 
 from . import __version__
-from .case import Case, CaseError, _parse, arm_to_dict, loads_to_dict
+from ._schema import arm_to_dict, loads_to_dict
+from .case import Case, CaseError, _parse
 from .equilibrium import Equilibrium
 from .lie import se3, so3
 
