@@ -519,7 +519,8 @@ def _tangent(J, t):
 
 @_jit
 def _follow(x, steps, base, arm, case, scratch, scale, dscale, length, threshold,
-            max_iterations, max_load_step, max_shootings, r, J, tip, counter, reached):
+            max_iterations, max_load_step, max_shootings, open_end, r, J, tip, counter,
+            reached):
     """Follow the equilibrium path from λ = 0 (x: the solution there, exact or close) to
     λ = 1 by predictor–corrector continuation. True on success, with x, r, J (7 columns) and
     the tip position at λ = 1 (converged to ``_LOOSE``: the caller refines it); otherwise
@@ -532,6 +533,10 @@ def _follow(x, steps, base, arm, case, scratch, scale, dscale, length, threshold
     Δλ makes the predicted motion ``_FIRST_MOTION``; then Δλ ← Δλ (aim/δ)^(1/3) within
     [Δλ/2, 2Δλ], δ the corrector's distance from the predictor; Δλ × 0.4 after a failure; a
     step that would leave less than half a step to λ = 1 is stretched to reach it.
+
+    With ``open_end``, the last step (to λ = 1) is predicted but not corrected: x is the
+    prediction, for the caller's corrector on a finer grid (with the same first-step limit
+    ``_DIST_MAX`` and contraction test, so the last step is checked as any other).
     """
     reached[0] = 0.0
     nt = J.shape[1]  # all 7 columns (a variable, not a literal: one compiled version)
@@ -572,6 +577,9 @@ def _follow(x, steps, base, arm, case, scratch, scale, dscale, length, threshold
         else:
             for i in range(6):
                 x[i] = x0[i] + (target - lam) * t[i]
+        if open_end and target == 1.0:
+            reached[0] = lam
+            return True
         for i in range(6):
             dx[i] = x[i]  # the prediction
         ok = _corrector(x, target, nt, steps, base, arm, case, scratch, scale, dscale, length,
@@ -767,9 +775,10 @@ def _chord(x, J_c, steps, base, arm, case, scratch, scale, threshold, max_iterat
                 size = max(size, abs(dx[i]) / scale[i])
             if not size <= _REFINE_MAX:
                 return 0
-        # the chord contraction: observed, or at first ~ 0.1 res (the Jacobians of N and 2N
-        # steps differ by the discretisation error, as r does)
-        rate = res / previous if math.isfinite(previous) else 0.1 * res
+        # the chord contraction: observed, or at first ~ 10 res (the Jacobians of N and 2N
+        # steps differ by the discretisation error, as r does; a cautious guess, since a
+        # wrong one costs a whole output pass)
+        rate = res / previous if math.isfinite(previous) else 10.0 * res
         previous = res
         for i in range(6):
             x[i] += dx[i]
@@ -849,7 +858,7 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, out):
     tip_c = np.empty(3)
     tip_f = np.empty(3)
     dscale = np.empty(6)
-    six, seven = nt_out * 0 + 6, nt_out * 0 + 7  # not literals: one compiled version
+    six = nt_out * 0 + 6  # not a literal: one compiled version
     # a Newton step of this size at N leaves an error of about its square: far below tol
     final_step = min(1e-3, math.sqrt(0.01 * tol / length)) if math.isfinite(tol) else 1e-9
     reached = np.zeros(1)
@@ -901,9 +910,10 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, out):
                         x[i] = memory[_MXC + i]  # exact at this step count
                     else:
                         x[i] = memory[_MXF + i]  # close: corrected at λ = 0
+                coarse = n_path < N  # the last step is corrected on the grid of N
                 if not _follow(x, steps, base, arm, case, scratch, scale, dscale, length,
-                               threshold, max_iterations, max_load_step, budget, r, J, tip_c,
-                               counter, reached):
+                               threshold, max_iterations, max_load_step, budget, coarse, r,
+                               J, tip_c, counter, reached):
                     if counter[0] > budget:
                         status[b] = BUDGET
                         break
@@ -920,11 +930,13 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, out):
                         continue
                     status[b] = PATH_FAILED
                     break
-                # the coarse solution at N, from the end of the path (a checked Newton)
+                # the coarse solution at N, from the end of the path (a checked Newton; from
+                # the last prediction when the path ran on the coarser grid)
                 _fill_steps(length, arm[1], N, 1, steps)
-                if not _corrector(x, 1.0, seven, steps, base, arm, case, scratch, scale,
-                                  dscale, length, threshold, max_iterations, _REFINE_MAX,
-                                  final_step, r, J, tip_c, counter):
+                if not _corrector(x, 1.0, six, steps, base, arm, case, scratch, scale,
+                                  dscale, length, threshold, max_iterations,
+                                  _DIST_MAX if coarse else _REFINE_MAX, final_step, r, J,
+                                  tip_c, counter):
                     if n_path < N:
                         fine_path = True
                         continue
@@ -978,7 +990,7 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, out):
             N = min(n_max // 2, max(N + 1, math.ceil(N * grow)))
             _fill_steps(length, arm[1], N, 1, steps)
             _copy(x_f, x)
-            path = not _corrector(x, 1.0, seven, steps, base, arm, case, scratch, scale, dscale,
+            path = not _corrector(x, 1.0, six, steps, base, arm, case, scratch, scale, dscale,
                                   length, threshold, max_iterations, _REFINE_MAX, final_step, r, J,
                                   tip_c, counter)
             if not path:

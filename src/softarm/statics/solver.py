@@ -36,9 +36,15 @@ _LOAD_LIMIT = 1e12
 def _kernels():
     """The compiled module, imported on first use: ``import softarm`` compiles nothing and
     does not import numba."""
-    from . import _kernels
+    global _KERNELS
+    if _KERNELS is None:
+        from . import _kernels as module
 
-    return _kernels
+        _KERNELS = module
+    return _KERNELS
+
+
+_KERNELS = None
 
 
 def check_base(base) -> np.ndarray:
@@ -331,6 +337,11 @@ class Solver:
         k = self.length
         fs, ms = self._data.scale[0], self._data.scale[3]
         with np.errstate(over="ignore", invalid="ignore"):
+            # a cheap bound first: every channel at its largest, summed
+            largest = max(np.max(np.abs(channels.piece), initial=0.0),
+                          np.max(np.abs(channels.tip_loads), initial=0.0))
+            if largest * 12.0 * max(k, 1.0) / min(fs, ms) <= _LOAD_LIMIT:
+                return
             piece = np.abs(channels.piece)
             tip = np.abs(channels.tip_loads)
             sizes = np.concatenate([
