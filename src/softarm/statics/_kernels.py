@@ -97,8 +97,8 @@ TIP_LOADS = 12
 
 # Solver options, one float array (OPTIONS long): see solve_cases.
 (_O_TOL, _O_ITER, _O_LOADSTEP, _O_NFIXED, _O_NMAX, _O_BUDGET, _O_CHAINED,
- _O_JACOBIANS) = range(8)
-OPTIONS = 8
+ _O_JACOBIANS, _O_COARSE) = range(9)
+OPTIONS = 9
 
 # The memory of a chained (quasi-static) solve, in and out (MEMORY long): x at the coarse
 # step count N (6), x at 2N (6), N, valid (1 if the memory holds a solved case).
@@ -107,14 +107,16 @@ MEMORY = 14
 
 # Continuation: largest first-corrector distance accepted, the distance aimed at by the step
 # control, largest contraction of successive corrector steps, smallest load-factor step.
-_DIST_MAX = 0.25
-_DIST_AIM = 0.1
+_DIST_MAX = 0.15
+_DIST_AIM = 0.05
 _CONTRACTION_MAX = 0.5
 _DLAM_MIN = 1e-5
 # Corrector steps no larger than this end a corrector on the way (not at λ = 1), and the
 # first load step predicts a tip motion of about _FIRST_MOTION (L or rad).
 _LOOSE = 1e-2
-_FIRST_MOTION = 0.3
+_FIRST_MOTION = 0.15
+# A step across which det ∂r/∂x changes sign is accepted only when no longer than this.
+_DLAM_CROSS = 1e-3
 # Refinement of a solution under a change of step count: distances are of the order of the
 # discretisation error, far below this.
 _REFINE_MAX = 0.05
@@ -468,9 +470,10 @@ def _corrector(x, lam, nt, steps, base, arm, case, scratch, scale, dscale, lengt
                max_iterations, first_limit, loose, r, J, tip, counter):
     """Newton at fixed λ from the prediction x, accepted only if it stays near it.
 
-    The first step must be no larger than ``first_limit`` (nondimensional, see _distance) and
-    every later step at most half the one before (contraction): a corrector that wanders or
-    stalls is rejected instead of accepted at whatever root it reaches. Converged when the
+    The steps together must be no larger than ``first_limit`` (nondimensional, see
+    _distance) and every step after the first at most half the one before (contraction): a
+    corrector that wanders or stalls is rejected instead of accepted at whatever root it
+    reaches. Converged when the
     residual is below ``threshold``, or when a step is no larger than ``loose``: that step is
     taken without integrating again (its error is of the order of its square), the tip
     position ``tip`` is moved by its linearisation and J is the one of the point before.
@@ -479,6 +482,7 @@ def _corrector(x, lam, nt, steps, base, arm, case, scratch, scale, dscale, lengt
     """
     dx = np.empty(6)
     previous = np.inf
+    travelled = 0.0
     y, T = scratch[0], scratch[1]
     for k in range(max_iterations + 1):
         _integrate(x, lam, nt, steps, base, arm, case, scratch, r, J)
@@ -498,6 +502,9 @@ def _corrector(x, lam, nt, steps, base, arm, case, scratch, scale, dscale, lengt
             # a step at round-off level cannot contract further: accept a tiny residual
             return res <= 1e3 * threshold
         previous = size
+        travelled += size
+        if travelled > first_limit:
+            return False  # wandered: the sum of the steps is a bound of the distance moved
         for i in range(6):
             x[i] += dx[i]
         if size <= loose:
@@ -506,6 +513,58 @@ def _corrector(x, lam, nt, steps, base, arm, case, scratch, scale, dscale, lengt
                     tip[i] += T[d, _TP + i] * dx[d]
             return True
     return False
+
+
+@_jit
+def _det_sign(J):
+    """The sign of det ∂r/∂x (J[:, :6]) by Gaussian elimination with partial pivoting; 0 if
+    singular. Its parity is that of the number of unstable directions: a change between
+    two points of the path means a singular point (fold or bifurcation) between them."""
+    M = np.empty((6, 6))
+    for i in range(6):
+        for k in range(6):
+            M[i, k] = J[i, k]
+    sign = 1.0
+    for c in range(6):
+        p = c
+        best = abs(M[c, c])
+        for i in range(c + 1, 6):
+            if abs(M[i, c]) > best:
+                best = abs(M[i, c])
+                p = i
+        if not best > 0.0:
+            return 0.0
+        if p != c:
+            sign = -sign
+            for k in range(6):
+                M[c, k], M[p, k] = M[p, k], M[c, k]
+        if M[c, c] < 0.0:
+            sign = -sign
+        for i in range(c + 1, 6):
+            g = M[i, c] / M[c, c]
+            for k in range(c, 6):
+                M[i, k] -= g * M[c, k]
+    return sign
+
+
+@_jit
+def _tip_motion(T, t, out):
+    """The tip displacement (spatial) per unit load factor along the path tangent t."""
+    for i in range(3):
+        acc = 0.0
+        for d in range(6):
+            acc += T[d, _TP + i] * t[d]
+        out[i] = acc
+
+
+@_jit
+def _cosine(a, b):
+    """The cosine of the angle between two 3-vectors (1 if either is zero)."""
+    aa = a[0] * a[0] + a[1] * a[1] + a[2] * a[2]
+    bb = b[0] * b[0] + b[1] * b[1] + b[2] * b[2]
+    if not (aa > 0.0 and bb > 0.0):
+        return 1.0
+    return (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) / math.sqrt(aa * bb)
 
 
 @_jit
@@ -551,6 +610,11 @@ def _follow(x, steps, base, arm, case, scratch, scale, dscale, length, threshold
     dx = np.empty(6)
     if not _tangent(J, t):
         return False
+    sign = _det_sign(J)
+    reached[1] = sign
+    motion_prev = np.empty(3)
+    _tip_motion(scratch[1], t, motion_prev)
+    motion_new = np.empty(3)
     lam = 0.0
     lam_p = -1.0  # no point before yet
     motion = _distance(t, scratch[1], dscale, length)
@@ -578,7 +642,7 @@ def _follow(x, steps, base, arm, case, scratch, scale, dscale, length, threshold
             for i in range(6):
                 x[i] = x0[i] + (target - lam) * t[i]
         if open_end and target == 1.0:
-            reached[0] = lam
+            reached[0] = lam  # reached[1]: the sign of det ∂r/∂x there, for the caller
             return True
         for i in range(6):
             dx[i] = x[i]  # the prediction
@@ -589,6 +653,21 @@ def _follow(x, steps, base, arm, case, scratch, scale, dscale, length, threshold
                 dx[i] = x[i] - dx[i]  # the corrector's distance from the prediction
                 t_new[i] = t[i]
             ok = _tangent(J, t_new)
+        if ok:
+            # det ∂r/∂x changed sign: a singular point lies in this step. Newton may have
+            # landed on another branch across it (an imperfect bifurcation): refuse the step
+            # until it is short enough that the singular point itself is being crossed.
+            # The same when the tip's direction of motion turns by more than 60° in one step
+            # (a double root, as on a round section, keeps the sign of det but not this).
+            new_sign = _det_sign(J)
+            _tip_motion(scratch[1], t_new, motion_new)
+            ok = dl <= _DLAM_CROSS or (new_sign == sign
+                                       and _cosine(motion_prev, motion_new) >= 0.5)
+            if ok:
+                sign = new_sign
+                reached[1] = sign
+                for i in range(3):
+                    motion_prev[i] = motion_new[i]
         if ok:
             for i in range(6):
                 xp[i] = x0[i]
@@ -824,7 +903,7 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, out):
     first : (piece (P, PIECE_LOADS), tip (TIP_LOADS,)): case 0's start loads when chained.
     options : (OPTIONS,) tol (m; inf with a fixed step count), max_iterations, max_load_step,
         fixed step count (0: from tol), largest step count, shootings budget, chained (0/1),
-        jacobians (0/1).
+        jacobians (0/1), the ratio of the step counts of the solution and of the path.
     memory : (MEMORY,) the chained start (x at N, x at 2N, N, valid), read and rewritten.
     out : (poses (B, S, 4, 4), strains (B, S, 6), stresses (B, S, 6), info (B, 5) [residual,
         error estimate, load factor reached, shootings, N], status (B,), J (B, 6, 6) at the
@@ -843,6 +922,7 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, out):
     budget = int(options[_O_BUDGET])
     chained = options[_O_CHAINED] > 0.0
     nt_out = 6 if options[_O_JACOBIANS] > 0.0 else 0
+    coarse_ratio = int(options[_O_COARSE])
     info, status, jac = out[3], out[4], out[5]
     scratch = _scratch(npieces)
     start = np.zeros((npieces, PIECE_LOADS))
@@ -861,7 +941,7 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, out):
     six = nt_out * 0 + 6  # not a literal: one compiled version
     # a Newton step of this size at N leaves an error of about its square: far below tol
     final_step = min(1e-3, math.sqrt(0.01 * tol / length)) if math.isfinite(tol) else 1e-9
-    reached = np.zeros(1)
+    reached = np.zeros(2)  # the load factor reached, the sign of det ∂r/∂x there
     steps = np.empty(npieces, dtype=np.int64)
     counter = np.zeros(1, dtype=np.int64)
     for b in range(nb):
@@ -900,8 +980,9 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, out):
         resume = False
         while True:
             if path:
-                # the path on a coarse grid (a third of the steps) unless that failed
-                n_path = N if fine_path or N <= 6 else (N + 2) // 3
+                # the path on a coarse grid (N / coarse_ratio steps) unless that failed
+                n_path = N if fine_path or N <= 6 else max(3, (N + coarse_ratio - 1)
+                                                           // coarse_ratio)
                 _fill_steps(length, arm[1], n_path, 1, steps)
                 for i in range(6):
                     if not warm:
@@ -936,7 +1017,8 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, out):
                 if not _corrector(x, 1.0, six, steps, base, arm, case, scratch, scale,
                                   dscale, length, threshold, max_iterations,
                                   _DIST_MAX if coarse else _REFINE_MAX, final_step, r, J,
-                                  tip_c, counter):
+                                  tip_c, counter) or (
+                                      coarse and _det_sign(J) != reached[1]):
                     if n_path < N:
                         fine_path = True
                         continue

@@ -273,7 +273,7 @@ class Solver:
     """
 
     def __init__(self, arm, *, s=None, tol=1e-8, base=None, max_iterations=12,
-                 max_load_step=1.0, steps=None, max_steps=_N_MAX, max_shootings=3000):
+                 max_load_step=1.0, steps=None, max_steps=_N_MAX, max_shootings=10000):
         self.arm = _check_arm(arm)
         self._data = _arm_data(arm)
         self.length = self._data.length
@@ -299,6 +299,7 @@ class Solver:
         self.steps = steps
         self.max_steps = _check_count(max_steps, "max_steps", 4)
         self.max_shootings = _check_count(max_shootings, "max_shootings", 1)
+        self._coarse_ratio = 4  # the path runs on N / 4 steps (benchmarks/run.py measures it)
         self.reset()
 
     def reset(self) -> None:
@@ -364,7 +365,8 @@ class Solver:
         n_max = max(self.max_steps, self.steps or 0)
         tol = math.inf if self.steps is not None else self.tol * self.length
         return np.array([tol, self.max_iterations, self.max_load_step, n_fixed, n_max,
-                         self.max_shootings, float(chained), float(jacobians)])
+                         self.max_shootings, float(chained), float(jacobians),
+                         self._coarse_ratio])
 
     # ---------------------------------------------------------------- solving
 
@@ -526,8 +528,9 @@ def _failure(k, b, shape, status, info, solver) -> ConvergenceError:
             load_factor=float(reached))
     if code == k.BUDGET:
         return ConvergenceError(
-            f"the shooting budget max_shootings={solver.max_shootings} ran out{where}",
-            residual, tried, load_factor=float(reached))
+            f"the shooting budget max_shootings={solver.max_shootings} ran out{where} with the "
+            f"loading path followed to load factor λ = {reached:.6g}", residual, tried,
+            load_factor=float(reached))
     if code == k.NOT_FINITE:
         return ConvergenceError(f"the solution became non-finite{where}", residual, tried)
     return ConvergenceError(
