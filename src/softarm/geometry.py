@@ -84,14 +84,16 @@ def tip_frame(poses, length: float) -> np.ndarray:
 
 @dataclass(frozen=True)
 class Arrow:
-    """Arrows of one load: ``origins`` and spatial ``vectors`` (k, 3), in the load's ``unit``;
-    ``moment``: the vectors are moments (drawn differently from forces)."""
+    """Arrows of one vector field of one load: ``origins`` and spatial ``vectors`` (k, 3), in
+    the load's ``unit``; ``moment``: the vectors are moments (drawn differently from forces);
+    ``key``: (index of the load in the loads, field name), stable when the values change."""
 
     label: str
     origins: np.ndarray
     vectors: np.ndarray
     unit: str
     moment: bool = False
+    key: tuple = ()
 
 
 def _at(poses, s, where):
@@ -119,7 +121,7 @@ def load_arrows(loads, poses, s, arm, count: int = 6) -> list[Arrow]:
     poses = np.asarray(poses, dtype=float)
     s = np.asarray(s, dtype=float)
     arrows = []
-    for load in loads:
+    for index, load in enumerate(loads):
         kind = getattr(load, "kind", type(load).__name__)
         follower = bool(getattr(load, "follower", False))
         if kind == "tip":
@@ -140,5 +142,5 @@ def load_arrows(loads, poses, s, arm, count: int = 6) -> list[Arrow]:
             label = load.describe() if len(load.vectors) == 1 else \
                 f"{'follower ' if follower else ''}{kind} {name}"
             arrows.append(Arrow(label, at[:, :3, 3].copy(), np.array(vectors), unit,
-                                moment="moment" in name))
+                                moment="moment" in name, key=(index, name)))
     return arrows

@@ -25,8 +25,8 @@ import numpy as np
 
 from .geometry import cube_limits, load_arrows, station_radii, tip_frame, tube_surface
 
-__all__ = ["PLOTLY_MISSING", "figure", "plotly_js_path", "to_html", "view_result_file",
-           "write_html"]
+__all__ = ["PLOTLY_MISSING", "figure", "plotly_js_path", "scene_traces", "to_html", "to_json",
+           "view_result_file", "write_html"]
 
 #: The message when plotly is not installed.
 PLOTLY_MISSING = "the browser views need plotly: pip install 'softarm[view]'"
@@ -80,7 +80,7 @@ def _arrow_traces(arrows, scales, length: float) -> list[dict]:
         for arrow in arrows:
             if arrow.moment is not moment:
                 continue
-            scale = scales.get(arrow.label, 1.0)
+            scale = scales.get(arrow.key, 0.0)
             for origin, vector in zip(arrow.origins, arrow.vectors, strict=True):
                 norm = float(np.linalg.norm(vector))
                 if norm == 0.0:
@@ -116,10 +116,10 @@ def _arrow_scales(arrows_per_frame, length: float) -> dict[str, float]:
     for arrows in arrows_per_frame:
         for arrow in arrows:
             norm = float(np.max(np.linalg.norm(arrow.vectors, axis=-1), initial=0.0))
-            largest[arrow.label] = max(largest.get(arrow.label, 0.0), norm)
-            several[arrow.label] = len(arrow.origins) > 1
-    return {label: (0.12 if several[label] else 0.25) * length / value
-            for label, value in largest.items() if value > 0}
+            largest[arrow.key] = max(largest.get(arrow.key, 0.0), norm)
+            several[arrow.key] = len(arrow.origins) > 1
+    return {key: (0.12 if several[key] else 0.25) * length / value
+            for key, value in largest.items() if value > 0}
 
 
 def _scene_traces(result, arrows, scales, radii) -> list[dict]:
@@ -160,6 +160,12 @@ def _scene_traces(result, arrows, scales, radii) -> list[dict]:
     return traces
 
 
+def scene_traces(result, scales) -> list[dict]:
+    """The 3D traces of one (unbatched) equilibrium, as in :func:`figure` with ``scales``."""
+    arrows = load_arrows(result.loads, result.poses, result.s, result.arm)
+    return _scene_traces(result, arrows, scales, station_radii(result.arm, result.s))
+
+
 def _extent(result, radii, arrows, scales) -> np.ndarray:
     poses = np.asarray(result.poses)
     points = [poses[..., :3, 3].reshape(-1, 3)]
@@ -168,7 +174,7 @@ def _extent(result, radii, arrows, scales) -> np.ndarray:
             points.append(tube_surface(pose, radii, sides=8).reshape(3, -1).T)
     for frame_arrows in arrows:
         for arrow in frame_arrows:
-            points.append(arrow.origins + arrow.vectors * scales.get(arrow.label, 0.0))
+            points.append(arrow.origins + arrow.vectors * scales.get(arrow.key, 0.0))
     return np.concatenate(points)
 
 
@@ -187,7 +193,8 @@ def _describe(loads) -> str:
 
 
 def figure(result, *, name: str | None = None, values=None, label: str | None = None,
-           sweep=None, title: str | None = None, height: int = 650) -> dict:
+           sweep=None, title: str | None = None, height: int = 650, scales=None,
+           limits=None) -> dict:
     """The plotly figure (a dict: ``data``, ``layout`` and, for a sweep, ``frames``).
 
     Parameters
@@ -203,6 +210,13 @@ def figure(result, *, name: str | None = None, values=None, label: str | None = 
     sweep : softarm.case.Sweep, optional
     title : str, optional
         Replaces the whole title.
+    height : int
+        In pixels.
+    scales : dict, optional
+        Arrow length in m per unit of each load's field, keyed by (load index, field name)
+        (default: each field's largest arrow is 0.25 L, or 0.12 L for distributed loads).
+    limits : (centre (3,), half side), optional
+        The axis cube (default: around everything drawn).
     """
     batch = result.batch_shape
     if len(batch) > 1:
@@ -211,8 +225,9 @@ def figure(result, *, name: str | None = None, values=None, label: str | None = 
     length = float(result.arm.length)
     radii = station_radii(result.arm, result.s)
     arrows = [load_arrows(case.loads, case.poses, case.s, case.arm) for case in cases]
-    scales = _arrow_scales(arrows, length)
-    centre, half = cube_limits(_extent(result, radii, arrows, scales))
+    scales = _arrow_scales(arrows, length) if scales is None else scales
+    centre, half = cube_limits(_extent(result, radii, arrows, scales)) if limits is None \
+        else limits
     scene = {"aspectmode": "cube", "domain": {"x": [0.0, 0.64 if batch else 1.0],
                                               "y": [0.0, 1.0]},
              "camera": {"eye": {"x": 1.1, "y": -1.6, "z": 0.75}}}
