@@ -221,6 +221,7 @@ def _title(case: Case, loads) -> str:
 
 _PAGE = """<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>softarm app: {name}</title>
+<link rel="icon" href="data:,">
 <style>
 body {{ font-family: sans-serif; margin: 0; display: flex; }}
 #controls {{ width: 330px; padding: 10px; font-size: 13px; height: 100vh; overflow-y: auto;
