@@ -142,7 +142,7 @@ class LiveCase:
                     (0.12 if several else 0.25) * length / largest
         # a fixed cube the arm cannot leave (it reaches at most about L from its base), so
         # that the view does not jump while the sliders move
-        self.limits = (np.zeros(3), 1.3 * length)
+        self.limits = (np.zeros(3), 1.05 * length)
 
     def update(self, query: dict[str, str]) -> None:
         """Set inputs from a request's query (BadRequest naming the first bad one)."""
@@ -223,10 +223,10 @@ _PAGE = """<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>softarm app: {name}</title>
 <link rel="icon" href="data:,">
 <style>
-body {{ font-family: sans-serif; margin: 0; display: flex; }}
+body {{ font-family: sans-serif; margin: 0; display: flex; overflow: hidden; }}
 #controls {{ width: 330px; padding: 10px; font-size: 13px; height: 100vh; overflow-y: auto;
   box-sizing: border-box; background: #f6f6f6; }}
-#plot {{ flex: 1; height: 100vh; }}
+#plot {{ flex: 1; min-width: 0; height: 100vh; }}
 fieldset {{ margin: 0 0 8px 0; border: 1px solid #ccc; }}
 label {{ display: block; margin-top: 4px; }}
 input[type=range] {{ width: 100%; }}
@@ -264,7 +264,7 @@ for (const item of INPUTS) {{
   label.append(item.label + " = ", out, " " + item.unit);
   const slider = document.createElement("input");
   slider.type = "range"; slider.id = item.name;
-  slider.min = item.low; slider.max = item.high; slider.step = item.step;
+  slider.min = item.low; slider.max = item.high; slider.step = "any";
   slider.value = item.value;
   out.textContent = Number(item.value).toPrecision(4);
   slider.addEventListener("input", () => {{
