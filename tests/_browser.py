@@ -9,6 +9,9 @@ import shutil
 
 import pytest
 
+#: Set (e.g. by CI) to make a missing browser a failure instead of a skip.
+REQUIRED = bool(os.environ.get("SOFTARM_REQUIRE_BROWSER"))
+
 INSTALL = ("browser tests need Debian's chromium and its driver: apt-get install -y chromium "
            "chromium-driver, and pip install selenium")
 
@@ -22,12 +25,17 @@ def _find(*names: str) -> str | None:
 
 
 def chromium():
-    """A headless chromium WebDriver (1200 × 800), or pytest.skip with how to install it."""
-    webdriver = pytest.importorskip("selenium.webdriver", reason=INSTALL)
+    """A headless chromium WebDriver (1200 × 800), or pytest.skip with how to install it
+    (pytest.fail if the environment variable SOFTARM_REQUIRE_BROWSER is set, as in CI)."""
+    missing = pytest.fail if REQUIRED else pytest.skip
+    try:
+        from selenium import webdriver
+    except ImportError:
+        missing(INSTALL)
     browser = os.environ.get("SOFTARM_CHROMIUM") or _find("chromium", "chromium-browser")
     driver_path = os.environ.get("SOFTARM_CHROMEDRIVER") or _find("chromedriver")
     if browser is None or driver_path is None:
-        pytest.skip(INSTALL)
+        missing(INSTALL)
     options = webdriver.ChromeOptions()
     options.binary_location = browser
     for flag in ("--headless=new", "--no-sandbox", "--disable-gpu", "--window-size=1200,800",

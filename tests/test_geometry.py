@@ -44,6 +44,28 @@ def test_tube_points_lie_at_the_radius_around_a_bent_axis():
     np.testing.assert_allclose(surface[:, :, 0], surface[:, :, -1], atol=1e-15)  # closed
 
 
+def test_tube_mesh_covers_the_surface_with_triangles():
+    s = np.linspace(0.0, 1.0, 5)
+    poses = se3.exp(s[:, None] * [1.0, 0, 0, 0, 1.0, 0])
+    vertices, triangles = geometry.tube_mesh(poses, np.full(5, 0.1), sides=6)
+    assert vertices.shape == (30, 3) and triangles.shape == (2 * 4 * 6, 3)
+    surface = geometry.tube_surface(poses, np.full(5, 0.1), sides=6)
+    np.testing.assert_allclose(vertices[6 * 2 + 3], surface[:, 2, 3])  # station 2, φ = π
+    # every triangle joins two neighbouring stations and neighbouring angles (with the seam)
+    station, angle = np.divmod(triangles, 6)
+    assert np.all(np.ptp(station, axis=1) == 1)
+    gaps = np.sort(angle, axis=1)
+    assert np.all((np.ptp(angle, axis=1) <= 1) | ((gaps[:, 0] == 0) & (gaps[:, -1] == 5)))
+    # the triangles tile the side of the tube: total area → 2π r L as the mesh refines
+    fine_v, fine_t = geometry.tube_mesh(se3.exp(np.linspace(0, 1, 200)[:, None]
+                                                * [1.0, 0, 0, 0, 1.0, 0]),
+                                        np.full(200, 0.1), sides=256)
+    corner = fine_v[fine_t]
+    area = 0.5 * np.linalg.norm(np.cross(corner[:, 1] - corner[:, 0],
+                                         corner[:, 2] - corner[:, 0]), axis=-1).sum()
+    np.testing.assert_allclose(area, 2 * np.pi * 0.1 * 1.0, rtol=1e-3)
+
+
 def test_silhouette_of_a_straight_arm_is_a_rectangle():
     points = np.stack([np.linspace(0.0, 2.0, 5), np.zeros(5)], -1)
     outline = geometry.silhouette(points, np.full(5, 0.1))

@@ -58,13 +58,18 @@ def test_figure_draws_the_equilibrium(demo):
     custom = decode(line["customdata"])
     expected = np.concatenate([result.s[:, None], result.strains, result.stresses], -1)
     np.testing.assert_allclose(custom, expected, rtol=1e-6, atol=1e-9)
-    # the tube: every surface point at the segment's radius (16 mm, then 11 mm) from the axis
-    (tube,) = traces(fig, "arm")
-    surface = np.stack([decode(tube[a]) for a in "xyz"], -1)
-    distance = np.linalg.norm(surface - p[:, None, :], axis=-1)
+    # the tube: every vertex at the segment's radius (16 mm, then 11 mm) from the axis, with
+    # the read-outs of its station
+    (tube,) = traces(fig, "arm", ("mesh3d",))
+    vertices = np.stack([decode(tube[a]) for a in "xyz"], -1).reshape(p.shape[0], -1, 3)
+    distance = np.linalg.norm(vertices - p[:, None, :], axis=-1)
     radius = np.where(result.s < 0.25, 0.016, 0.011)  # demo.toml: segment radii
     np.testing.assert_allclose(distance, np.broadcast_to(radius[:, None], distance.shape),
                                rtol=1e-5)
+    np.testing.assert_allclose(decode(tube["customdata"])[::vertices.shape[1]], expected,
+                               rtol=1e-6, atol=1e-9)
+    assert np.max(decode(tube["i"])) < vertices.shape[0] * vertices.shape[1]
+    surface = vertices
     # the tip frame: 0.15 L along each column of R(L)
     (e1,) = traces(fig, "tip frame e1 e2 e3")
     tip = np.stack([decode(e1[a]) for a in "xyz"], -1)

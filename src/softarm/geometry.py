@@ -18,6 +18,7 @@ __all__ = [
     "silhouette",
     "station_radii",
     "tip_frame",
+    "tube_mesh",
     "tube_surface",
 ]
 
@@ -47,6 +48,21 @@ def tube_surface(poses, radii, sides: int = 24) -> np.ndarray:
     ring = np.cos(phi)[None, :, None] * e2[:, None, :] + np.sin(phi)[None, :, None] * e3[:, None]
     points = poses[:, None, :3, 3] + radii[:, None, None] * ring
     return np.moveaxis(points, -1, 0)
+
+
+def tube_mesh(poses, radii, sides: int = 16) -> tuple[np.ndarray, np.ndarray]:
+    """The tube as a triangle mesh: vertices (N·sides, 3), ring by ring (vertex ``n·sides + j``
+    at station n, angle φ_j = 2πj/sides, as in :func:`tube_surface`), and triangles
+    (2·(N-1)·sides, 3) of vertex indices, wrapping around each ring. Open at both ends."""
+    points = tube_surface(poses, radii, sides)[:, :, :-1]  # drop the repeated seam column
+    n = points.shape[1]
+    vertices = np.moveaxis(points, 0, -1).reshape(-1, 3)
+    ring = np.arange(n - 1)[:, None] * sides
+    j = np.arange(sides)[None, :]
+    a, b = ring + j, ring + (j + 1) % sides  # this ring: φ_j, φ_j+1
+    c, d = a + sides, b + sides  # the next ring
+    triangles = np.concatenate([np.stack([a, c, b], -1), np.stack([b, c, d], -1)], axis=1)
+    return vertices, triangles.reshape(-1, 3)
 
 
 def silhouette(points2, radii) -> np.ndarray:

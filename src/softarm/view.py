@@ -7,8 +7,8 @@ The figures are built here as plain dicts in plotly's figure schema (``data``, `
 plotly.js and opens without a network.
 
 Drawn: the arm as a tube of its real radius (its centreline when the sections are not known),
-the centreline with hover read-outs (s, position, strains and stresses in the material
-frame), the tip's material frame (e1 red, e2 green, e3 blue), arrows for the loads (forces
+the arm and its centreline with hover read-outs (s, position, strains and stresses in the
+material frame), the tip's material frame (e1 red, e2 green, e3 blue), arrows for the loads (forces
 solid, moments dashed; each load's arrows are scaled to its own largest value, the hover
 gives the value) and the clamped base. A sweep gets a slider over its parameter, a play
 button and a plot of the tip coordinates against the parameter.
@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .geometry import cube_limits, load_arrows, station_radii, tip_frame, tube_surface
+from .geometry import cube_limits, load_arrows, station_radii, tip_frame, tube_mesh, tube_surface
 
 __all__ = ["PLOTLY_MISSING", "figure", "plotly_js_path", "scene_traces", "to_html", "to_json",
            "view_result_file", "write_html"]
@@ -128,17 +128,16 @@ def _scene_traces(result, arrows, scales, radii) -> list[dict]:
     p = poses[:, :3, 3]
     length = float(result.arm.length)
     traces = []
-    if radii is not None:
-        x, y, z = tube_surface(poses, radii, sides=_SIDES)
-        s_grid = np.repeat(np.asarray(result.s)[:, None], _SIDES + 1, axis=1)
-        traces.append({"type": "surface", "x": x, "y": y, "z": z, "customdata": s_grid,
-                       "surfacecolor": s_grid, "colorscale": [[0, _TUBE], [1, _TUBE]],
-                       "showscale": False, "opacity": 0.45, "name": "arm",
-                       "hovertemplate": "s = %{customdata:.4g} m<br>(%{x:.4g}, %{y:.4g}, "
-                       "%{z:.4g}) m<extra>tube surface</extra>",
-                       "lighting": {"ambient": 0.6, "diffuse": 0.6, "specular": 0.1}})
     custom = np.concatenate([np.asarray(result.s)[:, None], result.strains, result.stresses],
                             axis=-1)
+    if radii is not None:
+        vertices, triangles = tube_mesh(poses, radii, sides=_SIDES)
+        traces.append({"type": "mesh3d", "x": vertices[:, 0], "y": vertices[:, 1],
+                       "z": vertices[:, 2], "i": triangles[:, 0], "j": triangles[:, 1],
+                       "k": triangles[:, 2], "color": _TUBE, "opacity": 1.0,
+                       "customdata": np.repeat(custom, _SIDES, axis=0),
+                       "hovertemplate": _HOVER.replace("centreline", "arm"), "name": "arm",
+                       "showlegend": True})
     traces.append({"type": "scatter3d", "mode": "lines+markers", "x": p[:, 0], "y": p[:, 1],
                    "z": p[:, 2], "customdata": custom, "hovertemplate": _HOVER,
                    "line": {"color": _LINE, "width": 4}, "marker": {"size": 2, "color": _LINE},
@@ -323,8 +322,9 @@ def _compact(value):
     if isinstance(value, list):
         return [_compact(v) for v in value]
     if isinstance(value, np.ndarray) and value.dtype.kind in "fiu" and value.size:
-        data = np.ascontiguousarray(value, dtype=np.float32)
-        typed = {"dtype": "f4", "bdata": base64.b64encode(data.tobytes()).decode("ascii")}
+        dtype = "<f4" if value.dtype.kind == "f" else "<i4"
+        data = np.ascontiguousarray(value, dtype=dtype)
+        typed = {"dtype": dtype[1:], "bdata": base64.b64encode(data.tobytes()).decode("ascii")}
         if data.ndim > 1:
             typed["shape"] = ", ".join(str(n) for n in data.shape)
         return typed
