@@ -115,8 +115,10 @@ def test_sweep_figure_has_frames_slider_and_tip_plot(sweep):
     np.testing.assert_allclose(decode(tip_x["y"]), np.sin(tau) / tau, atol=1e-6)
     np.testing.assert_allclose(np.abs(decode(tip_z["y"])), (1 - np.cos(tau)) / tau, atol=1e-6)
     # each frame redraws the centreline of its own step
+    index = next(i for i, t in enumerate(fig["data"]) if t.get("name") == "centreline")
     for k, frame in enumerate(fig["frames"]):
-        line = next(t for t in frame["data"] if t.get("name") == "centreline")
+        assert index in frame["traces"]
+        line = frame["data"][frame["traces"].index(index)]
         np.testing.assert_allclose(decode(line["x"])[-1], np.sin(tau[k]) / tau[k], atol=1e-6)
 
 

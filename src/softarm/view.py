@@ -275,7 +275,7 @@ def figure(result, *, name: str | None = None, values=None, label: str | None = 
     names = [f"{v:.6g}" for v in values]
     frames = []
     for k, case in enumerate(cases):
-        traces = _scene_traces(case, arrows[k], scales, radii)
+        traces = [_changing(trace) for trace in _scene_traces(case, arrows[k], scales, radii)]
         traces.append({"x": [values[k]] * 3, "y": tips[k].tolist()})
         frames.append({"name": names[k], "data": traces,
                        "traces": [*range(n_scene), len(data) - 1],
@@ -297,6 +297,15 @@ def figure(result, *, name: str | None = None, values=None, label: str | None = 
                     {"label": "❚❚", "method": "animate", "args": [[None], now]}]}]
     layout["margin"]["b"] = 40
     return fig
+
+
+_CHANGING = ("x", "y", "z", "u", "v", "w", "customdata", "text")
+
+
+def _changing(trace: dict) -> dict:
+    """The part of a trace that changes from frame to frame (a frame updates the figure's
+    traces; the mesh's triangles, colours and hover templates stay)."""
+    return {"type": trace["type"], **{k: trace[k] for k in _CHANGING if k in trace}}
 
 
 def _plain(value):
