@@ -36,6 +36,7 @@ import numpy as np
 
 from .case import Case, CaseError
 from .errors import ConvergenceError
+from .geometry import cube_limits
 from .statics import Solver
 from .view import figure, plotly_js_path, scene_traces, to_json
 
@@ -131,18 +132,18 @@ class LiveCase:
         self.values = {item.name: item.value for item in self.inputs}
         self.solver = Solver(case.arm, s=int(case.solve.stations), tol=float(case.solve.tol))
         length = float(case.arm.length)
-        # arrows: each load field's largest slider setting is drawn 0.25 L long (0.12 L for
-        # distributed loads, drawn as several arrows)
+        # arrows: a component at the end of its slider is drawn 0.35 L long (0.2 L for
+        # distributed loads and gravity, drawn as several arrows)
         self.scales = {}
         for item in self.inputs:
             if item.field is not None:
-                largest = math.sqrt(3.0) * max(abs(item.low), abs(item.high))
+                largest = max(abs(item.low), abs(item.high))
                 several = case.loads[item.load].kind not in ("tip", "point")
                 self.scales[(item.load, item.field)] = \
-                    (0.12 if several else 0.25) * length / largest
-        # a fixed cube the arm cannot leave (it reaches at most about L from its base), so
-        # that the view does not jump while the sliders move
-        self.limits = (np.zeros(3), 1.05 * length)
+                    (0.2 if several else 0.35) * length / largest
+        # the axis cube (equal scaling) only grows, so that the view does not jump while the
+        # sliders move; set around the first drawing
+        self.limits = None
 
     def update(self, query: dict[str, str]) -> None:
         """Set inputs from a request's query (BadRequest naming the first bad one)."""
@@ -186,10 +187,32 @@ class LiveCase:
         seconds = time.perf_counter() - start
         result = _with_all_loads(result, self.case.loads, self.values)
         self.result = result
-        return {"data": scene_traces(result, self.scales), "title": _title(self.case, loads),
+        self._grow_limits(result)
+        centre, half = self.limits
+        return {"ranges": [[centre[k] - half, centre[k] + half] for k in range(3)],
+                "data": scene_traces(result, self.scales), "title": _title(self.case, loads),
                 "tip": np.asarray(result.tip_position).tolist(),
                 "solve_ms": 1e3 * seconds, "method": result.method,
                 "residual": float(np.max(result.residual))}
+
+    def _grow_limits(self, result) -> None:
+        """Enlarge the axis cube to hold the drawing of ``result`` (with a 30 % margin the
+        first time and whenever it grows)."""
+        from .geometry import load_arrows, station_radii
+
+        poses = np.asarray(result.poses)
+        radii = station_radii(result.arm, result.s)
+        reach = 0.0 if radii is None else float(np.max(radii))
+        points = [poses[:, :3, 3] + reach, poses[:, :3, 3] - reach]
+        for arrow in load_arrows(result.loads, poses, result.s, result.arm):
+            points.append(arrow.origins + arrow.vectors * self.scales.get(arrow.key, 0.0))
+        points = np.concatenate(points)
+        if self.limits is not None:
+            centre, half = self.limits
+            if np.all(np.abs(points - centre) <= half):
+                return
+            points = np.concatenate([points, [centre - half, centre + half]])
+        self.limits = cube_limits(points, margin=1.3)
 
     def figure(self) -> dict:
         """The page's first figure: the current equilibrium (solved once, from unloaded)."""
@@ -293,6 +316,8 @@ async function send(path) {{
     if (!reply.ok) {{ error.textContent = body.error; return; }}
     error.textContent = "";
     layout.title.text = body.title;
+    ["xaxis", "yaxis", "zaxis"].forEach((axis, k) => {{
+      layout.scene[axis].range = body.ranges[k]; }});
     await Plotly.react("plot", body.data, layout);
     await new Promise(done => requestAnimationFrame(() => requestAnimationFrame(done)));
     const t2 = performance.now();
