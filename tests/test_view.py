@@ -165,3 +165,17 @@ def test_show_writes_the_page(demo, tmp_path):
     _, result = demo
     path = result.show(tmp_path / "shown.html", browser=False)
     assert path.read_text(encoding="utf-8").count("Plotly.newPlot(") == 1
+
+
+def test_view_command_does_not_load_the_solver(tmp_path, demo):
+    # `softarm view` only reads and draws: the compiled solver (numba) stays unloaded
+    case, result = demo
+    softarm.io.save_result(result, tmp_path / "demo.npz", case)
+    code = ("import sys, softarm.cli; code = softarm.cli.main(['view', sys.argv[1]]); "
+            "print(code, 'numba' in sys.modules, 'matplotlib' in sys.modules)")
+    import subprocess
+    import sys
+
+    out = subprocess.run([sys.executable, "-c", code, str(tmp_path / "demo.npz")],
+                         capture_output=True, text=True, check=True)
+    assert out.stdout.split()[-3:] == ["0", "False", "False"]
