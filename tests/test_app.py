@@ -148,3 +148,20 @@ def test_ctrl_c_stops_the_app_cleanly():
             os.kill(child.pid, signal.SIGKILL)
     assert child.returncode == 130
     assert err.strip() == "softarm: interrupted"
+
+
+def test_axis_cube_holds_the_arm_and_only_grows():
+    live = app.LiveCase(softarm.load_case(EXAMPLES / "mattiasson_cantilever.toml"))
+    live.update({"l1.force.z": "0"})
+    first = live.solve()
+    ranges = np.array(first["ranges"])
+    sides = ranges[:, 1] - ranges[:, 0]
+    np.testing.assert_allclose(sides, sides[0])  # equal scaling on x, y and z
+    # straight arm: from the base (0, 0, 0) to the tip (1, 0, 0) m, inside the cube
+    assert np.all(ranges[:, 0] <= 0.0) and ranges[0, 1] >= 1.0
+    live.update({"l1.force.z": "-10"})  # k = 10: the arm hangs far below
+    hanging = np.array(live.solve()["ranges"])
+    assert np.all(hanging[:, 0] <= ranges[:, 0]) and np.all(hanging[:, 1] >= ranges[:, 1])
+    assert hanging[2, 0] <= live.result.tip_position[2]
+    live.update({"l1.force.z": "0"})  # back: the view keeps its size, it does not jump
+    np.testing.assert_allclose(live.solve()["ranges"], hanging)
