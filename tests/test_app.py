@@ -165,3 +165,13 @@ def test_axis_cube_holds_the_arm_and_only_grows():
     assert hanging[2, 0] <= live.result.tip_position[2]
     live.update({"l1.force.z": "0"})  # back: the view keeps its size, it does not jump
     np.testing.assert_allclose(live.solve()["ranges"], hanging)
+
+
+def test_without_plotly_one_line(monkeypatch, capsys):
+    def missing():
+        raise ImportError(softarm.view.PLOTLY_MISSING)
+
+    monkeypatch.setattr(app, "plotly_js_path", missing)
+    code = cli.main(["app", str(EXAMPLES / "mattiasson_cantilever.toml"), "--no-browser"])
+    _, err = capsys.readouterr()
+    assert code == 2 and err.count("\n") == 1 and "pip install 'softarm[view]'" in err

@@ -365,11 +365,12 @@ def _port(text: str) -> int:
 
 def _run_app(args) -> int:
     case = load_case(args.case)
+    from . import app
+
     try:
-        from . import app
-    except ImportError as error:  # pragma: no cover - plotly missing
+        return app.serve(case, port=args.port, browser=not args.no_browser)
+    except ImportError as error:  # plotly missing
         raise CaseError(str(error)) from None
-    return app.serve(case, port=args.port, browser=not args.no_browser)
 
 
 def _run_demo(args) -> int:
