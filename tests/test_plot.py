@@ -80,16 +80,6 @@ def test_line_only_without_sections(tmp_path):
     assert not xz.patches
 
 
-def test_tube_radius_per_segment():
-    arm = helix().arm
-    np.testing.assert_array_equal(plot._radii(arm, np.array([0.0, 0.2, 0.3, 0.4])),
-                                  [0.015, 0.015, 0.01, 0.01])
-    poses = se3.exp(np.linspace(0, 1, 5)[:, None] * [1.0, 0, 0, 0, 0, 0])
-    surface = plot._tube(poses, np.full(5, 0.1))
-    # every surface point lies at distance r from the axis
-    np.testing.assert_allclose(np.hypot(surface[1], surface[2]), 0.1)
-
-
 def test_sweep_png(tmp_path):
     path = tmp_path / "sweep.png"
     fig = plot.plot_sweep(helix(batch=5), [0.0, 1.0, 2.0, 3.0, 4.0], label="k (N)", path=path)

@@ -5,6 +5,8 @@
     softarm solve CASE.toml [-o out.csv|out.json|out.npz] [--plot out.png]
                             [--method auto|numeric] [--stations N] [--tol TOL]
     softarm plot RESULT.(csv|json|npz) [-o out.png]
+    softarm view RESULT.(csv|json|npz) [-o out.html]
+    softarm app CASE.toml [--port PORT] [--no-browser]
     softarm demo [--out DIR]
     softarm reproduce [--out DIR]
 
@@ -135,6 +137,28 @@ def _parser() -> argparse.ArgumentParser:
     plot.add_argument("-o", "--output", metavar="PICTURE",
                       help="picture to write (default: RESULT with suffix .png)")
     plot.set_defaults(run=_run_plot)
+
+    view = commands.add_parser(
+        "view", help="write an interactive 3D view of a saved result (HTML)",
+        description="Write a self-contained HTML file (opens offline in any browser) with an "
+        "interactive 3D view of a result written by 'softarm solve -o': the arm as a tube, "
+        "hover read-outs, the loads; a sweep gets a slider. Needs pip install 'softarm[view]'.")
+    view.add_argument("result", metavar="RESULT", help="result file (.csv, .json or .npz)")
+    view.add_argument("-o", "--output", metavar="HTML",
+                      help="HTML file to write (default: RESULT with suffix .html)")
+    view.set_defaults(run=_run_view)
+
+    app = commands.add_parser(
+        "app", help="explore a case live in the browser, with a slider per load",
+        description="Serve a live view of a case on http://127.0.0.1:PORT: a slider for each "
+        "load component re-solves the arm (following it from its last equilibrium) and "
+        "redraws it. Ctrl-C stops it. Needs pip install 'softarm[view]'.")
+    app.add_argument("case", metavar="CASE.toml", help="case file")
+    app.add_argument("--port", type=_port, default=8050,
+                     help="TCP port on 127.0.0.1 (default 8050; 0: any free port)")
+    app.add_argument("--no-browser", action="store_true",
+                     help="do not open a browser tab, only print the address")
+    app.set_defaults(run=_run_app)
 
     demo = commands.add_parser("demo", help="solve and plot a built-in example",
                                description="Solve the built-in two-segment silicone arm under "
@@ -313,6 +337,41 @@ def _run_plot(args) -> int:
     plot.plot_result_file(saved, path=picture)
     print(f"wrote {picture}")
     return 0
+
+
+def _run_view(args) -> int:
+    source = Path(args.result)
+    page = _check_output(args.output or str(source.with_suffix(".html")), (".html", ".htm"),
+                         "page", [source])
+    saved = load_saved(source)
+    try:
+        from . import view
+
+        view.view_result_file(saved, page)
+    except ImportError as error:  # plotly missing
+        raise CaseError(f"{page}: {error}") from None
+    print(f"wrote {page}")
+    return 0
+
+
+def _port(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be an integer, got {text!r}") from None
+    if not 0 <= value <= 65535:
+        raise argparse.ArgumentTypeError(f"must be in 0 ... 65535, got {value}")
+    return value
+
+
+def _run_app(args) -> int:
+    case = load_case(args.case)
+    from . import app
+
+    try:
+        return app.serve(case, port=args.port, browser=not args.no_browser)
+    except ImportError as error:  # plotly missing
+        raise CaseError(str(error)) from None
 
 
 def _run_demo(args) -> int:

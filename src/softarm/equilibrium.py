@@ -144,6 +144,42 @@ class Equilibrium:
         """Internal moment R m in the spatial frame about the centreline point (N m)."""
         return np.einsum("...ij,...j->...i", self.rotations, self.stresses[..., 3:])
 
+    def show(self, path=None, *, browser: bool = True, **options):
+        """Write an interactive 3D view (:func:`softarm.view.figure`, ``options`` as there) to
+        a self-contained HTML file, ``path`` or a new temporary file, open it in the web
+        browser unless ``browser`` is False, and return its path. Needs plotly
+        (``pip install "softarm[view]"``)."""
+        import tempfile
+        import webbrowser
+        from pathlib import Path
+
+        from .view import write_html
+
+        if path is None:
+            handle, path = tempfile.mkstemp(prefix="softarm-", suffix=".html")
+            import os
+
+            os.close(handle)
+        path = write_html(self, path, **options)
+        if browser:
+            webbrowser.open(Path(path).resolve().as_uri())
+        return path
+
+    def _repr_html_(self) -> str | None:
+        """Jupyter's rich display: the interactive 3D view with plotly.js embedded (about
+        5 MB per displayed result); None (the plain repr) without plotly or for a batch with
+        more than one axis."""
+        try:
+            from .view import figure, to_html
+        except ImportError:  # pragma: no cover - plotly missing
+            return None
+        if len(self.batch_shape) > 1:
+            return None
+        try:
+            return to_html(figure(self), full_html=False)
+        except ImportError:
+            return None
+
     def __repr__(self) -> str:
         tip = np.array2string(self.tip_position, precision=6) if not self.batch_shape else \
             f"batch {self.batch_shape}"

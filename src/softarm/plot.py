@@ -17,6 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .geometry import cube_limits, silhouette, station_radii, tube_surface
+
 __all__ = ["describe_loads", "plot_equilibrium", "plot_result_file", "plot_sweep"]
 
 #: Figure size in inches and resolution of saved pictures (pixels = size × dpi).
@@ -67,38 +69,6 @@ def _range(sweep) -> str:
     return f"{min(values):.4g} … {max(values):.4g} {sweep.unit} ({len(values)} steps)"
 
 
-def _radii(arm, s: np.ndarray):
-    """Tube radius at each station (m), or None if the sections are not known."""
-    segments = arm.segments
-    radii = [a.radius for a in segments]
-    if any(r is None for r in radii):
-        return None
-    bounds = np.asarray(arm.boundaries[1:-1])
-    return np.asarray(radii, dtype=float)[np.searchsorted(bounds, s, side="right")]
-
-
-def _tube(poses: np.ndarray, radii: np.ndarray, sides: int = 24):
-    """Surface points of the tube: p + r (cos φ e2 + sin φ e3), shape (3, N, sides + 1)."""
-    phi = np.linspace(0.0, 2.0 * np.pi, sides + 1)
-    e2, e3 = poses[:, :3, 1], poses[:, :3, 2]
-    ring = np.cos(phi)[None, :, None] * e2[:, None, :] + np.sin(phi)[None, :, None] * e3[:, None]
-    points = poses[:, None, :3, 3] + radii[:, None, None] * ring
-    return np.moveaxis(points, -1, 0)
-
-
-def _silhouette(points2: np.ndarray, radii: np.ndarray) -> np.ndarray:
-    """Outline of a tube of radius r around a planar polyline, shape (2N, 2)."""
-    tangent = np.gradient(points2, axis=0)
-    length = np.linalg.norm(tangent, axis=-1, keepdims=True)
-    # Where the arm points straight out of the plane the outline is a disc; any unit normal
-    # is as good as another there.
-    safe = np.where(length > 0, length, 1.0)
-    normal = np.where(length > 0, np.stack([-tangent[:, 1], tangent[:, 0]], -1) / safe,
-                      np.array([0.0, 1.0]))
-    offset = radii[:, None] * normal
-    return np.concatenate([points2 + offset, (points2 - offset)[::-1]])
-
-
 def _layout(fig):
     grid = fig.add_gridspec(2, 2, width_ratios=(1.25, 1.0), left=0.02, right=0.97,
                             bottom=0.09, top=0.88, wspace=0.18, hspace=0.38)
@@ -109,10 +79,7 @@ def _layout(fig):
 
 def _equal_3d(ax, points: np.ndarray) -> None:
     """Cube limits around ``points`` (..., 3): equal scaling on x, y and z."""
-    points = points.reshape(-1, 3)
-    low, high = points.min(axis=0), points.max(axis=0)
-    centre = 0.5 * (low + high)
-    half = 0.55 * max(float(np.max(high - low)), 1e-9)
+    centre, half = cube_limits(points)
     ax.set_xlim(centre[0] - half, centre[0] + half)
     ax.set_ylim(centre[1] - half, centre[1] + half)
     ax.set_zlim(centre[2] - half, centre[2] + half)
@@ -183,10 +150,10 @@ def plot_equilibrium(result, *, fig=None, path: str | os.PathLike | None = None,
     ax3, side = _layout(fig)
     poses = np.asarray(result.poses)
     p = poses[:, :3, 3]
-    radii = _radii(result.arm, np.asarray(result.s)) if tube else None
+    radii = station_radii(result.arm, result.s) if tube else None
     extent = p
     if radii is not None:
-        surface = _tube(poses, radii)
+        surface = tube_surface(poses, radii)
         step = max(1, len(poses) // 120)
         rows = np.r_[0:len(poses):step, len(poses) - 1]
         # rstride = cstride = 1: every face is a quad. With coarser strides matplotlib pads
@@ -201,7 +168,7 @@ def plot_equilibrium(result, *, fig=None, path: str | os.PathLike | None = None,
     _equal_3d(ax3, extent)
     for ax, ((_, i), (_, j)) in zip(side, _PLANES, strict=True):
         if radii is not None:
-            outline = _silhouette(p[:, [i, j]], radii)
+            outline = silhouette(p[:, [i, j]], radii)
             ax.fill(outline[:, 0], outline[:, 1], color=_TUBE_COLOR, alpha=0.35, linewidth=0)
         ax.plot(p[:, i], p[:, j], color=_LINE_COLOR if radii is None else "tab:red",
                 linewidth=1.2)

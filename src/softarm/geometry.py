@@ -1,0 +1,162 @@
+"""Geometry of a drawn equilibrium, shared by every front end (matplotlib pictures, the HTML
+viewer, the live app): the tube of the arm's real radius, its planar outlines, cube axis limits
+with equal scaling, the tip frame and arrows for the loads.
+
+numpy only: no plotting library is imported here. Positions are in m, in the spatial frame.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = [
+    "Arrow",
+    "cube_limits",
+    "load_arrows",
+    "silhouette",
+    "station_radii",
+    "tip_frame",
+    "tube_mesh",
+    "tube_surface",
+]
+
+
+def station_radii(arm, s) -> np.ndarray | None:
+    """Tube radius (m) at each station ``s`` (m), shape (N,), or None if a segment's cross-section
+    is not known (an arm given by its stiffnesses only). At a joint the tip-side segment's
+    radius is used."""
+    radii = [segment.radius for segment in arm.segments]
+    if any(r is None for r in radii):
+        return None
+    bounds = np.asarray(arm.boundaries[1:-1], dtype=float)
+    index = np.searchsorted(bounds, np.asarray(s, dtype=float), side="right")
+    return np.asarray(radii, dtype=float)[index]
+
+
+def tube_surface(poses, radii, sides: int = 24) -> np.ndarray:
+    """Surface points of the tube p(s) + r(s) (cos φ e2(s) + sin φ e3(s)), φ in [0, 2π].
+
+    ``poses`` (N, 4, 4), ``radii`` (N,) in m. Returns shape (3, N, sides + 1): the x, y and z
+    grids (the first and last columns coincide, closing the tube).
+    """
+    poses = np.asarray(poses, dtype=float)
+    radii = np.asarray(radii, dtype=float)
+    phi = np.linspace(0.0, 2.0 * np.pi, sides + 1)
+    e2, e3 = poses[:, :3, 1], poses[:, :3, 2]
+    ring = np.cos(phi)[None, :, None] * e2[:, None, :] + np.sin(phi)[None, :, None] * e3[:, None]
+    points = poses[:, None, :3, 3] + radii[:, None, None] * ring
+    return np.moveaxis(points, -1, 0)
+
+
+def tube_mesh(poses, radii, sides: int = 16) -> tuple[np.ndarray, np.ndarray]:
+    """The tube as a triangle mesh: vertices (N·sides, 3), ring by ring (vertex ``n·sides + j``
+    at station n, angle φ_j = 2πj/sides, as in :func:`tube_surface`), and triangles
+    (2·(N-1)·sides, 3) of vertex indices, wrapping around each ring. Open at both ends."""
+    points = tube_surface(poses, radii, sides)[:, :, :-1]  # drop the repeated seam column
+    n = points.shape[1]
+    vertices = np.moveaxis(points, 0, -1).reshape(-1, 3)
+    ring = np.arange(n - 1)[:, None] * sides
+    j = np.arange(sides)[None, :]
+    a, b = ring + j, ring + (j + 1) % sides  # this ring: φ_j, φ_j+1
+    c, d = a + sides, b + sides  # the next ring
+    triangles = np.concatenate([np.stack([a, c, b], -1), np.stack([b, c, d], -1)], axis=1)
+    return vertices, triangles.reshape(-1, 3)
+
+
+def silhouette(points2, radii) -> np.ndarray:
+    """Outline of a tube of radius r around a planar polyline (N, 2), shape (2N, 2)."""
+    points2 = np.asarray(points2, dtype=float)
+    radii = np.asarray(radii, dtype=float)
+    tangent = np.gradient(points2, axis=0)
+    length = np.linalg.norm(tangent, axis=-1, keepdims=True)
+    # Where the arm points straight out of the plane the outline is a disc; any unit normal
+    # is as good as another there.
+    safe = np.where(length > 0, length, 1.0)
+    normal = np.where(length > 0, np.stack([-tangent[:, 1], tangent[:, 0]], -1) / safe,
+                      np.array([0.0, 1.0]))
+    offset = radii[:, None] * normal
+    return np.concatenate([points2 + offset, (points2 - offset)[::-1]])
+
+
+def cube_limits(points, margin: float = 1.1) -> tuple[np.ndarray, float]:
+    """(centre (3,), half side) of a cube holding ``points`` (..., 3) with equal scaling on x, y
+    and z; ``margin`` enlarges it (1.1: 10 %)."""
+    points = np.asarray(points, dtype=float).reshape(-1, 3)
+    low, high = points.min(axis=0), points.max(axis=0)
+    centre = 0.5 * (low + high)
+    half = 0.5 * margin * max(float(np.max(high - low)), 1e-9)
+    return centre, half
+
+
+def tip_frame(poses, length: float) -> np.ndarray:
+    """The tip's material frame as three segments of ``length`` (m) from the tip along e1, e2
+    and e3: shape (3, 2, 3) = (axis, [start, end], xyz)."""
+    tip = np.asarray(poses, dtype=float)[-1]
+    start = tip[:3, 3]
+    return np.stack([np.stack([start, start + length * tip[:3, k]]) for k in range(3)])
+
+
+@dataclass(frozen=True)
+class Arrow:
+    """Arrows of one vector field of one load: ``origins`` and spatial ``vectors`` (k, 3), in
+    the load's ``unit``; ``moment``: the vectors are moments (drawn differently from forces);
+    ``key``: (index of the load in the loads, field name), stable when the values change."""
+
+    label: str
+    origins: np.ndarray
+    vectors: np.ndarray
+    unit: str
+    moment: bool = False
+    key: tuple = ()
+
+
+def _at(poses, s, where):
+    """Poses interpolated at arc lengths ``where`` (nearest station; for drawing only)."""
+    index = np.clip(np.searchsorted(s, where), 0, len(s) - 1)
+    return poses[index]
+
+
+def _span(load, arm) -> tuple[float, float]:
+    span = getattr(load, "span", None)
+    if span is not None:
+        return float(span[0]), float(span[1])
+    segment = getattr(load, "segment", None)
+    bounds = arm.boundaries
+    if segment is not None and segment + 1 < len(bounds):
+        return float(bounds[segment]), float(bounds[segment + 1])
+    return 0.0, float(arm.length)
+
+
+def load_arrows(loads, poses, s, arm, count: int = 6) -> list[Arrow]:
+    """Arrows for the (unbatched) ``loads`` acting on the drawn equilibrium (``poses`` (N, 4, 4)
+    at stations ``s`` (N,)): tip and point wrenches at their station, distributed loads and
+    gravity as ``count`` arrows along their span. Follower components are turned into the
+    spatial frame with the material frame where they act. Zero vectors give no arrow."""
+    poses = np.asarray(poses, dtype=float)
+    s = np.asarray(s, dtype=float)
+    arrows = []
+    for index, load in enumerate(loads):
+        kind = getattr(load, "kind", type(load).__name__)
+        follower = bool(getattr(load, "follower", False))
+        if kind == "tip":
+            where = np.array([s[-1]])
+        elif kind == "point":
+            where = np.array([float(load.s)])
+        else:
+            s0, s1 = _span(load, arm)
+            where = np.linspace(s0, s1, count + 2)[1:-1] if kind != "gravity" else \
+                np.linspace(0.0, float(arm.length), count + 2)[1:-1]
+        at = _at(poses, s, where)
+        for name, unit in load.vectors:
+            vector = np.asarray(getattr(load, name), dtype=float)
+            if vector.ndim != 1 or not np.any(vector != 0):
+                continue
+            vectors = at[:, :3, :3] @ vector if follower else \
+                np.broadcast_to(vector, at[:, :3, 3].shape)
+            label = load.describe() if len(load.vectors) == 1 else \
+                f"{'follower ' if follower else ''}{kind} {name}"
+            arrows.append(Arrow(label, at[:, :3, 3].copy(), np.array(vectors), unit,
+                                moment="moment" in name, key=(index, name)))
+    return arrows

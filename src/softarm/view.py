@@ -1,0 +1,376 @@
+"""Interactive 3D views of equilibria in a browser: ``softarm view RESULT -o view.html``,
+:meth:`softarm.Equilibrium.show` and the figures of the live app (``softarm app``).
+
+The figures are built here as plain dicts in plotly's figure schema (``data``, ``layout``,
+``frames``) from :mod:`softarm.geometry`, with numpy only; plotly (``pip install
+"softarm[view]"``) is imported only to write them as a self-contained HTML file, which embeds
+plotly.js and opens without a network.
+
+Drawn: the arm as a tube of its real radius (its centreline when the sections are not known),
+the arm and its centreline with hover read-outs (s, position, strains and stresses in the
+material frame), the tip's material frame (e1 red, e2 green, e3 blue), arrows for the loads (forces
+solid, moments dashed; each load's arrows are scaled to its own largest value, the hover
+gives the value) and the clamped base. A sweep gets a slider over its parameter, a play
+button and a plot of the tip coordinates against the parameter.
+"""
+
+from __future__ import annotations
+
+import base64
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+
+from .geometry import cube_limits, load_arrows, station_radii, tip_frame, tube_mesh, tube_surface
+
+__all__ = ["PLOTLY_MISSING", "figure", "plotly_js_path", "scene_traces", "to_html", "to_json",
+           "view_result_file", "write_html"]
+
+#: The message when plotly is not installed.
+PLOTLY_MISSING = "the browser views need plotly: pip install 'softarm[view]'"
+
+_TUBE = "rgb(255,127,14)"
+_LINE = "rgb(214,39,40)"
+_AXES = ("rgb(220,40,40)", "rgb(40,160,40)", "rgb(40,80,220)")
+_FORCE = "rgb(60,60,60)"
+_MOMENT = "rgb(148,103,189)"
+_SIDES = 16  # tube facets: enough for a smooth look, few enough for a small file
+
+
+def _plotly():
+    try:
+        import plotly.io
+    except ImportError as error:
+        raise ImportError(PLOTLY_MISSING) from error
+    return plotly.io
+
+
+def plotly_js_path() -> Path:
+    """The plotly.min.js file shipped with the installed plotly package (ImportError if none)."""
+    _plotly()
+    import plotly
+
+    path = Path(plotly.__file__).parent / "package_data" / "plotly.min.js"
+    if not path.is_file():  # pragma: no cover - a broken plotly installation
+        raise ImportError(f"plotly.js not found at {path}; reinstall plotly")
+    return path
+
+
+def _vec(v) -> str:
+    return "(" + ", ".join(f"{c:.4g}" for c in np.asarray(v, dtype=float)) + ")"
+
+
+_HOVER = ("s = %{customdata[0]:.4g} m<br>p = (%{x:.4g}, %{y:.4g}, %{z:.4g}) m"
+          "<br>γ = (%{customdata[1]:.3g}, %{customdata[2]:.3g}, %{customdata[3]:.3g})"
+          "<br>κ = (%{customdata[4]:.3g}, %{customdata[5]:.3g}, %{customdata[6]:.3g}) 1/m"
+          "<br>n = (%{customdata[7]:.3g}, %{customdata[8]:.3g}, %{customdata[9]:.3g}) N"
+          "<br>m = (%{customdata[10]:.3g}, %{customdata[11]:.3g}, %{customdata[12]:.3g}) N m"
+          "<br><i>strains, stresses: material frame</i><extra>centreline</extra>")
+
+
+def _arrow_traces(arrows, scales, length: float) -> list[dict]:
+    """Shafts (lines) and heads (cones) of the force arrows, then of the moment arrows."""
+    traces = []
+    for moment in (False, True):
+        xs: list = [[], [], []]
+        text: list = []
+        tips, dirs = [], []
+        for arrow in arrows:
+            if arrow.moment is not moment:
+                continue
+            scale = scales.get(arrow.key, 0.0)
+            for origin, vector in zip(arrow.origins, arrow.vectors, strict=True):
+                norm = float(np.linalg.norm(vector))
+                if norm == 0.0:
+                    continue
+                end = origin + vector * scale
+                for k in range(3):
+                    xs[k] += [float(origin[k]), float(end[k]), None]
+                text += [f"{arrow.label}<br>{_vec(vector)} {arrow.unit}"] * 2 + [None]
+                tips.append(end)
+                dirs.append(vector / norm * 0.06 * length)
+        color = _MOMENT if moment else _FORCE
+        name = "moments" if moment else "forces"
+        traces.append({"type": "scatter3d", "mode": "lines", "x": xs[0], "y": xs[1],
+                       "z": xs[2], "text": text, "hovertemplate": "%{text}<extra></extra>",
+                       "line": {"color": color, "width": 5, "dash": "dash" if moment else
+                                "solid"}, "name": name, "legendgroup": name,
+                       "showlegend": True})
+        tips_a = np.array(tips).reshape(-1, 3)
+        dirs_a = np.array(dirs).reshape(-1, 3)
+        traces.append({"type": "cone", "x": tips_a[:, 0], "y": tips_a[:, 1], "z": tips_a[:, 2],
+                       "u": dirs_a[:, 0], "v": dirs_a[:, 1], "w": dirs_a[:, 2],
+                       "anchor": "tip", "sizemode": "raw", "sizeref": 1.0,
+                       "colorscale": [[0, color], [1, color]], "showscale": False,
+                       "hoverinfo": "skip", "legendgroup": name, "name": name})
+    return traces
+
+
+def _arrow_scales(arrows_per_frame, length: float) -> dict[str, float]:
+    """m per load unit for each load: its largest arrow over all frames is 0.25 L long (tip
+    and point loads) or 0.12 L (distributed loads and gravity, drawn as several arrows)."""
+    largest: dict[str, float] = {}
+    several: dict[str, bool] = {}
+    for arrows in arrows_per_frame:
+        for arrow in arrows:
+            norm = float(np.max(np.linalg.norm(arrow.vectors, axis=-1), initial=0.0))
+            largest[arrow.key] = max(largest.get(arrow.key, 0.0), norm)
+            several[arrow.key] = len(arrow.origins) > 1
+    return {key: (0.12 if several[key] else 0.25) * length / value
+            for key, value in largest.items() if value > 0}
+
+
+def _scene_traces(result, arrows, scales, radii) -> list[dict]:
+    """The traces of one (unbatched) equilibrium, always the same number and order."""
+    poses = np.asarray(result.poses)
+    p = poses[:, :3, 3]
+    length = float(result.arm.length)
+    traces = []
+    custom = np.concatenate([np.asarray(result.s)[:, None], result.strains, result.stresses],
+                            axis=-1)
+    if radii is not None:
+        vertices, triangles = tube_mesh(poses, radii, sides=_SIDES)
+        traces.append({"type": "mesh3d", "x": vertices[:, 0], "y": vertices[:, 1],
+                       "z": vertices[:, 2], "i": triangles[:, 0], "j": triangles[:, 1],
+                       "k": triangles[:, 2], "color": _TUBE, "opacity": 1.0,
+                       "customdata": np.repeat(custom, _SIDES, axis=0),
+                       "hovertemplate": _HOVER.replace("centreline", "arm"), "name": "arm",
+                       "showlegend": True})
+    traces.append({"type": "scatter3d", "mode": "lines+markers", "x": p[:, 0], "y": p[:, 1],
+                   "z": p[:, 2], "customdata": custom, "hovertemplate": _HOVER,
+                   "line": {"color": _LINE, "width": 4}, "marker": {"size": 2, "color": _LINE},
+                   "name": "centreline"})
+    frame = tip_frame(poses, 0.15 * length)
+    for k, axis in enumerate(("e1", "e2", "e3")):
+        traces.append({"type": "scatter3d", "mode": "lines", "x": frame[k, :, 0],
+                       "y": frame[k, :, 1], "z": frame[k, :, 2],
+                       "line": {"color": _AXES[k], "width": 6},
+                       "name": "tip frame e1 e2 e3" if k == 0 else f"tip {axis}",
+                       "legendgroup": "tip frame", "showlegend": k == 0,
+                       "hovertemplate": f"tip frame {axis}<extra></extra>"})
+    traces += _arrow_traces(arrows, scales, length)
+    traces.append({"type": "scatter3d", "mode": "markers", "x": p[:1, 0], "y": p[:1, 1],
+                   "z": p[:1, 2],
+                   "marker": {"symbol": "square", "size": 5, "color": "rgb(80,80,80)"},
+                   "name": "base", "hovertemplate": "clamped base<extra></extra>",
+                   "showlegend": False})
+    return traces
+
+
+def scene_traces(result, scales) -> list[dict]:
+    """The 3D traces of one (unbatched) equilibrium, as in :func:`figure` with ``scales``."""
+    arrows = load_arrows(result.loads, result.poses, result.s, result.arm)
+    return _scene_traces(result, arrows, scales, station_radii(result.arm, result.s))
+
+
+def _extent(result, radii, arrows, scales) -> np.ndarray:
+    poses = np.asarray(result.poses)
+    points = [poses[..., :3, 3].reshape(-1, 3)]
+    if radii is not None:
+        for pose in poses.reshape(-1, *poses.shape[-3:]):
+            points.append(tube_surface(pose, radii, sides=8).reshape(3, -1).T)
+    for frame_arrows in arrows:
+        for arrow in frame_arrows:
+            points.append(arrow.origins + arrow.vectors * scales.get(arrow.key, 0.0))
+    return np.concatenate(points)
+
+
+def _take(result, k: int):
+    """Case k of a batched equilibrium, as an unbatched one (for drawing)."""
+    import dataclasses
+
+    loads = tuple(load.take(k) if load.batch_shape else load for load in result.loads)
+    return dataclasses.replace(result, poses=result.poses[k], strains=result.strains[k],
+                               stresses=result.stresses[k], loads=loads, residual=0.0,
+                               error_estimate=0.0, tip_compliance=None, compliance=None)
+
+
+def _describe(loads) -> str:
+    return " + ".join(load.describe() for load in loads) or "no load"
+
+
+def figure(result, *, name: str | None = None, values=None, label: str | None = None,
+           sweep=None, title: str | None = None, height: int = 650, scales=None,
+           limits=None) -> dict:
+    """The plotly figure (a dict: ``data``, ``layout`` and, for a sweep, ``frames``).
+
+    Parameters
+    ----------
+    result : Equilibrium
+        Batch shape () or (steps,) (a sweep).
+    name : str, optional
+        Case name for the title.
+    values : array_like, shape (steps,), optional
+        A sweep's parameter per step (default ``sweep.values``, else 0, 1, 2, …).
+    label : str, optional
+        The parameter's label with unit (default ``sweep.label``, else "step").
+    sweep : softarm.case.Sweep, optional
+    title : str, optional
+        Replaces the whole title.
+    height : int
+        In pixels.
+    scales : dict, optional
+        Arrow length in m per unit of each load's field, keyed by (load index, field name)
+        (default: each field's largest arrow is 0.25 L, or 0.12 L for distributed loads).
+    limits : (centre (3,), half side), optional
+        The axis cube (default: around everything drawn).
+    """
+    batch = result.batch_shape
+    if len(batch) > 1:
+        raise ValueError(f"result must have batch shape () or (steps,), got {batch}")
+    cases = [result] if not batch else [_take(result, k) for k in range(batch[0])]
+    length = float(result.arm.length)
+    radii = station_radii(result.arm, result.s)
+    arrows = [load_arrows(case.loads, case.poses, case.s, case.arm) for case in cases]
+    scales = _arrow_scales(arrows, length) if scales is None else scales
+    centre, half = cube_limits(_extent(result, radii, arrows, scales)) if limits is None \
+        else limits
+    scene = {"aspectmode": "cube", "domain": {"x": [0.0, 0.64 if batch else 1.0],
+                                              "y": [0.0, 1.0]},
+             "camera": {"eye": {"x": 1.1, "y": -1.6, "z": 0.75}}}
+    for k, axis in enumerate("xyz"):
+        scene[f"{axis}axis"] = {"range": [centre[k] - half, centre[k] + half],
+                                "title": {"text": f"{axis} (m)"}}
+    head = name or "softarm"
+    layout = {"scene": scene, "height": height, "margin": {"l": 10, "r": 10, "t": 60, "b": 10},
+              "legend": {"x": 0.0, "y": 1.0}, "hovermode": "closest",
+              "uirevision": "keep the camera"}
+    data = _scene_traces(cases[0], arrows[0], scales, radii)
+
+    def caption(case) -> str:
+        tip = np.asarray(case.tip_position)
+        text = title if title is not None else f"{head}: {_describe(case.loads)}"
+        return f"{text}<br><sub>tip at {_vec(tip)} m; method {result.method}</sub>"
+
+    layout["title"] = {"text": caption(cases[0]), "x": 0.02, "font": {"size": 14}}
+    fig = {"data": data, "layout": layout}
+    if not batch:
+        return fig
+
+    steps = batch[0]
+    if values is None:
+        values = sweep.values if sweep is not None else np.arange(steps)
+    values = np.asarray(values, dtype=float)
+    if values.shape != (steps,):
+        raise ValueError(f"values must have shape ({steps},), got {values.shape}")
+    if label is None:
+        label = sweep.label if sweep is not None else "step"
+    tips = np.asarray(result.tip_position)
+    n_scene = len(data)
+    for k, axis in enumerate("xyz"):
+        data.append({"type": "scatter", "mode": "lines+markers", "x": values, "y": tips[:, k],
+                     "xaxis": "x", "yaxis": "y", "name": f"tip {axis}",
+                     "line": {"color": _AXES[k]}, "marker": {"size": 5},
+                     "hovertemplate": f"{label} = %{{x:.4g}}<br>tip {axis} = %{{y:.4g}} m"
+                     "<extra></extra>"})
+    data.append({"type": "scatter", "mode": "markers", "x": [values[0]] * 3,
+                 "y": tips[0].tolist(), "xaxis": "x", "yaxis": "y", "name": "shown",
+                 "marker": {"size": 12, "color": "rgba(0,0,0,0)",
+                            "line": {"color": "black", "width": 2}},
+                 "hoverinfo": "skip", "showlegend": False})
+    layout["xaxis"] = {"domain": [0.72, 1.0], "anchor": "y", "title": {"text": label}}
+    layout["yaxis"] = {"domain": [0.3, 0.9], "anchor": "x", "title": {"text": "tip (m)"}}
+    names = [f"{v:.6g}" for v in values]
+    frames = []
+    for k, case in enumerate(cases):
+        traces = [_changing(trace) for trace in _scene_traces(case, arrows[k], scales, radii)]
+        traces.append({"x": [values[k]] * 3, "y": tips[k].tolist()})
+        frames.append({"name": names[k], "data": traces,
+                       "traces": [*range(n_scene), len(data) - 1],
+                       "layout": {"title": {"text": caption(case), "x": 0.02,
+                                            "font": {"size": 14}}}})
+    fig["frames"] = frames
+    now = {"mode": "immediate", "frame": {"duration": 0, "redraw": True},
+           "transition": {"duration": 0}}
+    layout["sliders"] = [{
+        "active": 0, "x": 0.05, "len": 0.9, "y": 0.0, "pad": {"t": 10},
+        "currentvalue": {"prefix": f"{label} = ", "font": {"size": 13}},
+        "steps": [{"label": n, "method": "animate", "args": [[n], now]} for n in names]}]
+    play = {"mode": "immediate", "fromcurrent": True, "frame": {"duration": 400, "redraw": True},
+            "transition": {"duration": 0}}
+    layout["updatemenus"] = [{
+        "type": "buttons", "direction": "left", "x": 0.05, "y": 0.08, "xanchor": "right",
+        "showactive": False,
+        "buttons": [{"label": "▶", "method": "animate", "args": [None, play]},
+                    {"label": "❚❚", "method": "animate", "args": [[None], now]}]}]
+    layout["margin"]["b"] = 40
+    return fig
+
+
+_CHANGING = ("x", "y", "z", "u", "v", "w", "customdata", "text")
+
+
+def _changing(trace: dict) -> dict:
+    """The part of a trace that changes from frame to frame (a frame updates the figure's
+    traces; the mesh's triangles, colours and hover templates stay)."""
+    return {"type": trace["type"], **{k: trace[k] for k in _CHANGING if k in trace}}
+
+
+def _plain(value):
+    if isinstance(value, np.ndarray):
+        return np.where(np.isfinite(value), value, np.nan).tolist() if value.dtype.kind == "f" \
+            else value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    raise TypeError(f"not JSON serialisable: {type(value).__name__}")
+
+
+def to_json(fig: dict) -> str:
+    """The figure as JSON text (numpy arrays as lists), for plotly.js without plotly.py."""
+    return json.dumps(_compact(fig), default=_plain, separators=(",", ":"), allow_nan=False)
+
+
+def _compact(value):
+    """``value`` with numeric arrays as plotly.js typed arrays (``{"dtype": "f4", "bdata":
+    base64, "shape": "N, M"}``): float32 keeps 7 significant digits, more than a drawing or
+    its read-outs show, in a fifth of the characters of decimal text."""
+    if isinstance(value, dict):
+        return {k: _compact(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_compact(v) for v in value]
+    if isinstance(value, np.ndarray) and value.dtype.kind in "fiu" and value.size:
+        dtype = "<f4" if value.dtype.kind == "f" else "<i4"
+        data = np.ascontiguousarray(value, dtype=dtype)
+        typed = {"dtype": dtype[1:], "bdata": base64.b64encode(data.tobytes()).decode("ascii")}
+        if data.ndim > 1:
+            typed["shape"] = ", ".join(str(n) for n in data.shape)
+        return typed
+    return value
+
+
+def to_html(fig: dict, *, full_html: bool = True, div_id: str | None = None) -> str:
+    """A self-contained HTML page (or ``<div>``) of ``fig`` with plotly.js embedded.
+
+    ``div_id``: the id of the figure's ``<div>`` (default: a fresh unique one)."""
+    pio = _plotly()
+    return pio.to_html(_compact(fig), include_plotlyjs=True, full_html=full_html, auto_play=False,
+                       div_id=div_id, validate=False,
+                       config={"displaylogo": False, "responsive": True})
+
+
+def write_html(result, path: str | os.PathLike, **options) -> Path:
+    """Write :func:`figure` (``options`` as there) as a self-contained HTML file, atomically."""
+    from .io import write_atomic
+
+    text = to_html(figure(result, **options), div_id="softarm-view")
+    path = Path(path)
+    with write_atomic(path, "wb") as stream:
+        stream.write(text.encode("utf-8"))
+    return path
+
+
+def view_result_file(source, path: str | os.PathLike) -> Path:
+    """:func:`write_html` for a result file written by :func:`softarm.io.save_result` (CSV,
+    JSON or NPZ; a path or a :class:`softarm.io.SavedResult`)."""
+    from .io import SavedResult, load_saved
+
+    saved = source if isinstance(source, SavedResult) else load_saved(source)
+    result = saved.result
+    if len(result.batch_shape) > 1:
+        raise ValueError(f"{saved.path}: cannot view a batch of shape {result.batch_shape}")
+    case = saved.case
+    return write_html(result, path, name=case.name if case is not None else None,
+                      values=saved.sweep_values, label=saved.sweep_label,
+                      sweep=case.sweep if case is not None else None)

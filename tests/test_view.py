@@ -1,0 +1,181 @@
+"""The HTML viewer without a browser: the figure's numbers against the equilibrium drawn, the
+self-contained page, `softarm view` on the command line and the notebook display."""
+
+from __future__ import annotations
+
+import base64
+import json
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import softarm
+from softarm import cli
+
+pytest.importorskip("plotly", reason="the viewer needs plotly: pip install 'softarm[view]'")
+
+from softarm import view
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+
+
+def decode(value):
+    """A plotly.js typed array {"dtype": "f4", "bdata", "shape"} as numpy (plotly.js's own
+    format: little-endian float32 in base64, shape "N, M"), or the value as an array."""
+    if isinstance(value, dict):
+        array = np.frombuffer(base64.b64decode(value["bdata"]), dtype="<f4")
+        shape = value.get("shape")
+        return array.reshape([int(n) for n in shape.split(",")]) if shape else array
+    return np.asarray(value, dtype=float)
+
+
+@pytest.fixture(scope="module")
+def demo():
+    case = softarm.load_case(EXAMPLES / "demo.toml")
+    return case, softarm.solve(case.arm, case.loads)
+
+
+@pytest.fixture(scope="module")
+def sweep():
+    case = softarm.load_case(EXAMPLES / "fig2_sweep.toml")
+    return case, softarm.case.solve_case(case)
+
+
+def traces(fig, name, kind=("scatter3d", "surface", "scatter")):
+    return [t for t in fig["data"] if t.get("name") == name and t["type"] in kind]
+
+
+def test_figure_draws_the_equilibrium(demo):
+    case, result = demo
+    fig = json.loads(view.to_json(view.figure(result, name=case.name)))
+    (line,) = traces(fig, "centreline")
+    p = np.asarray(result.positions)
+    for k, axis in enumerate("xyz"):
+        np.testing.assert_allclose(decode(line[axis]), p[:, k], rtol=1e-6, atol=1e-7)
+    # hover read-outs: s, strains (γ; κ), stresses (n; m), material frame
+    custom = decode(line["customdata"])
+    expected = np.concatenate([result.s[:, None], result.strains, result.stresses], -1)
+    np.testing.assert_allclose(custom, expected, rtol=1e-6, atol=1e-9)
+    # the tube: every vertex at the segment's radius (16 mm, then 11 mm) from the axis, with
+    # the read-outs of its station
+    (tube,) = traces(fig, "arm", ("mesh3d",))
+    vertices = np.stack([decode(tube[a]) for a in "xyz"], -1).reshape(p.shape[0], -1, 3)
+    distance = np.linalg.norm(vertices - p[:, None, :], axis=-1)
+    radius = np.where(result.s < 0.25, 0.016, 0.011)  # demo.toml: segment radii
+    np.testing.assert_allclose(distance, np.broadcast_to(radius[:, None], distance.shape),
+                               rtol=1e-5)
+    np.testing.assert_allclose(decode(tube["customdata"])[::vertices.shape[1]], expected,
+                               rtol=1e-6, atol=1e-9)
+    assert np.max(decode(tube["i"])) < vertices.shape[0] * vertices.shape[1]
+    surface = vertices
+    # the tip frame: 0.15 L along each column of R(L)
+    (e1,) = traces(fig, "tip frame e1 e2 e3")
+    tip = np.stack([decode(e1[a]) for a in "xyz"], -1)
+    np.testing.assert_allclose(tip[1] - tip[0], 0.15 * 0.4 * result.tip[:3, 0], atol=1e-6)
+    # equal axis scaling: a cube holding every point drawn
+    scene = fig["layout"]["scene"]
+    assert scene["aspectmode"] == "cube"
+    ranges = np.array([scene[f"{a}axis"]["range"] for a in "xyz"])
+    np.testing.assert_allclose(ranges[:, 1] - ranges[:, 0], ranges[0, 1] - ranges[0, 0])
+    assert np.all(ranges[:, 0] <= surface.min(axis=(0, 1)))
+    assert np.all(ranges[:, 1] >= surface.max(axis=(0, 1)))
+
+
+def test_load_arrows_in_the_figure(demo):
+    _, result = demo
+    fig = json.loads(view.to_json(view.figure(result)))
+    (forces,) = traces(fig, "forces")
+    x = np.array([np.nan if v is None else v for v in forces["x"]])
+    ends = np.stack([np.array([np.nan if v is None else v for v in forces[a]])
+                     for a in "xyz"], -1).reshape(-1, 3, 3)[:, :2]
+    assert len(ends) == 6 + 1 and np.isfinite(x).sum() == 14  # 6 gravity arrows, 1 tip
+    tip_arrow = ends[-1]
+    np.testing.assert_allclose(tip_arrow[0], result.tip_position, atol=1e-12)
+    direction = (tip_arrow[1] - tip_arrow[0]) / np.linalg.norm(tip_arrow[1] - tip_arrow[0])
+    force = np.array([0.0, 0.15, -0.4])  # demo.toml, the tip load (dead: spatial)
+    np.testing.assert_allclose(direction, force / np.linalg.norm(force), atol=1e-12)
+    assert "0.15" in forces["text"][-2] and "N" in forces["text"][-2]
+
+
+def test_sweep_figure_has_frames_slider_and_tip_plot(sweep):
+    case, result = sweep
+    fig = json.loads(view.to_json(view.figure(result, sweep=case.sweep, name=case.name)))
+    values = np.asarray(case.sweep.values)
+    assert [f["name"] for f in fig["frames"]] == [f"{v:.6g}" for v in values]
+    slider = fig["layout"]["sliders"][0]
+    assert [s["args"][0] for s in slider["steps"]] == [[f["name"]] for f in fig["frames"]]
+    assert fig["layout"]["updatemenus"][0]["buttons"][0]["label"] == "▶"
+    # the tip against the parameter: pure bending, tip = (sin(τL)/τ, 0, (1 - cos τL)/τ)
+    # for EI = 1 N m², L = 1 m (circular arc of curvature τ/EI, paper Fig. 2)
+    tip_x, tip_z = traces(fig, "tip x")[0], traces(fig, "tip z")[0]
+    np.testing.assert_allclose(decode(tip_x["x"]), values)
+    tau = values
+    np.testing.assert_allclose(decode(tip_x["y"]), np.sin(tau) / tau, atol=1e-6)
+    np.testing.assert_allclose(np.abs(decode(tip_z["y"])), (1 - np.cos(tau)) / tau, atol=1e-6)
+    # each frame redraws the centreline of its own step
+    index = next(i for i, t in enumerate(fig["data"]) if t.get("name") == "centreline")
+    for k, frame in enumerate(fig["frames"]):
+        assert index in frame["traces"]
+        line = frame["data"][frame["traces"].index(index)]
+        np.testing.assert_allclose(decode(line["x"])[-1], np.sin(tau[k]) / tau[k], atol=1e-6)
+
+
+def test_page_is_self_contained(demo, tmp_path):
+    _, result = demo
+    path = view.write_html(result, tmp_path / "demo.html")
+    text = path.read_text(encoding="utf-8")
+    assert not re.search(r"<script[^>]+src=", text), "the page must not load scripts"
+    assert "plotly.js v" in text[:200000]  # the library itself is embedded
+    assert 'Plotly.newPlot(' in text and '"softarm-view"' in text
+
+
+def test_cli_view(tmp_path, capsys, sweep):
+    result_file = tmp_path / "fig2.npz"
+    assert cli.main(["solve", str(EXAMPLES / "fig2_sweep.toml"), "-o", str(result_file)]) == 0
+    assert cli.main(["view", str(result_file)]) == 0
+    assert (tmp_path / "fig2.html").stat().st_size > 1_000_000
+    assert cli.main(["view", str(result_file), "-o", str(tmp_path / "v.html")]) == 0
+    out, _ = capsys.readouterr()
+    assert f"wrote {tmp_path / 'v.html'}" in out
+    for argv, message in [
+        (["view", str(tmp_path / "missing.npz")], "no such file"),
+        (["view", str(result_file), "-o", str(tmp_path / "v.png")], "unknown page format"),
+        (["view", str(result_file), "-o", str(tmp_path / "nofolder" / "v.html")],
+         "does not exist"),
+    ]:
+        assert cli.main(argv) == 2
+        _, err = capsys.readouterr()
+        assert err.count("\n") == 1 and message in err and "Traceback" not in err
+
+
+def test_notebook_display(demo):
+    _, result = demo
+    html = result._repr_html_()
+    assert html.startswith("<div") and "Plotly.newPlot(" in html
+    poses = np.broadcast_to(result.poses, (2, 2, *result.poses.shape))
+    batch = softarm.Equilibrium(result.s, poses,
+                                np.zeros((2, 2, result.s.size, 6)),
+                                np.zeros((2, 2, result.s.size, 6)), result.arm, (), "x", True)
+    assert batch._repr_html_() is None
+
+
+def test_show_writes_the_page(demo, tmp_path):
+    _, result = demo
+    path = result.show(tmp_path / "shown.html", browser=False)
+    assert path.read_text(encoding="utf-8").count("Plotly.newPlot(") == 1
+
+
+def test_view_command_does_not_load_the_solver(tmp_path, demo):
+    # `softarm view` only reads and draws: the compiled solver (numba) stays unloaded
+    case, result = demo
+    softarm.io.save_result(result, tmp_path / "demo.npz", case)
+    code = ("import sys, softarm.cli; code = softarm.cli.main(['view', sys.argv[1]]); "
+            "print(code, 'numba' in sys.modules, 'matplotlib' in sys.modules)")
+    import subprocess
+    import sys
+
+    out = subprocess.run([sys.executable, "-c", code, str(tmp_path / "demo.npz")],
+                         capture_output=True, text=True, check=True)
+    assert out.stdout.split()[-3:] == ["0", "False", "False"]
