@@ -6,7 +6,7 @@ import dataclasses
 
 import numpy as np
 
-from ..loads import TipLoad, as_loads, batch_shape
+from ..loads import as_loads, batch_shape
 from ..model import SegmentedArm
 from ._common import check_arm, checked_stations, moment_is_principal
 from .elastica import solve_elastica
@@ -16,11 +16,39 @@ from .moment import helix_applies, solve_tip_moment
 __all__ = ["exact_closed_form"]
 
 
-def _tip_wrench(loads, shape):
-    """Summed force and moment of tip loads sharing one frame, shape B + (3,) each."""
-    force = sum(np.broadcast_to(load.force, (*shape, 3)) for load in loads)
-    moment = sum(np.broadcast_to(load.moment, (*shape, 3)) for load in loads)
-    return np.array(force, dtype=np.float64), np.array(moment, dtype=np.float64)
+class _TipWrench:
+    """A :class:`~softarm.loads.LoadTarget` that sums the tip wrenches of the loads, dead and
+    follower apart, and notes any other channel (distributed, interior point, or a channel it
+    does not know): the closed forms here apply to tip wrenches alone. It fails closed, so a
+    new kind of load never reaches a closed form that ignores it."""
+
+    def __init__(self, arm, shape):
+        self.arm, self.length = arm, arm.length
+        self.wrench = {False: np.zeros((*shape, 6)), True: np.zeros((*shape, 6))}
+        self.used = set()
+        self.other = False
+
+    def tip(self, *, force=None, moment=None, follower=False):
+        self.used.add(bool(follower))
+        if force is not None:
+            self.wrench[bool(follower)][..., :3] += force
+        if moment is not None:
+            self.wrench[bool(follower)][..., 3:] += moment
+
+    def point(self, s, *, force=None, moment=None):
+        if s >= self.length:
+            self.tip(force=force, moment=moment)
+        else:
+            self.other = True
+
+    def distributed(self, **_):
+        self.other = True
+
+    def __getattr__(self, name):  # any other channel: no closed form here
+        if name.startswith("__"):
+            raise AttributeError(name)
+        self.other = True
+        return lambda *args, **kwargs: None
 
 
 def exact_closed_form(arm, loads, s=None):
@@ -38,8 +66,10 @@ def exact_closed_form(arm, loads, s=None):
       GAy = GAz): the extensible, shearable :func:`elastica`;
     * a zero tip wrench: the undeformed arm (an empty list of loads gives None).
 
-    Several TipLoads in the same frame are summed; any other load (Gravity, DistributedForce,
-    PointLoad), mixed dead/follower tip loads, a force together with a moment, a follower
+    Several tip wrenches in the same frame are summed (through each load's
+    :meth:`~softarm.Load.apply`, so a point load at s = L counts as one); any other load
+    (gravity, distributed, interior point loads), mixed dead/follower tip loads, a force
+    together with a moment, a follower
     transverse force or a SegmentedArm give None.
 
     Parameters
@@ -74,15 +104,15 @@ def exact_closed_form(arm, loads, s=None):
     arm = check_arm(arm, "exact_closed_form")
     loads = as_loads(loads)
     s = checked_stations(s, arm.length)
-    if not loads or not all(isinstance(load, TipLoad) for load in loads):
+    if not loads:
         return None
-    if len({bool(load.follower) for load in loads}) != 1:
+    target = _TipWrench(arm, batch_shape(loads))
+    for load in loads:
+        load.apply(target)
+    if target.other or len(target.used) != 1:  # other loads, or dead and follower mixed
         return None
-    follower = bool(loads[0].follower)
-    if len(loads) == 1 and loads[0].force.shape == loads[0].moment.shape == (3,):
-        force, moment = loads[0].force, loads[0].moment  # one unbatched load: no summing
-    else:
-        force, moment = _tip_wrench(loads, batch_shape(loads))
+    follower = target.used.pop()
+    force, moment = target.wrench[follower][..., :3], target.wrench[follower][..., 3:]
     result = _dispatch(arm, force, moment, follower, s, loads)
     if result is None or not result.exact:
         return None
