@@ -115,6 +115,9 @@ _DLAM_MIN = 1e-5
 # first load step predicts a tip motion of about _FIRST_MOTION (L or rad).
 _LOOSE = 1e-2
 _FIRST_MOTION = 0.15
+# A residual that stops decreasing is accepted within this factor of the threshold (round-off
+# of an ill-conditioned shooting map; still 1e-9 of the case's own load).
+_STALL = 1e3
 # A step across which det ∂r/∂x changes sign is accepted only when no longer than this.
 _DLAM_CROSS = 1e-3
 # Refinement of a solution under a change of step count: distances are of the order of the
@@ -500,7 +503,7 @@ def _corrector(x, lam, nt, steps, base, arm, case, scratch, scale, dscale, lengt
                 return False
         elif size > _CONTRACTION_MAX * previous:
             # a step at round-off level cannot contract further: accept a tiny residual
-            return res <= 1e3 * threshold
+            return res <= _STALL * threshold
         previous = size
         travelled += size
         if travelled > first_limit:
@@ -824,8 +827,8 @@ def _first_steps(arm, tol, turning):
 
 
 @_jit
-def _chord(x, J_c, steps, base, arm, case, scratch, scale, threshold, max_iterations, r,
-           J, tip, counter):
+def _chord(x, J_c, steps, base, arm, case, scratch, scale, threshold, max_iterations,
+           may_defer, r, J, tip, counter):
     """The solution at λ = 1 with another step count by chord iterations from x (a solution
     with a nearby step count) with that solution's Jacobian J_c, state only (no tangents).
 
@@ -833,7 +836,10 @@ def _chord(x, J_c, steps, base, arm, case, scratch, scale, threshold, max_iterat
     each iteration must at least halve the residual. Returns 0 (failed), 1 (converged: r and
     tip are x's) or 2 (the last step was taken without integrating it, because the observed
     contraction predicts a residual below the threshold: the output pass checks it, and
-    ``tip`` is the position before that step, an error of the order of the step).
+    ``tip`` is the position before that step, an error of the order of the step; only if
+    ``may_defer``). A residual that stops halving is accepted if within ``_STALL`` times the
+    threshold: the round-off floor of an ill-conditioned shooting map (a long, thin, stiff
+    wire), still 1e-9 of the case's own load.
     """
     dx = np.empty(6)
     previous = np.inf
@@ -846,7 +852,11 @@ def _chord(x, J_c, steps, base, arm, case, scratch, scale, threshold, max_iterat
         res = _norm_scaled(r, scale)
         if res <= threshold:
             return 1
-        if not res < 0.5 * previous or not _newton_step(J_c, r, dx):
+        if not res < 0.5 * previous:
+            # stalled: at round-off for this problem's conditioning, if small against the
+            # case's own load (1e-9 of it), else a failure
+            return 1 if res <= _STALL * threshold else 0
+        if not _newton_step(J_c, r, dx):
             return 0
         if not math.isfinite(previous):  # the first step: a change of discretisation only
             size = 0.0
@@ -861,7 +871,7 @@ def _chord(x, J_c, steps, base, arm, case, scratch, scale, threshold, max_iterat
         previous = res
         for i in range(6):
             x[i] += dx[i]
-        if rate * res <= threshold:
+        if may_defer and rate * res <= threshold:
             return 2
     return 0
 
@@ -978,6 +988,7 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, out):
         fine_path = False
         recorded = False
         resume = False
+        deferred_failed = False
         while True:
             if path:
                 # the path on a coarse grid (N / coarse_ratio steps) unless that failed
@@ -1034,7 +1045,7 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, out):
                 _copy(x, x_f)
             resume = False
             fine = _chord(x_f, J_c, steps, base, arm, case, scratch, scale, threshold,
-                          max_iterations, r, J, tip_f, counter)
+                          max_iterations, not deferred_failed, r, J, tip_f, counter)
             if fine == 0:
                 _copy(x, x_f)
                 fine = _corrector(x_f, 1.0, six, steps, base, arm, case, scratch, scale, dscale,
@@ -1062,6 +1073,7 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, out):
                         break
                     path = False
                     resume = True
+                    deferred_failed = True  # from now on every chord step is integrated
                     continue  # not converged after all: chord again from here
                 break
             if 2 * N >= n_max:
