@@ -816,13 +816,15 @@ def _load_size(arm, scale, start, end, tip_start, tip_end):
 
 @_jit
 def _first_steps(arm, tol, turning):
-    """The first coarse step count: 0.1 (1 + turning) (tol/L)^-1/4, in [2, 256]."""
+    """The first coarse step count: 0.07 (1 + turning) (tol/L)^-1/4, in [2, 256] (the
+    constant measured: the Richardson estimate then lands at 0.003-0.5 tol on the benchmark
+    cases, so N rarely has to grow)."""
     kappa0 = 0.0
     for j in range(arm[1].size):
         kappa0 += arm[1][j] * math.sqrt(arm[3][j, 3] ** 2 + arm[3][j, 4] ** 2
                                         + arm[3][j, 5] ** 2)
     rel = tol / arm[6] if math.isfinite(tol) else 1e-8
-    n = math.ceil(0.1 * (1.0 + kappa0 + turning) * rel ** -0.25)
+    n = math.ceil(0.07 * (1.0 + kappa0 + turning) * rel ** -0.25)
     return min(256, max(2, n))
 
 
