@@ -17,6 +17,7 @@ __all__ = [
     "load_arrows",
     "silhouette",
     "station_radii",
+    "sweep_axis",
     "tip_frame",
     "tube_mesh",
     "tube_surface",
@@ -160,3 +161,17 @@ def load_arrows(loads, poses, s, arm, count: int = 6) -> list[Arrow]:
             arrows.append(Arrow(label, at[:, :3, 3].copy(), np.array(vectors), unit,
                                 moment="moment" in name, key=(index, name)))
     return arrows
+
+
+def sweep_axis(steps: int, sweep=None, values=None, label=None) -> tuple[np.ndarray, str]:
+    """The parameter values (shape (steps,)) and axis label of a sweep result's batch axis:
+    ``values``/``label`` as given, else the sweep's (a :class:`softarm.sweep.Sweep`), else the
+    step index. ValueError if ``values`` has the wrong shape."""
+    if values is None:
+        values = sweep.values if sweep is not None else np.arange(steps)
+    values = np.asarray(values, dtype=float)
+    if values.shape != (steps,):
+        raise ValueError(f"values must have shape ({steps},), got {values.shape}")
+    if label is None:
+        label = sweep.label if sweep is not None else "step"
+    return values, label

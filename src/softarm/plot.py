@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .geometry import cube_limits, silhouette, station_radii, tube_surface
+from .geometry import cube_limits, silhouette, station_radii, sweep_axis, tube_surface
 
 __all__ = ["describe_loads", "plot_equilibrium", "plot_result_file", "plot_sweep"]
 
@@ -211,13 +211,7 @@ def plot_sweep(result, values=None, *, label: str | None = None, fig=None,
                          f"{result.batch_shape}")
     matplotlib, Figure = _matplotlib()
     steps = result.batch_shape[0]
-    if values is None:
-        values = sweep.values if sweep is not None else np.arange(steps)
-    values = np.asarray(values, dtype=float)
-    if values.shape != (steps,):
-        raise ValueError(f"values must have shape ({steps},), got {values.shape}")
-    if label is None:
-        label = sweep.label if sweep is not None else "step"
+    values, label = sweep_axis(steps, sweep, values, label)
     fig = Figure(figsize=FIGSIZE) if fig is None else fig
     fig.clear()
     ax3, side = _layout(fig)

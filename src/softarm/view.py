@@ -23,7 +23,15 @@ from pathlib import Path
 
 import numpy as np
 
-from .geometry import cube_limits, load_arrows, station_radii, tip_frame, tube_mesh, tube_surface
+from .geometry import (
+    cube_limits,
+    load_arrows,
+    station_radii,
+    sweep_axis,
+    tip_frame,
+    tube_mesh,
+    tube_surface,
+)
 
 __all__ = ["PLOTLY_MISSING", "figure", "plotly_js_path", "scene_traces", "to_html", "to_json",
            "view_result_file", "write_html"]
@@ -250,13 +258,7 @@ def figure(result, *, name: str | None = None, values=None, label: str | None = 
         return fig
 
     steps = batch[0]
-    if values is None:
-        values = sweep.values if sweep is not None else np.arange(steps)
-    values = np.asarray(values, dtype=float)
-    if values.shape != (steps,):
-        raise ValueError(f"values must have shape ({steps},), got {values.shape}")
-    if label is None:
-        label = sweep.label if sweep is not None else "step"
+    values, label = sweep_axis(steps, sweep, values, label)
     tips = np.asarray(result.tip_position)
     n_scene = len(data)
     for k, axis in enumerate("xyz"):

@@ -507,3 +507,53 @@ def test_r8_import_and_solve_without_a_writable_cache(tmp_path):
     assert out["tip"][2] == pytest.approx(0.30172, abs=2e-5)
     warned = out["import_warnings"] + out["solve_warnings"]
     assert any("NUMBA_CACHE_DIR" in w for w in warned), warned
+
+
+# ---------------------------------------------------------------------------------------------
+# a fold is named, never stepped over
+
+
+def _folding_arm_and_loads():
+    """A two-segment precurved silicone arm under gravity, a tip load and a follower
+    distributed force (case 145 of the large invariant run): its loading path folds."""
+    from softarm import Arm, Circle, Material, SegmentedArm
+    arm = SegmentedArm((
+        Arm(0.057223175772382645, Circle(0.006442504304126564),
+            Material(1412509.6998014837, 0.45838143782569835, density=1166.3554475481694)),
+        Arm(0.06618812950420067, Circle(0.003616947541333363),
+            Material(3375017.1648721294, 0.46084365394229315, density=1062.677284099753),
+            curvature=(0.585028501892152, 19.629228462126353, 3.855973461989754)),
+    ))
+    loads = [softarm.Gravity([0.5343718257142738, 8.975736710575093, -3.922588081142014]),
+             softarm.TipLoad(force=[-0.16034632351717393, -0.2942841125760248,
+                                    0.08767939608339592],
+                             moment=[-0.0004259798954824446, 5.268703753457297e-05,
+                                     5.146484277363034e-05]),
+             softarm.DistributedForce([7.498238810500564, 7.297987066688497,
+                                       0.7367217597926948], follower=True)]
+    return arm, loads
+
+
+def test_a_fold_is_named_with_its_load_factor():
+    """The solve stops at the fold with its load factor. Independent evidence that it is a
+    fold (a second method): along the path followed quasi-statically, det ∂r/∂x from the
+    shooting primitive at 400 fixed steps falls to zero like √(λ_c - λ), the signature of a
+    limit point, and extrapolates to the same λ_c."""
+    arm, loads = _folding_arm_and_loads()
+    with pytest.raises(softarm.ConvergenceError) as info:
+        softarm.solve(arm, loads)
+    lam_c = info.value.load_factor
+    assert 0.63 < lam_c < 0.65 and f"{lam_c:.6g}" in str(info.value)
+    solver = softarm.statics.Solver(arm, tol=1e-8)
+    lams = np.array([0.62, 0.63, 0.64])
+    dets = []
+    for lam in lams:
+        scaled = [load.scaled(lam) for load in loads]
+        eq = solver.solve(scaled)
+        x = eq.stresses[0]  # the base reaction: R(0) = I, material = spatial components
+        dets.append(np.linalg.det(solver.shoot(scaled, x, steps=400).jacobian_x))
+    # det² linear in λ near a fold: its zero from the last two points
+    d2 = np.square(dets)
+    assert np.all(np.diff(d2) < 0)
+    root = lams[1] - d2[1] * (lams[2] - lams[1]) / (d2[2] - d2[1])
+    assert abs(root - lam_c) < 2e-3, (root, lam_c)

@@ -395,14 +395,12 @@ def _integrate(x, lam, nt, steps, base, arm, case, scratch, r, J):
 
 
 @_jit
-def _linear_solve(A, b, out, cols):
-    """out = A[:, :6]⁻¹ b by Gaussian elimination with partial pivoting; False if singular
-    or not finite. ``cols`` > 0 also solves for the columns A[:, 6:6+cols] into out[:, 1:]."""
-    M = np.empty((6, 7))
-    for i in range(6):
-        for k in range(6):
-            M[i, k] = A[i, k]
-        M[i, 6] = b[i]
+def _eliminate(M):
+    """Gaussian elimination with partial pivoting of the 6 rows of M in place (the first 6
+    columns are the matrix, any further ones right-hand sides). Returns the sign of the
+    determinant (the permutation's sign times the pivots'), 0.0 if singular."""
+    sign = 1.0
+    cols = M.shape[1]
     for c in range(6):
         p = c
         best = abs(M[c, c])
@@ -411,14 +409,30 @@ def _linear_solve(A, b, out, cols):
                 best = abs(M[i, c])
                 p = i
         if not best > 0.0:
-            return False
+            return 0.0
         if p != c:
-            for k in range(7):
+            sign = -sign
+            for k in range(cols):
                 M[c, k], M[p, k] = M[p, k], M[c, k]
+        if M[c, c] < 0.0:
+            sign = -sign
         for i in range(c + 1, 6):
             g = M[i, c] / M[c, c]
-            for k in range(c, 7):
+            for k in range(c, cols):
                 M[i, k] -= g * M[c, k]
+    return sign
+
+
+@_jit
+def _linear_solve(A, b, out):
+    """out = A[:, :6]⁻¹ b; False if singular or not finite."""
+    M = np.empty((6, 7))
+    for i in range(6):
+        for k in range(6):
+            M[i, k] = A[i, k]
+        M[i, 6] = b[i]
+    if _eliminate(M) == 0.0:
+        return False
     for c in range(5, -1, -1):
         acc = M[c, 6]
         for k in range(c + 1, 6):
@@ -436,7 +450,7 @@ def _newton_step(J, r, dx):
     neg = np.empty(6)
     for i in range(6):
         neg[i] = -r[i]
-    return _linear_solve(J, neg, dx, 0)
+    return _linear_solve(J, neg, dx)
 
 
 @_jit
@@ -520,34 +534,14 @@ def _corrector(x, lam, nt, steps, base, arm, case, scratch, scale, dscale, lengt
 
 @_jit
 def _det_sign(J):
-    """The sign of det ∂r/∂x (J[:, :6]) by Gaussian elimination with partial pivoting; 0 if
-    singular. Its parity is that of the number of unstable directions: a change between
-    two points of the path means a singular point (fold or bifurcation) between them."""
+    """The sign of det ∂r/∂x (J[:, :6]); 0 if singular. Its parity is that of the number of
+    unstable directions: a change between two points of the path means a singular point
+    (fold or bifurcation) between them."""
     M = np.empty((6, 6))
     for i in range(6):
         for k in range(6):
             M[i, k] = J[i, k]
-    sign = 1.0
-    for c in range(6):
-        p = c
-        best = abs(M[c, c])
-        for i in range(c + 1, 6):
-            if abs(M[i, c]) > best:
-                best = abs(M[i, c])
-                p = i
-        if not best > 0.0:
-            return 0.0
-        if p != c:
-            sign = -sign
-            for k in range(6):
-                M[c, k], M[p, k] = M[p, k], M[c, k]
-        if M[c, c] < 0.0:
-            sign = -sign
-        for i in range(c + 1, 6):
-            g = M[i, c] / M[c, c]
-            for k in range(c, 6):
-                M[i, k] -= g * M[c, k]
-    return sign
+    return _eliminate(M)
 
 
 @_jit
@@ -576,7 +570,7 @@ def _tangent(J, t):
     rhs = np.empty(6)
     for i in range(6):
         rhs[i] = -J[i, LAM]
-    return _linear_solve(J, rhs, t, 0)
+    return _linear_solve(J, rhs, t)
 
 
 @_jit

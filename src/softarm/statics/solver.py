@@ -68,10 +68,6 @@ def check_tol(tol) -> float:
     return tol
 
 
-def _check_count(value, name: str, low: int) -> int:
-    return count(value, name, low)
-
-
 def _normal_positive(values, what: str) -> None:
     """ValueError unless every value is finite and a positive normal float."""
     values = np.asarray(values, dtype=np.float64)
@@ -289,16 +285,16 @@ class Solver:
         self.tol = check_tol(tol)
         self.base = check_base(base)
         self._base_kernel = self.base.copy()  # private and writable (one kernel type)
-        self.max_iterations = _check_count(max_iterations, "max_iterations", 1)
+        self.max_iterations = count(max_iterations, "max_iterations", 1)
         self.max_load_step = real(max_load_step, "max_load_step")
         if not 0.0 < self.max_load_step <= 1.0:
             raise ValueError(f"max_load_step must be a load-factor step in (0, 1], got "
                              f"{max_load_step!r}")
-        if steps is not None and (_check_count(steps, "steps", 2) % 2 or steps > _N_MAX):
+        if steps is not None and (count(steps, "steps", 2) % 2 or steps > _N_MAX):
             raise ValueError(f"steps must be an even integer in [2, {_N_MAX}], got {steps!r}")
         self.steps = steps
-        self.max_steps = _check_count(max_steps, "max_steps", 4)
-        self.max_shootings = _check_count(max_shootings, "max_shootings", 1)
+        self.max_steps = count(max_steps, "max_steps", 4)
+        self.max_shootings = count(max_shootings, "max_shootings", 1)
         self._coarse_ratio = 4  # the path runs on N / 4 steps (benchmarks/run.py measures it)
         self.reset()
 
@@ -462,7 +458,7 @@ class Solver:
         x = np.asarray(x, dtype=np.float64)
         if x.shape != (6,) or not np.all(np.isfinite(x)):
             raise ValueError(f"x must be 6 finite numbers (n(0); m(0)), got {x!r}")
-        n = 200 if steps is None else _check_count(steps, "steps", 1)
+        n = 200 if steps is None else count(steps, "steps", 1)
         counts = np.maximum(1, np.floor(n * pieces[1] / self.length + 0.5)).astype(np.int64)
         case = (np.zeros_like(channels.piece[0]), channels.piece[0].copy(),
                 np.zeros(k.TIP_LOADS), channels.tip_loads[0].copy())
