@@ -491,3 +491,20 @@ def test_convergence_error_is_raised_not_a_wrong_answer():
     with pytest.raises(ConvergenceError):  # a huge follower load on a tiny work budget
         numeric(arm, TipLoad(force=[0.0, 30.0, 100.0], moment=[0.0, 50.0, 0.0], follower=True),
                 max_iterations=3, max_shootings=20)
+
+
+def test_prepared_solver_follows_through_a_change_of_cut():
+    """A Solver driven from one load set to another whose point loads and spans cut the arm
+    elsewhere (its memory is re-expressed on the union of the cuts) reaches the equilibrium
+    that softarm.solve finds from the unloaded arm (loads moderate: a unique equilibrium)."""
+    arm = softarm.Arm.from_stiffness(1.0, EA=1e6, GAy=1e6, GAz=1e6, GJ=1.0, EIy=1.0, EIz=1.2)
+    solver = Solver(arm, tol=1e-9)
+    solver.solve([PointLoad(0.3, force=[0.0, 0.5, -1.0]),
+                  softarm.DistributedForce([0.0, 0.0, -0.5], span=(0.2, 0.7))])
+    second = [PointLoad(0.6, force=[0.0, 0.2, -1.5]),
+              softarm.DistributedMoment([0.1, 0.0, 0.0], span=(0.0, 0.45))]
+    followed = solver.solve(second)
+    direct = softarm.solve(arm, second, tol=1e-9)
+    np.testing.assert_allclose(followed.poses, direct.poses, rtol=0, atol=1e-8)
+    solver.reset()  # back to the unloaded arm: the same answer again, from there
+    np.testing.assert_allclose(solver.solve(second).poses, direct.poses, rtol=0, atol=1e-8)
