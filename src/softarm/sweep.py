@@ -183,14 +183,8 @@ def solve_case(case: Case, *, method: str | None = None, stations: int | None = 
 
 
 def _take(loads: tuple, start: int, stop: int) -> tuple:
-    out = []
-    for load in loads:
-        if load.batch_shape:
-            load = replace(load, **{name: np.asarray(getattr(load, name))[start:stop]
-                                    for name, _ in load.vectors
-                                    if np.ndim(getattr(load, name)) > 1})
-        out.append(load)
-    return tuple(out)
+    """Cases start..stop-1 of the batched loads (unbatched loads as they are)."""
+    return tuple(load.take(slice(start, stop)) if load.batch_shape else load for load in loads)
 
 
 def _concatenate(parts: list[Equilibrium], loads: tuple) -> Equilibrium:

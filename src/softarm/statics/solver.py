@@ -300,7 +300,7 @@ class Solver:
 
     def reset(self) -> None:
         """Return the quasi-static state to the unloaded arm."""
-        self._memory = np.zeros(14)  # _kernels.MEMORY, without importing the kernels
+        self._memory = None  # the kernel's chained-solve memory, made on first use
         self._last = None  # (cut starts, piece loads, tip loads) of the last solved case
 
     # ---------------------------------------------------------------- preparation
@@ -394,12 +394,17 @@ class Solver:
         last = self._last if chained else None
         loads, shape, count, pieces, channels = self._prepare(
             loads, () if last is None else tuple(last[0]))
-        first_piece = np.zeros((pieces[0].size, k.PIECE_LOADS))
-        first_tip = np.zeros(k.TIP_LOADS)
-        memory = self._memory if chained else np.zeros(k.MEMORY)
-        if last is not None:
-            first_piece = _recut(last[0], last[1], pieces[0])
-            first_tip = last[2]
+        if last is None:  # from the unloaded arm
+            first_piece, first_tip = np.zeros((pieces[0].size, k.PIECE_LOADS)), np.zeros(
+                k.TIP_LOADS)
+        else:
+            first_piece, first_tip = _recut(last[0], last[1], pieces[0]), last[2]
+        if self._memory is None or not chained:
+            memory = np.zeros(k.MEMORY)
+            if chained:
+                self._memory = memory
+        else:
+            memory = self._memory
         S = self.s.size
         poses = np.empty((count, S, 4, 4))
         strains = np.empty((count, S, 6))
