@@ -648,7 +648,6 @@ def _follow(x, steps, base, arm, case, scratch, scale, dscale, length, threshold
         if ok:
             for i in range(6):
                 dx[i] = x[i] - dx[i]  # the corrector's distance from the prediction
-                t_new[i] = t[i]
             ok = _tangent(J, t_new)
         if ok:
             # det ∂r/∂x changed sign: a singular point lies in this step. Newton may have
