@@ -6,12 +6,22 @@ they exist (:mod:`softarm.analytic`) and a geometrically exact solver for any lo
 
 __version__ = "0.1.0"  # first, so that submodules may import it
 
-from . import analytic, sweep
+from . import analytic, routing, sweep
 from .case import Case, CaseError, load_case
 from .dispatch import solve
 from .equilibrium import Equilibrium
 from .errors import ApproximationWarning, ConvergenceError
-from .loads import DistributedForce, DistributedMoment, Gravity, Load, PointLoad, TipLoad
+from .loads import (
+    Chamber,
+    DistributedForce,
+    DistributedMoment,
+    Gravity,
+    Load,
+    MagneticField,
+    PointLoad,
+    Tendon,
+    TipLoad,
+)
 from .model import Arm, Circle, Material, Rectangle, Rigidities, Section, SegmentedArm, Tube
 
 __all__ = [
@@ -19,6 +29,7 @@ __all__ = [
     "Arm",
     "Case",
     "CaseError",
+    "Chamber",
     "Circle",
     "ConvergenceError",
     "DistributedForce",
@@ -26,17 +37,20 @@ __all__ = [
     "Equilibrium",
     "Gravity",
     "Load",
+    "MagneticField",
     "Material",
     "PointLoad",
     "Rectangle",
     "Rigidities",
     "Section",
     "SegmentedArm",
+    "Tendon",
     "TipLoad",
     "Tube",
     "__version__",
     "analytic",
     "load_case",
+    "routing",
     "solve",
     "sweep",
 ]

@@ -82,6 +82,15 @@ class Equilibrium:
         1/(N m)). None otherwise.
     compliance : ndarray, shape (B..., N, 6, 6), or None
         The same map to every station's (δp(s); δθ(s)), spatial components.
+    base_wrench : ndarray, shape (B..., 6), or None
+        The total wrench (N; N m) the base carries, spatial components: the clamp's reaction
+        on the rod plus what the actuators pull or push on the base (tendons' motors, the
+        chambers' fluid). The rod's own share is ``forces_spatial[..., 0, :]`` and
+        ``moments_spatial[..., 0, :]``. Numerical route only (None from closed forms).
+    tendon_tensions, tendon_lengths, tendon_length_changes : ndarray, shape (B..., T), or None
+        Per :class:`~softarm.Tendon`, in the order given: its tension (N), its length from
+        the base to its anchor (m), and that length less the unloaded arm's (m; negative
+        when pulled in: what a motor encoder measures). None without tendons.
     """
 
     s: np.ndarray
@@ -96,6 +105,10 @@ class Equilibrium:
     error_estimate: float | np.ndarray = 0.0
     tip_compliance: np.ndarray | None = None
     compliance: np.ndarray | None = None
+    base_wrench: np.ndarray | None = None
+    tendon_tensions: np.ndarray | None = None
+    tendon_lengths: np.ndarray | None = None
+    tendon_length_changes: np.ndarray | None = None
 
     def __post_init__(self):
         for name in ("s", "poses", "strains", "stresses"):

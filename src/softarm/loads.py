@@ -20,17 +20,21 @@ from typing import ClassVar, Protocol
 
 import numpy as np
 
-from ._validate import as_array, as_vectors
+from ._validate import as_array, as_matrices, as_vectors, real
+from .routing import Routing
 
 __all__ = [
     "LOAD_KINDS",
+    "Chamber",
     "DistributedForce",
     "DistributedMoment",
     "Gravity",
     "Key",
     "Load",
     "LoadTarget",
+    "MagneticField",
     "PointLoad",
+    "Tendon",
     "TipLoad",
     "as_loads",
     "batch_shape",
@@ -98,14 +102,25 @@ class LoadTarget(Protocol):
     def tip(self, *, force=None, moment=None, follower: bool = False) -> None:
         """A wrench at the tip, dead or follower."""
 
+    def actuator(self, kind: str, magnitude, routing: Routing,
+                 span: tuple[float, float]) -> None:
+        """An actuator acting through the constitutive law on ``span`` (m): ``kind``
+        "tendon" (``magnitude`` its tension τ, N) or "chamber" (p A, N), along ``routing``."""
+
+    def field(self, field, gradient=None) -> None:
+        """A magnetic field B(x) = B0 + G x, spatial (T, T/m), acting on the arm's
+        magnetisation and dipoles."""
+
 
 @dataclass(frozen=True)
 class Key:
     """One key of a load's case-file table (``[[load]]``), read and written alike.
 
-    ``kind``: "vector" (3 numbers in ``unit``), "number" (in ``unit``), "flag" (a bool),
-    "span" ((s0, s1) in m) or "index" (an integer >= 0). An absent optional key takes the
-    load class's default.
+    ``kind``: "vector" (3 numbers in ``unit``, batchable: shape (..., 3)), "magnitude" (a
+    number in ``unit``, batchable: shape (...)), "matrix" (3 × 3 in ``unit``, batchable:
+    (..., 3, 3)), "number" (in ``unit``, not batchable), "flag" (a bool), "span" ((s0, s1)
+    in m), "index" (an integer >= 0) or "routing" (a :mod:`softarm.routing` path, a table
+    in the file). An absent optional key takes the load class's default.
     """
 
     name: str
@@ -117,11 +132,17 @@ class Key:
         """``value`` as a TOML-ready value (lists and plain numbers), or None to omit it."""
         if value is None:
             return None
-        if self.kind == "vector":
+        if self.kind in ("vector", "magnitude", "matrix"):
             return np.asarray(value).tolist()
         if self.kind == "span":
             return [float(v) for v in value]
+        if self.kind == "routing":
+            return value.to_case()
         return {"number": float, "flag": bool, "index": int}[self.kind](value)
+
+
+#: The trailing (object) shape of each batchable key kind.
+_OBJECT_SHAPES = {"vector": (3,), "magnitude": (), "matrix": (3, 3)}
 
 
 #: Every load kind by its case-file name, filled as the classes are defined.
@@ -149,11 +170,16 @@ class Load(abc.ABC):
     schema: ClassVar[tuple[Key, ...]]
     #: The vector fields of the load, (name, unit): derived from ``schema``.
     vectors: ClassVar[tuple[tuple[str, str], ...]] = ()
+    #: Every batchable field, (name, unit, object shape): vectors (3,), magnitudes (),
+    #: matrices (3, 3); derived from ``schema``.
+    arrays: ClassVar[tuple[tuple[str, str, tuple[int, ...]], ...]] = ()
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
         if "schema" in cls.__dict__:
             cls.vectors = tuple((k.name, k.unit) for k in cls.schema if k.kind == "vector")
+            cls.arrays = tuple((k.name, k.unit, _OBJECT_SHAPES[k.kind]) for k in cls.schema
+                               if k.kind in _OBJECT_SHAPES)
         if "kind" in cls.__dict__:
             LOAD_KINDS[cls.kind] = cls
 
@@ -176,9 +202,11 @@ class Load(abc.ABC):
         """Add this load to ``target``'s load channels."""
 
     @abc.abstractmethod
-    def in_base_frame(self, R: np.ndarray) -> Load:
-        """The same load for an arm clamped with base rotation R: dead (spatial) components
-        re-expressed in the base frame (Rᵀ v), follower components unchanged."""
+    def in_base_frame(self, R: np.ndarray, origin=None) -> Load:
+        """The same load for an arm clamped with base rotation R at ``origin`` (m, default
+        the spatial origin): dead (spatial) components re-expressed in the base frame
+        (Rᵀ v), follower components unchanged (a field that varies in space is also moved
+        by ``origin``)."""
 
     @abc.abstractmethod
     def describe(self, swept: tuple[str, str] | None = None) -> str:
@@ -206,9 +234,15 @@ class Load(abc.ABC):
         """ValueError if the load does not fit ``arm`` (default: every load fits)."""
 
     def scaled(self, factor) -> Load:
-        """The same load with every vector field multiplied by ``factor`` (broadcast)."""
-        factor = np.asarray(factor, dtype=np.float64)[..., None]
-        return self.replace(**{name: getattr(self, name) * factor for name, _ in self.vectors})
+        """The same load with every batchable field (force, tension, field, ...) multiplied
+        by ``factor`` (broadcast over the batch axes)."""
+        factor = np.asarray(factor, dtype=np.float64)
+        changes = {}
+        for name, _, shape in self.arrays:
+            value = getattr(self, name)
+            if value is not None:
+                changes[name] = value * factor.reshape(factor.shape + (1,) * len(shape))
+        return self.replace(**changes)
 
     def replace(self, **changes) -> Load:
         """A copy with some fields changed (validated like a new load)."""
@@ -218,8 +252,8 @@ class Load(abc.ABC):
         """The load of one case (or a sub-batch) of a batch: ``index`` into the batch axes."""
         shape = self.batch_shape
         return self.replace(**{
-            name: np.broadcast_to(getattr(self, name), (*shape, 3))[index]
-            for name, _ in self.vectors})
+            name: np.broadcast_to(getattr(self, name), (*shape, *object_shape))[index]
+            for name, _, object_shape in self.arrays if getattr(self, name) is not None})
 
 
 @dataclass(frozen=True, eq=False)
@@ -262,7 +296,7 @@ class TipLoad(Load):
     def apply(self, target: LoadTarget) -> None:
         target.tip(force=self.force, moment=self.moment, follower=self.follower)
 
-    def in_base_frame(self, R) -> TipLoad:
+    def in_base_frame(self, R, origin=None) -> TipLoad:
         if self.follower:
             return self
         return TipLoad(_rotated(R, self.force), _rotated(R, self.moment))
@@ -303,7 +337,7 @@ class Gravity(Load):
     def apply(self, target: LoadTarget) -> None:
         target.distributed(force=self.acceleration, per_mass=True)
 
-    def in_base_frame(self, R) -> Gravity:
+    def in_base_frame(self, R, origin=None) -> Gravity:
         return Gravity(_rotated(R, self.acceleration))
 
     def describe(self, swept=None) -> str:
@@ -386,7 +420,7 @@ class _Distributed(Load):
         target.distributed(**{name: getattr(self, name)}, follower=self.follower,
                            span=_resolved_span(self, target.arm))
 
-    def in_base_frame(self, R):
+    def in_base_frame(self, R, origin=None):
         if self.follower:
             return self
         name, _ = self.vectors[0]
@@ -489,11 +523,256 @@ class PointLoad(Load):
     def apply(self, target: LoadTarget) -> None:
         target.point(self.s, force=self.force, moment=self.moment)
 
-    def in_base_frame(self, R) -> PointLoad:
+    def in_base_frame(self, R, origin=None) -> PointLoad:
         return PointLoad(self.s, _rotated(R, self.force), _rotated(R, self.moment))
 
     def describe(self, swept=None) -> str:
         return f"point load at s = {self.s:.4g} m: " + self._fields_text(swept)
+
+
+def _magnitude(obj, name: str, *, nonnegative: bool, unit: str) -> np.ndarray:
+    """A batchable number (shape (...)), a private frozen copy; >= 0 if ``nonnegative``."""
+    array = as_array(getattr(obj, name), f"{type(obj).__name__}.{name}").copy()
+    if nonnegative and np.any(array < 0.0):
+        raise ValueError(f"{type(obj).__name__}.{name} must be >= 0 {unit} (a tendon cannot "
+                         f"push), got {np.min(array)!r}")
+    array.setflags(write=False)
+    object.__setattr__(obj, name, array)
+    return array
+
+
+def _routing(obj) -> None:
+    if not isinstance(obj.routing, Routing):
+        raise TypeError(f"{type(obj).__name__}.routing must be a softarm.routing path "
+                        f"(Straight, Helix or Polynomial), got {obj.routing!r}")
+
+
+def _magnitude_text(value: np.ndarray, unit: str, swept, name: str) -> str:
+    if swept is not None and swept[0] == name:
+        return swept[1]
+    if value.ndim:
+        return f"(batch of {value.shape})"
+    return f"{float(value):.4g} {unit}"
+
+
+def _check_on_arm(obj, arm, *names) -> None:
+    for name in names:
+        value = getattr(obj, name)
+        if value is not None and not 0.0 <= value <= arm.length * (1 + 8 * np.finfo(float).eps):
+            raise ValueError(f"{type(obj).__name__}.{name} must lie on the arm, in [0, L] = "
+                             f"[0, {arm.length!r}] m, got {value!r}")
+
+
+@dataclass(frozen=True, eq=False)
+class Tendon(Load):
+    """A frictionless tendon pulled with tension τ, anchored at arc length ``end``, running
+    along ``routing`` through the sections from the base (Rucker & Webster 2011).
+
+    The arm and its tendons are solved together: the tendon acts through the constitutive
+    law (``docs/actuation.md``), its pull on the sections it bends around and its anchor
+    load included exactly.
+
+    Parameters
+    ----------
+    tension : float or array_like, shape (...)
+        τ >= 0 in N (a tendon cannot push), batchable.
+    routing : softarm.routing.Straight, Helix or Polynomial
+        The path r(s) in the section, material frame, as a function of the arm's arc length.
+    end : float, optional
+        Arc length in m where the tendon is anchored (default: the tip).
+
+    Examples
+    --------
+    >>> from softarm.routing import Straight
+    >>> Tendon(2.0, Straight(0.0, 0.01)).describe()
+    'tendon 2 N, straight at (y, z) = (0, 0.01) m, anchored at the tip'
+    """
+
+    kind: ClassVar[str] = "tendon"
+    schema: ClassVar = (Key("tension", "magnitude", "N", required=True),
+                        Key("routing", "routing", required=True), Key("end", "number", "m"))
+
+    tension: np.ndarray
+    routing: Routing
+    end: float | None = None
+
+    def __post_init__(self):
+        _magnitude(self, "tension", nonnegative=True, unit="N")
+        _routing(self)
+        if self.end is not None:
+            end = real(self.end, "Tendon.end", "m")
+            if not end > 0.0:
+                raise ValueError(f"Tendon.end must be an arc length > 0 m, got {self.end!r}")
+            object.__setattr__(self, "end", end)
+
+    @property
+    def batch_shape(self) -> tuple[int, ...]:
+        return self.tension.shape
+
+    def check(self, arm) -> None:
+        _check_on_arm(self, arm, "end")
+
+    def cuts(self, arm) -> tuple[float, ...]:
+        return () if self.end is None or self.end >= arm.length else (self.end,)
+
+    def apply(self, target: LoadTarget) -> None:
+        end = target.length if self.end is None else min(self.end, target.length)
+        target.actuator("tendon", self.tension, self.routing, (0.0, end))
+
+    def in_base_frame(self, R, origin=None) -> Tendon:
+        return self  # material frame throughout
+
+    def describe(self, swept=None) -> str:
+        where = "the tip" if self.end is None else f"s = {self.end:.4g} m"
+        return (f"tendon {_magnitude_text(self.tension, 'N', swept, 'tension')}, "
+                f"{self.routing.describe()}, anchored at {where}")
+
+
+@dataclass(frozen=True, eq=False)
+class Chamber(Load):
+    """A pneumatic chamber at uniform pressure p between arc lengths ``start`` and ``end``,
+    its centroid along ``routing``.
+
+    The exact rigid-section model: the fluid cut by each section pushes p A d1 through the
+    chamber's centroid r(s), a wrench p A (e1; r × e1) on the section (material), closed by
+    end caps at ``end`` and ``start``. Not modelled: ballooning of the walls, a stiffness that
+    changes with pressure, volume (rather than pressure) control (``docs/actuation.md``).
+
+    Parameters
+    ----------
+    pressure : float or array_like, shape (...)
+        p in Pa (gauge; negative for vacuum), batchable.
+    area : float
+        A in m², the chamber's area in the cross-section plane (> 0).
+    routing : softarm.routing path
+        The chamber centroid's path in the section (material frame).
+    start, end : float
+        Arc lengths in m (defaults: 0 and the tip).
+    """
+
+    kind: ClassVar[str] = "chamber"
+    schema: ClassVar = (Key("pressure", "magnitude", "Pa", required=True),
+                        Key("area", "number", "m²", required=True),
+                        Key("routing", "routing", required=True), Key("start", "number", "m"),
+                        Key("end", "number", "m"))
+
+    pressure: np.ndarray
+    area: float
+    routing: Routing
+    start: float = 0.0
+    end: float | None = None
+
+    def __post_init__(self):
+        _magnitude(self, "pressure", nonnegative=False, unit="Pa")
+        area = real(self.area, "Chamber.area", "m²")
+        if not area > 0.0:
+            raise ValueError(f"Chamber.area must be > 0 m², got {self.area!r}")
+        object.__setattr__(self, "area", area)
+        _routing(self)
+        object.__setattr__(self, "start", real(self.start, "Chamber.start", "m"))
+        if self.end is not None:
+            object.__setattr__(self, "end", real(self.end, "Chamber.end", "m"))
+        if self.start < 0.0 or (self.end is not None and not self.end > self.start):
+            raise ValueError(f"Chamber.start and Chamber.end must satisfy 0 <= start < end, "
+                             f"got start={self.start!r}, end={self.end!r}")
+
+    @property
+    def batch_shape(self) -> tuple[int, ...]:
+        return self.pressure.shape
+
+    def check(self, arm) -> None:
+        _check_on_arm(self, arm, "start", "end")
+        if self.start >= arm.length:
+            raise ValueError(f"Chamber.start must be < L = {arm.length!r} m, got {self.start!r}")
+
+    def cuts(self, arm) -> tuple[float, ...]:
+        return tuple(c for c in (self.start, self.end) if c is not None and 0.0 < c < arm.length)
+
+    def apply(self, target: LoadTarget) -> None:
+        end = target.length if self.end is None else min(self.end, target.length)
+        target.actuator("chamber", self.pressure * self.area, self.routing, (self.start, end))
+
+    def in_base_frame(self, R, origin=None) -> Chamber:
+        return self
+
+    def describe(self, swept=None) -> str:
+        span = "" if self.start == 0.0 and self.end is None else \
+            f" on [{self.start:.4g}, {self.end if self.end is not None else 'L'}] m"
+        return (f"chamber {_magnitude_text(self.pressure, 'Pa', swept, 'pressure')} over "
+                f"{self.area:.4g} m², {self.routing.describe()}{span}")
+
+
+@dataclass(frozen=True, eq=False)
+class MagneticField(Load):
+    """An external magnetic field B(x) = B0 + G x acting on the arm's hard magnets (its
+    ``magnetization`` per length and ``tip_magnet`` dipoles, fixed in the material).
+
+    A magnetisation m (material, A m²/m) feels the torque (R m) × B(p) and the force
+    Gᵀ (R m) per unit length; a dipole the same, concentrated. A field in current-free space
+    has a symmetric, traceless gradient; another gets a warning.
+
+    Parameters
+    ----------
+    field : array_like, shape (..., 3)
+        B0 in T, spatial components, batchable.
+    gradient : array_like, shape (..., 3, 3), optional
+        G in T/m, spatial (B varies as G x, x the spatial position in m); default uniform.
+    """
+
+    kind: ClassVar[str] = "magnetic"
+    schema: ClassVar = (Key("field", "vector", "T", required=True),
+                        Key("gradient", "matrix", "T/m"))
+
+    field: np.ndarray
+    gradient: np.ndarray | None = None
+
+    def __post_init__(self):
+        _vector(self, "field")
+        if self.gradient is not None:
+            G = as_matrices(self.gradient, "MagneticField.gradient", 3).copy()
+            G.setflags(write=False)
+            object.__setattr__(self, "gradient", G)
+            asymmetry = np.max(np.abs(G - np.swapaxes(G, -1, -2)), initial=0.0)
+            trace = np.max(np.abs(np.trace(G, axis1=-2, axis2=-1)), initial=0.0)
+            size = max(np.max(np.abs(G), initial=0.0), 1e-300)
+            if max(asymmetry, trace) > 1e-9 * size:
+                import warnings
+                warnings.warn(
+                    f"MagneticField.gradient is not symmetric and traceless (largest asymmetry "
+                    f"{asymmetry:.3g} T/m, trace {trace:.3g} T/m): no field in current-free "
+                    "space has such a gradient (curl B = 0, div B = 0)", UserWarning,
+                    stacklevel=3)
+            try:
+                np.broadcast_shapes(self.field.shape[:-1], G.shape[:-2])
+            except ValueError:
+                raise ValueError(f"MagneticField.field and MagneticField.gradient must have "
+                                 f"batch shapes that broadcast, got {self.field.shape} and "
+                                 f"{G.shape}") from None
+
+    @property
+    def batch_shape(self) -> tuple[int, ...]:
+        if self.gradient is None:
+            return self.field.shape[:-1]
+        return np.broadcast_shapes(self.field.shape[:-1], self.gradient.shape[:-2])
+
+    def apply(self, target: LoadTarget) -> None:
+        target.field(self.field, self.gradient)
+
+    def in_base_frame(self, R, origin=None) -> MagneticField:
+        # B at x = o + R x' in base components: Rᵀ (B0 + G o) + Rᵀ G R x'
+        if self.gradient is None:
+            return MagneticField(_rotated(R, self.field))
+        o = np.zeros(3) if origin is None else np.asarray(origin, dtype=np.float64)
+        B = self.field + np.einsum("...ij,j->...i", self.gradient, o)
+        return MagneticField(_rotated(R, B), np.einsum("ji,...jk,kl->...il", R, self.gradient,
+                                                         R))
+
+    def describe(self, swept=None) -> str:
+        text = "magnetic " + self._fields_text(swept)
+        if self.gradient is not None:
+            text += (", gradient (batch)" if self.gradient.ndim > 2 else
+                     f", gradient up to {np.max(np.abs(self.gradient)):.4g} T/m")
+        return text
 
 
 def as_loads(loads) -> tuple[Load, ...]:

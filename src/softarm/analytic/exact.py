@@ -102,6 +102,9 @@ def exact_closed_form(arm, loads, s=None):
     if isinstance(arm, SegmentedArm):
         return None
     arm = check_arm(arm, "exact_closed_form")
+    K = arm.stiffness
+    if np.any(K != np.diag(np.diagonal(K))):  # coupled stiffness: no closed form here
+        return None
     loads = as_loads(loads)
     s = checked_stations(s, arm.length)
     if not loads:

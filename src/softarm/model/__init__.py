@@ -2,7 +2,7 @@
 
 from .arm import Arm, SegmentedArm
 from .material import Material
-from .sections import Circle, Rectangle, Rigidities, Section, Tube
+from .sections import Circle, Rectangle, Rigidities, Section, StiffnessMatrix, Tube
 
 __all__ = [
     "Arm",
@@ -12,5 +12,6 @@ __all__ = [
     "Rigidities",
     "Section",
     "SegmentedArm",
+    "StiffnessMatrix",
     "Tube",
 ]

@@ -9,11 +9,11 @@ import numpy as np
 
 from .._validate import as_vectors, length, positive
 from .material import Material
-from .sections import Circle, Rectangle, Rigidities, Section, Tube
+from .sections import Circle, Rectangle, Rigidities, Section, StiffnessMatrix, Tube
 
 __all__ = ["Arm", "SegmentedArm"]
 
-_SECTION_KINDS = (Circle, Tube, Rectangle, Section, Rigidities)
+_SECTION_KINDS = (Circle, Tube, Rectangle, Section, Rigidities, StiffnessMatrix)
 
 
 @dataclass(frozen=True)
@@ -37,6 +37,13 @@ class Arm:
         κ⁰ = (twist, curvature about y, curvature about z) in 1/m, material frame.
     mass_per_length : float, optional
         kg/m; overrides ρ A (e.g. for an arm with embedded parts).
+    magnetization : array_like, shape (3,), optional
+        A hard magnetisation per unit length (A m²/m = A m), material components, fixed in
+        the material (it turns with the section): acted on by a
+        :class:`~softarm.MagneticField`.
+    tip_magnet : array_like, shape (3,), optional
+        A dipole (A m²), material components, at the arm's distal end (on a segment of a
+        :class:`SegmentedArm`, at that segment's distal end).
 
     Examples
     --------
@@ -52,6 +59,8 @@ class Arm:
     material: Material | None = None
     curvature: tuple[float, float, float] = (0.0, 0.0, 0.0)
     mass_per_length: float | None = None
+    magnetization: tuple[float, float, float] | None = None
+    tip_magnet: tuple[float, float, float] | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "length", length(self.length, "Arm.length"))
@@ -60,7 +69,7 @@ class Arm:
                 "Arm.section must be a Circle, Tube, Rectangle, Section or Rigidities, got "
                 f"{self.section!r}"
             )
-        if isinstance(self.section, Rigidities):
+        if isinstance(self.section, (Rigidities, StiffnessMatrix)):
             if self.material is not None:
                 raise ValueError(
                     "Arm.material must be None when the section is given by its Rigidities "
@@ -75,10 +84,34 @@ class Arm:
         if self.mass_per_length is not None:
             object.__setattr__(self, "mass_per_length",
                                positive(self.mass_per_length, "Arm.mass_per_length", "kg/m"))
+        for name in ("magnetization", "tip_magnet"):
+            value = getattr(self, name)
+            if value is not None:
+                vector = as_vectors(value, f"Arm.{name}", 3)
+                if vector.shape != (3,):
+                    raise ValueError(f"Arm.{name} must have shape (3,), got shape "
+                                     f"{vector.shape}")
+                object.__setattr__(self, name, tuple(float(c) for c in vector))
+
+    @classmethod
+    def from_stiffness_matrix(cls, length, K, curvature=(0.0, 0.0, 0.0), mass_per_length=None,
+                              magnetization=None, tip_magnet=None) -> Arm:
+        """An arm with a full symmetric positive-definite 6 × 6 stiffness K (N, N m, N m²;
+        linear part first), coupling extension, shear, twist and bending (a fibre-reinforced
+        actuator). ValueError for a K that is not symmetric positive definite.
+
+        Examples
+        --------
+        >>> K = np.diag([1e4, 1e4, 1e4, 0.5, 1.0, 1.0]); K[0, 3] = K[3, 0] = 20.0
+        >>> Arm.from_stiffness_matrix(0.2, K).stiffness[0, 3]
+        np.float64(20.0)
+        """
+        return cls(length, StiffnessMatrix(K), None, curvature, mass_per_length,
+                   magnetization, tip_magnet)
 
     @classmethod
     def from_stiffness(cls, length, EA, GAy, GAz, GJ, EIy, EIz, curvature=(0.0, 0.0, 0.0),
-                       mass_per_length=None) -> Arm:
+                       mass_per_length=None, magnetization=None, tip_magnet=None) -> Arm:
         """An arm known only by its stiffnesses (N for EA, GAy, GAz; N m² for GJ, EIy, EIz).
 
         Examples
@@ -88,18 +121,22 @@ class Arm:
         np.float64(1.0)
         """
         return cls(length, Rigidities(EA, GAy, GAz, GJ, EIy, EIz), None, curvature,
-                   mass_per_length)
+                   mass_per_length, magnetization, tip_magnet)
 
     @functools.cached_property
     def rigidities(self) -> Rigidities:
         """The six stiffnesses EA, GAy, GAz, GJ, EIy, EIz (computed once per arm)."""
         if isinstance(self.section, Rigidities):
             return self.section
+        if isinstance(self.section, StiffnessMatrix):
+            return self.section.rigidities
         return self.section.rigidities(self.material)
 
     @property
     def stiffness(self) -> np.ndarray:
         """K, the 6×6 stiffness matrix of eqs. 10-12 (N and N m²), linear part first."""
+        if isinstance(self.section, StiffnessMatrix):
+            return np.array(self.section.matrix)
         return self.rigidities.matrix
 
     @property
@@ -119,7 +156,7 @@ class Arm:
     @property
     def radius(self) -> float | None:
         """Radius used to draw the arm as a tube (m), None if only stiffnesses are known."""
-        if isinstance(self.section, Rigidities):
+        if isinstance(self.section, (Rigidities, StiffnessMatrix)):
             return None
         return self.section.envelope_radius
 

@@ -17,7 +17,7 @@ import numpy as np
 from .._validate import length, positive
 from .material import Material
 
-__all__ = ["Circle", "Rectangle", "Rigidities", "Section", "Tube"]
+__all__ = ["Circle", "Rectangle", "Rigidities", "Section", "StiffnessMatrix", "Tube"]
 
 
 @dataclass(frozen=True)
@@ -53,6 +53,42 @@ class Rigidities:
     def matrix(self) -> np.ndarray:
         """K = diag(EA, GAy, GAz, GJ, EIy, EIz), shape (6, 6) (eqs. 10-12)."""
         return np.diag([self.EA, self.GAy, self.GAz, self.GJ, self.EIy, self.EIz]).astype(float)
+
+
+@dataclass(frozen=True)
+class StiffnessMatrix:
+    """A section known by a full symmetric positive-definite 6 × 6 stiffness K (linear part
+    first: (n; m) = K (γ; κ)), e.g. a fibre-reinforced actuator whose bending, twist and
+    extension are coupled. Use :meth:`softarm.Arm.from_stiffness_matrix`.
+
+    ``matrix`` is stored as a tuple of rows (an arm stays hashable); :attr:`rigidities` are
+    its diagonal, for the places that need a scale (the closed forms do not apply).
+    """
+
+    matrix: tuple
+
+    def __post_init__(self):
+        try:
+            K = np.array(self.matrix, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise TypeError(f"the stiffness matrix K must be a 6 × 6 array of numbers, got "
+                            f"{self.matrix!r}") from None
+        if K.shape != (6, 6) or not np.all(np.isfinite(K)):
+            raise ValueError(f"the stiffness matrix K must be a finite 6 × 6 array, got shape "
+                             f"{K.shape}")
+        if not np.allclose(K, K.T, rtol=1e-12, atol=0.0):
+            raise ValueError("the stiffness matrix K must be symmetric (largest asymmetry "
+                             f"{np.max(np.abs(K - K.T)):.3g})")
+        smallest = float(np.min(np.linalg.eigvalsh(K)))
+        if not smallest > 0.0:
+            raise ValueError(f"the stiffness matrix K must be positive definite, got smallest "
+                             f"eigenvalue {smallest:.3g}")
+        object.__setattr__(self, "matrix", tuple(tuple(float(x) for x in row) for row in K))
+
+    @property
+    def rigidities(self) -> Rigidities:
+        """The diagonal of K as :class:`Rigidities`."""
+        return Rigidities(*np.diagonal(np.array(self.matrix)))
 
 
 @dataclass(frozen=True)

@@ -86,11 +86,26 @@ _TP, _TT, _TN, _TM = 0, 3, 6, 9
 NT = 12
 LAM = 6  # the tangent column of the load factor
 
-# Per-piece load channels (PIECE_LOADS = 24): distributed dead force (spatial), follower
-# force (material), dead moment, follower moment, each per unit length; the point wrench at
-# the piece start, dead (spatial) and follower (material).
+# Per-piece load channels (PIECE_LOADS = 36, then one column per actuator): distributed dead
+# force (spatial), follower force (material), dead moment, follower moment, each per unit
+# length; the point wrench at the piece start, dead (spatial) and follower (material); the
+# magnetic field B(x) = B0 + G x (B0 in T, G row-major in T/m, spatial; the same on every
+# piece); from ACT on, each actuator's magnitude on this piece (0 where it does not act):
+# a tendon's tension τ (N), a chamber's pressure times area p A (N).
 FD, FF, LD, LF, JD, JF = _FD, _FF, _LD, _LF, _JD, _JF = 0, 3, 6, 9, 12, 18
-PIECE_LOADS = 24
+FB, FG = _FB, _FG = 24, 27
+PIECE_LOADS = 36
+ACT = _ACT = 36
+# Actuator kinds (the arm tuple's ``kinds``).
+TENDON, CHAMBER = 0, 1
+# The columns of an actuator's routing row (the arm tuple's ``routes``): a bound of its
+# distance from the centreline (m, for load sizes), the helix radius (m), angular rate
+# 2π n (rad/m) and phase (rad), then D power-series coefficients of y(s), then D of z(s).
+_RHO, _HR, _HW, _HP, _POLY = 0, 1, 2, 3, 4
+# Newton on the actuated constitutive law: the largest number of iterations, and the size
+# of a correction (strain; curvature times L) below which the next would be at round-off.
+_LAW_ITER = 30
+_LAW_TOL = 1e-9
 # Tip channels (TIP_LOADS = 12): the dead tip wrench (spatial), the follower one (material).
 TD, TF = _TD, _TF = 0, 6
 TIP_LOADS = 12
@@ -149,14 +164,189 @@ def _strain(C, f0, j, diag, s0, s1, s2, s3, s4, s5):
 
 
 @_jit
-def _deriv(work, twork, nt, stage, arm, j, now, rate):
-    """F(y) and the right-hand side of the first nt tangent columns, on piece j.
+def _route(routes, a, s):
+    """Actuator a's path in the section at arc length s: (y, z, dy/ds, dz/ds), m and m/m,
+    material frame (a power series in s plus a helix)."""
+    D = (routes.shape[1] - _POLY) // 2
+    y, z, dy, dz = 0.0, 0.0, 0.0, 0.0
+    for k in range(D - 1, -1, -1):  # Horner, value and derivative together
+        dy = dy * s + y
+        y = y * s + routes[a, _POLY + k]
+        dz = dz * s + z
+        z = z * s + routes[a, _POLY + D + k]
+    radius = routes[a, _HR]
+    if radius != 0.0:
+        angle = routes[a, _HP] + routes[a, _HW] * s
+        c, sn = math.cos(angle), math.sin(angle)
+        y += radius * c
+        z += radius * sn
+        dy -= radius * routes[a, _HW] * sn
+        dz += radius * routes[a, _HW] * c
+    return y, z, dy, dz
+
+
+@_jit
+def _law(arm, j, s, now, law, s0, s1, s2, s3, s4, s5):
+    """The constitutive law of piece j at arc length s with its actuators (Rucker & Webster
+    2011, in total-wrench form): the strains ε = (v; u) solving
+
+        K (ε - f⁰) + Σ_tendons τ (t; r × t) = σ + Σ_chambers p A (e1; r × e1),
+        t = w/|w|, w = v + u × r + r',
+
+    σ the total wrench (rod, tendons, fluid) in material components, r(s) each actuator's
+    path in the section. For τ ≥ 0 the left side is the gradient of a strictly convex
+    function, so Newton from the tendons-along-d1 guess (exact for straight tendons on a
+    diagonal K) converges to the unique root. On return ``law[0][:, :6]`` holds the
+    Jacobian H = K + Σ τ Jᵀ (I - t tᵀ) J / |w|, J = [I, -r~] (the tangents' linear map is
+    H⁻¹), ``law[1][a]`` = (t, |w|, y, z, dy, dz) of every active actuator. NaN strains if
+    Newton fails (|w| → 0: a tendon path folded onto itself).
+    """
+    f0, C, K = arm[3], arm[2], arm[8]
+    routes, kinds, active = arm[9], arm[10], arm[11]
+    M, tw, vec, jw = law
+    length = arm[6]
+    rhs, eps = vec[0], vec[2]
+    rhs[0], rhs[1], rhs[2], rhs[3], rhs[4], rhs[5] = s0, s1, s2, s3, s4, s5
+    g = vec[1]
+    for i in range(6):
+        g[i] = rhs[i]
+    tendons = 0
+    for a in range(routes.shape[0]):
+        if active[j, a] == 0.0:
+            continue
+        y, z, dy, dz = _route(routes, a, s)
+        tw[a, 4], tw[a, 5], tw[a, 6], tw[a, 7] = y, z, dy, dz
+        q = now[j, _ACT + a]
+        # the fluid's wrench p A (e1; r × e1), r × e1 = (0, z, -y); a tendon along d1: -τ that
+        sign = 1.0 if kinds[a] == CHAMBER else -1.0
+        if kinds[a] == CHAMBER:
+            rhs[0] += q
+            rhs[4] += q * z
+            rhs[5] -= q * y
+        else:
+            tendons += 1
+        g[0] += sign * q
+        g[4] += sign * q * z
+        g[5] -= sign * q * y
+    for i in range(6):
+        acc = f0[j, i]
+        for k in range(6):
+            acc += C[j, i, k] * g[k]
+        eps[i] = acc
+    for i in range(6):
+        for k in range(6):
+            M[i, k] = K[j, i, k]
+    if tendons == 0:
+        return eps[0], eps[1], eps[2], eps[3], eps[4], eps[5]
+    F = vec[1]
+    previous = np.inf
+    for it in range(_LAW_ITER + 1):
+        v0, v1, v2, u0, u1, u2 = eps[0], eps[1], eps[2], eps[3], eps[4], eps[5]
+        for i in range(6):
+            acc = -rhs[i]
+            for k in range(6):
+                acc += K[j, i, k] * (eps[k] - f0[j, k])
+                M[i, k] = K[j, i, k]
+            F[i] = acc
+        for a in range(routes.shape[0]):
+            if active[j, a] == 0.0 or kinds[a] == CHAMBER:
+                continue
+            y, z, dy, dz = tw[a, 4], tw[a, 5], tw[a, 6], tw[a, 7]
+            w0 = v0 + u1 * z - u2 * y
+            w1 = v1 - u0 * z + dy
+            w2 = v2 + u0 * y + dz
+            nw = math.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
+            t0, t1, t2 = w0 / nw, w1 / nw, w2 / nw
+            tw[a, 0], tw[a, 1], tw[a, 2], tw[a, 3] = t0, t1, t2, nw
+            q = now[j, _ACT + a]
+            if q == 0.0:
+                continue
+            F[0] += q * t0
+            F[1] += q * t1
+            F[2] += q * t2
+            F[3] += q * (y * t2 - z * t1)  # r × t, r = (0, y, z)
+            F[4] += q * z * t0
+            F[5] -= q * y * t0
+            # H += Jᵀ P J, P = τ (I - t tᵀ)/|w|, J = [I | -r~] = [I | (0 z -y; -z 0 0; y 0 0)]
+            for i in range(3):
+                for k in range(6):
+                    jw[i, k] = 0.0
+                jw[i, i] = 1.0
+            jw[0, 4], jw[0, 5] = z, -y
+            jw[1, 3] = -z
+            jw[2, 3] = y
+            c = q / nw
+            for k in range(6):
+                tj = t0 * jw[0, k] + t1 * jw[1, k] + t2 * jw[2, k]
+                jw[3, k] = c * (jw[0, k] - t0 * tj)
+                jw[4, k] = c * (jw[1, k] - t1 * tj)
+                jw[5, k] = c * (jw[2, k] - t2 * tj)
+            for i in range(6):
+                for k in range(6):
+                    M[i, k] += jw[0, i] * jw[3, k] + jw[1, i] * jw[4, k] + jw[2, i] * jw[5, k]
+        if previous <= _LAW_TOL:
+            break  # ε converged with the last correction: M holds H at ε
+        if it == _LAW_ITER:
+            return np.nan, np.nan, np.nan, np.nan, np.nan, np.nan
+        for i in range(6):
+            M[i, 6] = -F[i]
+        if _eliminate_columns(M, 1) == 0.0:
+            return np.nan, np.nan, np.nan, np.nan, np.nan, np.nan
+        previous = 0.0
+        for i in range(6):
+            eps[i] += M[i, 6]
+            previous = max(previous, abs(M[i, 6]) * (length if i >= 3 else 1.0))
+        if not math.isfinite(previous):
+            return np.nan, np.nan, np.nan, np.nan, np.nan, np.nan
+    return eps[0], eps[1], eps[2], eps[3], eps[4], eps[5]
+
+
+@_jit
+def _actuator_rates(arm, j, rate, law, ds):
+    """The actuators' own change with λ in the constitutive law, added to the λ column ds
+    (material): Σ_chambers d(pA)/dλ (e1; r × e1) - Σ_tendons dτ/dλ (t; r × t)."""
+    routes, kinds, active = arm[9], arm[10], arm[11]
+    tw = law[1]
+    for a in range(routes.shape[0]):
+        if active[j, a] == 0.0:
+            continue
+        q = rate[j, _ACT + a]
+        y, z = tw[a, 4], tw[a, 5]
+        if kinds[a] == CHAMBER:
+            ds[0] += q
+            ds[4] += q * z
+            ds[5] -= q * y
+        else:
+            t0, t1, t2 = tw[a, 0], tw[a, 1], tw[a, 2]
+            ds[0] -= q * t0
+            ds[1] -= q * t1
+            ds[2] -= q * t2
+            ds[3] -= q * (y * t2 - z * t1)
+            ds[4] -= q * z * t0
+            ds[5] += q * y * t0
+
+
+@_jit
+def _actuated(arm, j):
+    """Whether actuators act on piece j (the constitutive law then is :func:`_law`)."""
+    active = arm[11]
+    for a in range(active.shape[1]):
+        if active[j, a] != 0.0:
+            return True
+    return False
+
+
+@_jit
+def _deriv(work, twork, nt, stage, s, arm, j, now, rate, law):
+    """F(y) and the right-hand side of the first nt tangent columns, on piece j at arc
+    length s.
 
     Reads the state from ``work[4]`` and the tangents from ``twork[4]``; writes F(y) into
-    ``work[stage]`` and the tangent derivatives into ``twork[stage]``. Scalars throughout:
-    no array views (each costs reference counting in the innermost loop), no allocation.
+    ``work[stage]`` and the tangent derivatives into ``twork[stage]``. Scalars throughout
+    where it matters: no array views in the passive arm's path, no allocation.
     """
     C, f0, zero, diag = arm[2], arm[3], arm[4], arm[5]
+    mag = arm[12]
     Y = 4
     R00, R01, R02 = work[Y, _R], work[Y, _R + 1], work[Y, _R + 2]
     R10, R11, R12 = work[Y, _R + 3], work[Y, _R + 4], work[Y, _R + 5]
@@ -170,7 +360,11 @@ def _deriv(work, twork, nt, stage, arm, j, now, rate):
     s3 = R00 * mx + R10 * my + R20 * mz
     s4 = R01 * mx + R11 * my + R21 * mz
     s5 = R02 * mx + R12 * my + R22 * mz
-    v0, v1, v2, u0, u1, u2 = _strain(C, f0, j, diag, s0, s1, s2, s3, s4, s5)
+    actuated = _actuated(arm, j)
+    if actuated:
+        v0, v1, v2, u0, u1, u2 = _law(arm, j, s, now, law, s0, s1, s2, s3, s4, s5)
+    else:
+        v0, v1, v2, u0, u1, u2 = _strain(C, f0, j, diag, s0, s1, s2, s3, s4, s5)
     # follower loads in spatial components: R f_f, R l_f
     ff0, ff1, ff2 = now[j, _FF], now[j, _FF + 1], now[j, _FF + 2]
     lf0, lf1, lf2 = now[j, _LF], now[j, _LF + 1], now[j, _LF + 2]
@@ -196,20 +390,57 @@ def _deriv(work, twork, nt, stage, arm, j, now, rate):
     w[_M] = -(py * nz - pz * ny) - (now[j, _LD] + R00 * lf0 + R01 * lf1 + R02 * lf2)
     w[_M + 1] = -(pz * nx - px * nz) - (now[j, _LD + 1] + R10 * lf0 + R11 * lf1 + R12 * lf2)
     w[_M + 2] = -(px * ny - py * nx) - (now[j, _LD + 2] + R20 * lf0 + R21 * lf1 + R22 * lf2)
+    # a hard magnetisation m (material, A m²/m) in B(x) = B0 + G x: force Gᵀ (R m), torque
+    # (R m) × B(p) per unit length
+    ma0, ma1, ma2 = mag[j, 0], mag[j, 1], mag[j, 2]
+    magnetic = ma0 != 0.0 or ma1 != 0.0 or ma2 != 0.0
+    if magnetic:
+        _dipole(work[Y], twork[Y], 0, ma0, ma1, ma2, now[j], rate[j], law[2][3])
+        for i in range(3):
+            w[_N + i] -= law[2][3, i]
+            w[_M + i] -= law[2][3, 3 + i]
+    # the tendons' lengths: ℓ' = |w| where they run
+    for a in range(w.size - 18):
+        w[18 + a] = law[1][a, 3] if actuated and arm[11][j, a] != 0.0 and \
+            arm[10][a] == TENDON else 0.0
+    if nt == 0:
+        return
+    # δσ = (Rᵀδn + σ_n × δθ; Rᵀδm + σ_m × δθ), then δ(v; u) = dstrain δσ (+ the actuators'
+    # own change with λ), all columns at once: one factorisation of H when actuated
+    M = law[0]
     for d in range(nt):
         t = twork[Y, d]
         th0, th1, th2 = t[_TT], t[_TT + 1], t[_TT + 2]
         dn0, dn1, dn2 = t[_TN], t[_TN + 1], t[_TN + 2]
         dm0, dm1, dm2 = t[_TM], t[_TM + 1], t[_TM + 2]
-        # δσ = (Rᵀδn + σ_n × δθ; Rᵀδm + σ_m × δθ); δ(v; u) by the constitutive step
-        c0, c1, c2, c3, c4, c5 = _strain(
-            C, zero, j, diag,
-            R00 * dn0 + R10 * dn1 + R20 * dn2 + s1 * th2 - s2 * th1,
-            R01 * dn0 + R11 * dn1 + R21 * dn2 + s2 * th0 - s0 * th2,
-            R02 * dn0 + R12 * dn1 + R22 * dn2 + s0 * th1 - s1 * th0,
-            R00 * dm0 + R10 * dm1 + R20 * dm2 + s4 * th2 - s5 * th1,
-            R01 * dm0 + R11 * dm1 + R21 * dm2 + s5 * th0 - s3 * th2,
-            R02 * dm0 + R12 * dm1 + R22 * dm2 + s3 * th1 - s4 * th0)
+        d0 = R00 * dn0 + R10 * dn1 + R20 * dn2 + s1 * th2 - s2 * th1
+        d1 = R01 * dn0 + R11 * dn1 + R21 * dn2 + s2 * th0 - s0 * th2
+        d2 = R02 * dn0 + R12 * dn1 + R22 * dn2 + s0 * th1 - s1 * th0
+        d3 = R00 * dm0 + R10 * dm1 + R20 * dm2 + s4 * th2 - s5 * th1
+        d4 = R01 * dm0 + R11 * dm1 + R21 * dm2 + s5 * th0 - s3 * th2
+        d5 = R02 * dm0 + R12 * dm1 + R22 * dm2 + s3 * th1 - s4 * th0
+        if actuated:
+            M[0, 6 + d], M[1, 6 + d], M[2, 6 + d] = d0, d1, d2
+            M[3, 6 + d], M[4, 6 + d], M[5, 6 + d] = d3, d4, d5
+        else:
+            (M[0, 6 + d], M[1, 6 + d], M[2, 6 + d], M[3, 6 + d], M[4, 6 + d],
+             M[5, 6 + d]) = _strain(C, zero, j, diag, d0, d1, d2, d3, d4, d5)
+    if actuated:
+        if nt > LAM:
+            _actuator_rates(arm, j, rate, law, law[2][4])
+            for i in range(6):
+                M[i, 6 + LAM] += law[2][4, i]
+                law[2][4, i] = 0.0
+        if _eliminate_columns(M, nt) == 0.0:
+            for d in range(nt):
+                for i in range(6):
+                    M[i, 6 + d] = np.nan
+    for d in range(nt):
+        t = twork[Y, d]
+        th0, th1, th2 = t[_TT], t[_TT + 1], t[_TT + 2]
+        dn0, dn1, dn2 = t[_TN], t[_TN + 1], t[_TN + 2]
+        c0, c1, c2 = M[0, 6 + d], M[1, 6 + d], M[2, 6 + d]
+        c3, c4, c5 = M[3, 6 + d], M[4, 6 + d], M[5, 6 + d]
         # δp' = R (δθ × v + δv)
         a0 = th1 * v2 - th2 * v1 + c0
         a1 = th2 * v0 - th0 * v2 + c1
@@ -244,6 +475,14 @@ def _deriv(work, twork, nt, stage, arm, j, now, rate):
             k0 -= rate[j, _LD]
             k1 -= rate[j, _LD + 1]
             k2 -= rate[j, _LD + 2]
+        if magnetic:  # the magnetic force and torque densities' variations
+            _dipole(work[Y], twork[Y], d + 1, ma0, ma1, ma2, now[j], rate[j], law[2][3])
+            g0 -= law[2][3, 0]
+            g1 -= law[2][3, 1]
+            g2 -= law[2][3, 2]
+            k0 -= law[2][3, 3]
+            k1 -= law[2][3, 4]
+            k2 -= law[2][3, 5]
         o = twork[stage, d]
         o[_TP] = q0
         o[_TP + 1] = q1
@@ -261,9 +500,66 @@ def _deriv(work, twork, nt, stage, arm, j, now, rate):
 
 
 @_jit
-def _rk4(y, T, nt, h, arm, j, now, rate, work, twork):
-    """One RK4 step of length h on piece j in place (the state and the first nt tangent
-    columns of T), then R ← R (3I - RᵀR)/2: one Björck step towards the nearest rotation.
+def _dipole(y, T, which, m0, m1, m2, now, rate, out):
+    """The wrench of a magnetic dipole m (material components, A m², or A m²/m for a
+    density) carried by the section of state y in the field B(x) = B0 + G x of the load row
+    ``now``: out = (Gᵀ (R m); (R m) × B(p)), spatial. With ``which`` = d + 1 instead its
+    variation along tangent column d of T: R (δθ × m) = δ(R m) in both terms, G δp in the
+    torque, and in the load-factor column the field's own change (``rate``)."""
+    R = y[_R:_R + 9]
+    a0 = R[0] * m0 + R[1] * m1 + R[2] * m2  # R m, spatial
+    a1 = R[3] * m0 + R[4] * m1 + R[5] * m2
+    a2 = R[6] * m0 + R[7] * m1 + R[8] * m2
+    px, py, pz = y[_P], y[_P + 1], y[_P + 2]
+    if which == 0:
+        G, B = now[_FG:_FG + 9], now[_FB:_FB + 3]
+        b0 = B[0] + G[0] * px + G[1] * py + G[2] * pz
+        b1 = B[1] + G[3] * px + G[4] * py + G[5] * pz
+        b2 = B[2] + G[6] * px + G[7] * py + G[8] * pz
+        out[0] = G[0] * a0 + G[3] * a1 + G[6] * a2
+        out[1] = G[1] * a0 + G[4] * a1 + G[7] * a2
+        out[2] = G[2] * a0 + G[5] * a1 + G[8] * a2
+        out[3] = a1 * b2 - a2 * b1
+        out[4] = a2 * b0 - a0 * b2
+        out[5] = a0 * b1 - a1 * b0
+        return
+    d = which - 1
+    t = T[d]
+    th0, th1, th2 = t[_TT], t[_TT + 1], t[_TT + 2]
+    c0, c1, c2 = th1 * m2 - th2 * m1, th2 * m0 - th0 * m2, th0 * m1 - th1 * m0
+    e0 = R[0] * c0 + R[1] * c1 + R[2] * c2  # δ(R m) = R (δθ × m)
+    e1 = R[3] * c0 + R[4] * c1 + R[5] * c2
+    e2 = R[6] * c0 + R[7] * c1 + R[8] * c2
+    G, B = now[_FG:_FG + 9], now[_FB:_FB + 3]
+    b0 = B[0] + G[0] * px + G[1] * py + G[2] * pz
+    b1 = B[1] + G[3] * px + G[4] * py + G[5] * pz
+    b2 = B[2] + G[6] * px + G[7] * py + G[8] * pz
+    dp0, dp1, dp2 = t[_TP], t[_TP + 1], t[_TP + 2]
+    g0 = G[0] * dp0 + G[1] * dp1 + G[2] * dp2  # G δp
+    g1 = G[3] * dp0 + G[4] * dp1 + G[5] * dp2
+    g2 = G[6] * dp0 + G[7] * dp1 + G[8] * dp2
+    f0 = G[0] * e0 + G[3] * e1 + G[6] * e2
+    f1 = G[1] * e0 + G[4] * e1 + G[7] * e2
+    f2 = G[2] * e0 + G[5] * e1 + G[8] * e2
+    if d == LAM:
+        Gr, Br = rate[_FG:_FG + 9], rate[_FB:_FB + 3]
+        f0 += Gr[0] * a0 + Gr[3] * a1 + Gr[6] * a2
+        f1 += Gr[1] * a0 + Gr[4] * a1 + Gr[7] * a2
+        f2 += Gr[2] * a0 + Gr[5] * a1 + Gr[8] * a2
+        g0 += Br[0] + Gr[0] * px + Gr[1] * py + Gr[2] * pz
+        g1 += Br[1] + Gr[3] * px + Gr[4] * py + Gr[5] * pz
+        g2 += Br[2] + Gr[6] * px + Gr[7] * py + Gr[8] * pz
+    out[0], out[1], out[2] = f0, f1, f2
+    out[3] = e1 * b2 - e2 * b1 + a1 * g2 - a2 * g1
+    out[4] = e2 * b0 - e0 * b2 + a2 * g0 - a0 * g2
+    out[5] = e0 * b1 - e1 * b0 + a0 * g1 - a1 * g0
+
+
+@_jit
+def _rk4(y, T, nt, h, s, arm, j, now, rate, work, twork, law):
+    """One RK4 step of length h from arc length s on piece j in place (the state and the
+    first nt tangent columns of T), then R ← R (3I - RᵀR)/2: one Björck step towards the
+    nearest rotation.
 
     Loops are written out (no slice assignment, no array expression): numba compiles those
     with shape checks whose error messages pull in its string machinery.
@@ -271,14 +567,14 @@ def _rk4(y, T, nt, h, arm, j, now, rate, work, twork):
     for stage in range(4):  # work rows 0-3: the stage derivatives; row 4: the stage state
         a = 0.0 if stage == 0 else (h if stage == 3 else 0.5 * h)
         prev = max(stage - 1, 0)
-        for i in range(18):
+        for i in range(y.size):
             work[4, i] = y[i] + a * work[prev, i] if stage else y[i]
         for d in range(nt):
             for i in range(NT):
                 twork[4, d, i] = T[d, i] + a * twork[prev, d, i] if stage else T[d, i]
-        _deriv(work, twork, nt, stage, arm, j, now, rate)
+        _deriv(work, twork, nt, stage, s + a, arm, j, now, rate, law)
     w = h / 6.0
-    for i in range(18):
+    for i in range(y.size):
         y[i] += w * (work[0, i] + 2.0 * work[1, i] + 2.0 * work[2, i] + work[3, i])
     for d in range(nt):
         for i in range(NT):
@@ -298,9 +594,11 @@ def _rk4(y, T, nt, h, arm, j, now, rate, work, twork):
 
 
 @_jit
-def _jump(y, T, nt, now, rate, j):
+def _jump(y, T, nt, now, rate, j, arm, law):
     """The point wrench at the start of piece j: n and m drop by W_d + R W_f (and their
-    tangents by R (δθ × W_f), plus ∂_λ W in the load-factor column)."""
+    tangents by R (δθ × W_f), plus ∂_λ W in the load-factor column), and by the wrench of a
+    magnetic dipole there (a segment's ``tip_magnet``)."""
+    _dipole_jump(y, T, nt, arm[13], j, now[j], rate[j], law[2][5], y, T, -1.0)
     for half in range(2):
         at = 3 * half
         W0, W1, W2 = now[j, _JF + at], now[j, _JF + at + 1], now[j, _JF + at + 2]
@@ -324,6 +622,27 @@ def _jump(y, T, nt, now, rate, j):
 
 
 @_jit
+def _dipole_jump(y, T, nt, dipoles, at, now, rate, out, ydst, Tdst, sign):
+    """Add ``sign`` × the wrench of dipole ``dipoles[at]`` (A m², material) to n, m of
+    ``ydst`` and its variations to the first nt tangent columns of ``Tdst`` (rows 6:12), or
+    with ``ydst`` the residual r (6) and ``Tdst`` the Jacobian J (6, 7) (see callers)."""
+    m0, m1, m2 = dipoles[at, 0], dipoles[at, 1], dipoles[at, 2]
+    if m0 == 0.0 and m1 == 0.0 and m2 == 0.0:
+        return
+    off = _N if ydst.size >= 18 else 0
+    for d in range(nt):
+        _dipole(y, T, d + 1, m0, m1, m2, now, rate, out)
+        for i in range(6):
+            if off:
+                Tdst[d, _TN + i] += sign * out[i]
+            else:
+                Tdst[i, d] += sign * out[i]
+    _dipole(y, T, 0, m0, m1, m2, now, rate, out)
+    for i in range(6):
+        ydst[off + i] += sign * out[i]
+
+
+@_jit
 def _start(y, T, nt, base, x):
     """The state at the clamp from the base reaction x, and the tangents' initial values."""
     for i in range(3):
@@ -332,6 +651,8 @@ def _start(y, T, nt, base, x):
             y[_R + 3 * i + k] = base[i, k]
         y[_N + i] = x[i]
         y[_M + i] = x[3 + i]
+    for i in range(18, y.size):
+        y[i] = 0.0  # the tendons' lengths
     for d in range(nt):
         for i in range(NT):
             T[d, i] = 0.0
@@ -340,8 +661,9 @@ def _start(y, T, nt, base, x):
 
 
 @_jit
-def _tip_residual(y, T, nt, tip_now, tip_rate, r, J):
-    """The boundary residual r at the tip and its Jacobian columns J[:, :nt]."""
+def _tip_residual(y, T, nt, tip_now, tip_rate, r, J, arm, now, rate, law):
+    """The boundary residual r at the tip and its Jacobian columns J[:, :nt]: the total
+    wrench n(L), m(L) minus the tip loads (and the tip dipole's wrench)."""
     for half in range(2):
         at = 3 * half
         F0, F1, F2 = tip_now[_TF + at], tip_now[_TF + at + 1], tip_now[_TF + at + 2]
@@ -362,6 +684,8 @@ def _tip_residual(y, T, nt, tip_now, tip_rate, r, J):
                     y[_R + 3 * i] * c0 + y[_R + 3 * i + 1] * c1 + y[_R + 3 * i + 2] * c2)
                 if d == LAM:
                     J[at + i, d] -= tip_rate[_TD + at + i]
+    last = now.shape[0] - 1
+    _dipole_jump(y, T, nt, arm[13], last + 1, now[last], rate[last], law[2][5], r, J, -1.0)
 
 
 @_jit
@@ -369,7 +693,7 @@ def _set_loads(lam, case, now, tip_now):
     """The loads at load factor λ: start + λ (end - start), per piece and at the tip."""
     start, rate, tip_start, tip_rate = case
     for j in range(start.shape[0]):
-        for i in range(PIECE_LOADS):
+        for i in range(start.shape[1]):
             now[j, i] = start[j, i] + lam * rate[j, i]
     for i in range(TIP_LOADS):
         tip_now[i] = tip_start[i] + lam * tip_rate[i]
@@ -382,16 +706,17 @@ def _integrate(x, lam, nt, steps, base, arm, case, scratch, r, J):
     scratch's y and its tangents in T (for the tip motion per unit x)."""
     y, T, work, twork, now, tip_now = scratch[0], scratch[1], scratch[2], scratch[3], \
         scratch[4], scratch[5]
+    law = scratch[8]
     rate, tip_rate = case[1], case[3]
     _set_loads(lam, case, now, tip_now)
-    piece_len = arm[1]
+    piece_start, piece_len = arm[0], arm[1]
     _start(y, T, nt, base, x)
     for j in range(piece_len.size):
-        _jump(y, T, nt, now, rate, j)
+        _jump(y, T, nt, now, rate, j, arm, law)
         h = piece_len[j] / steps[j]
-        for _ in range(steps[j]):
-            _rk4(y, T, nt, h, arm, j, now, rate, work, twork)
-    _tip_residual(y, T, nt, tip_now, tip_rate, r, J)
+        for i in range(steps[j]):
+            _rk4(y, T, nt, h, piece_start[j] + i * h, arm, j, now, rate, work, twork, law)
+    _tip_residual(y, T, nt, tip_now, tip_rate, r, J, arm, now, rate, law)
 
 
 @_jit
@@ -399,8 +724,13 @@ def _eliminate(M):
     """Gaussian elimination with partial pivoting of the 6 rows of M in place (the first 6
     columns are the matrix, any further ones right-hand sides). Returns the sign of the
     determinant (the permutation's sign times the pivots'), 0.0 if singular."""
+    return _eliminate_upto(M, M.shape[1])
+
+
+@_jit
+def _eliminate_upto(M, cols):
+    """:func:`_eliminate` on the first ``cols`` columns of M only."""
     sign = 1.0
-    cols = M.shape[1]
     for c in range(6):
         p = c
         best = abs(M[c, c])
@@ -420,6 +750,22 @@ def _eliminate(M):
             g = M[i, c] / M[c, c]
             for k in range(c, cols):
                 M[i, k] -= g * M[c, k]
+    return sign
+
+
+@_jit
+def _eliminate_columns(M, k):
+    """Solve M[:, :6] X = M[:, 6:6+k] in place (X overwrites those k columns; M[:, :6] is
+    destroyed). Returns the sign of the determinant, 0.0 if singular."""
+    sign = _eliminate_upto(M, 6 + k)
+    if sign == 0.0:
+        return 0.0
+    for col in range(6, 6 + k):
+        for c in range(5, -1, -1):
+            acc = M[c, col]
+            for i in range(c + 1, 6):
+                acc -= M[c, i] * M[i, col]
+            M[c, col] = acc / M[c, c]
     return sign
 
 
@@ -685,9 +1031,11 @@ def _follow(x, steps, base, arm, case, scratch, scale, dscale, length, threshold
 
 
 @_jit
-def _write(y, T, nt, C, pose, strain, stress, E):
-    """One station's outputs: pose, material strain and stress, and (nt = 6) the station's
-    motion per unit base reaction, E = ∂(δp; δθ)/∂x with both rows in spatial components."""
+def _write(y, T, nt, j, s, arm, now, law, pose, strain, stress, E):
+    """One station's outputs: pose, the rod's own material strain ε - f⁰ and stress
+    K (ε - f⁰) (with actuators, the total wrench less the tendons' and the fluid's share),
+    and (nt = 6) the station's motion per unit base reaction, E = ∂(δp; δθ)/∂x with both
+    rows in spatial components."""
     for i in range(4):
         for k in range(4):
             pose[i, k] = 0.0
@@ -700,11 +1048,24 @@ def _write(y, T, nt, C, pose, strain, stress, E):
         stress[i] = y[_R + i] * y[_N] + y[_R + 3 + i] * y[_N + 1] + y[_R + 6 + i] * y[_N + 2]
         stress[3 + i] = (y[_R + i] * y[_M] + y[_R + 3 + i] * y[_M + 1]
                          + y[_R + 6 + i] * y[_M + 2])
-    for i in range(6):
-        acc = 0.0
-        for k in range(6):
-            acc += C[i, k] * stress[k]
-        strain[i] = acc
+    if _actuated(arm, j):
+        f0, K = arm[3], arm[8]
+        eps = _law(arm, j, s, now, law, stress[0], stress[1], stress[2], stress[3],
+                   stress[4], stress[5])
+        for i in range(6):
+            strain[i] = eps[i] - f0[j, i]
+        for i in range(6):
+            acc = 0.0
+            for k in range(6):
+                acc += K[j, i, k] * strain[k]
+            stress[i] = acc
+    else:
+        C = arm[2]
+        for i in range(6):
+            acc = 0.0
+            for k in range(6):
+                acc += C[j, i, k] * stress[k]
+            strain[i] = acc
     for d in range(min(nt, 6)):
         for i in range(3):
             E[i, d] = T[d, _TP + i]
@@ -716,25 +1077,26 @@ def _write(y, T, nt, C, pose, strain, stress, E):
 def _record(x, nt, steps, base, arm, case, scratch, s_out, out, b, r, J):
     """Integrate the solution x at λ = 1 once more and write every station's outputs (the
     same steps as :func:`_integrate`, so the same numbers), the tip residual r and, with
-    nt = 6, the Jacobian J and the station tangents.
+    nt = 6, the Jacobian J and the station tangents; and the case's base reaction and
+    tendon lengths.
 
     A station inside a step is reached by its own RK4 step from the start of that step, so
     the stations never change the steps of the solution. A station at a piece start gets the
     state after the point wrench there (the tip side). The station s = L (and any station
     past the last step's start) is written from the tip state itself.
     """
-    y, T, work, twork, now, tip_now, ys, Ts = scratch
+    y, T, work, twork, now, tip_now, ys, Ts, law = scratch
     poses, strains, stresses = out[0][b], out[1][b], out[2][b]
     E = out[6][b if nt > 0 else 0]  # a (1, S, 6, 6) placeholder without tangents
     rate, tip_rate = case[1], case[3]
-    piece_start, piece_len, C = arm[0], arm[1], arm[2]
+    piece_start, piece_len = arm[0], arm[1]
     _set_loads(1.0, case, now, tip_now)
     _start(y, T, nt, base, x)
     k = 0
     ns = s_out.size
     npieces = piece_len.size
     for j in range(npieces):
-        _jump(y, T, nt, now, rate, j)
+        _jump(y, T, nt, now, rate, j, arm, law)
         h = piece_len[j] / steps[j]
         for i in range(steps[j]):
             t0 = piece_start[j] + i * h
@@ -744,18 +1106,25 @@ def _record(x, nt, steps, base, arm, case, scratch, s_out, out, b, r, J):
             while k < ns and s_out[k] < t1:  # stations inside this step: own steps
                 if last and s_out[k] >= arm[6]:
                     break  # the tip station: the tip state itself, below
-                for a in range(18):
+                for a in range(y.size):
                     ys[a] = y[a]
                 for d in range(nt):
                     for a in range(NT):
                         Ts[d, a] = T[d, a]
-                _rk4(ys, Ts, nt, s_out[k] - t0, arm, j, now, rate, work, twork)
-                _write(ys, Ts, nt, C[j], poses[k], strains[k], stresses[k], E[k])
+                _rk4(ys, Ts, nt, s_out[k] - t0, t0, arm, j, now, rate, work, twork, law)
+                _write(ys, Ts, nt, j, s_out[k], arm, now, law, poses[k], strains[k],
+                       stresses[k], E[k])
                 k += 1
-            _rk4(y, T, nt, h, arm, j, now, rate, work, twork)
+            _rk4(y, T, nt, h, t0, arm, j, now, rate, work, twork, law)
     for i in range(k, ns):
-        _write(y, T, nt, C[npieces - 1], poses[i], strains[i], stresses[i], E[i])
-    _tip_residual(y, T, nt, tip_now, tip_rate, r, J)
+        _write(y, T, nt, npieces - 1, arm[6], arm, now, law, poses[i], strains[i],
+               stresses[i], E[i])
+    _tip_residual(y, T, nt, tip_now, tip_rate, r, J, arm, now, rate, law)
+    base_out, lengths = out[7], out[8]
+    for i in range(6):
+        base_out[b, i] = x[i]
+    for a in range(lengths.shape[1]):
+        lengths[b, a] = y[18 + a]
 
 
 @_jit
@@ -773,8 +1142,11 @@ def _load_size(arm, scale, start, end, tip_start, tip_end):
     the homotopy) and an upper estimate of the total turning of the arm (rad), the largest
     load moment about the base times ∫ ds/EI with each piece's softest bending
     compliance (bending; the pieces of a very soft segment need as many steps as its
-    turning)."""
+    turning). An actuator counts as a force |q| and a moment |q| ρ (ρ its largest distance
+    from the centreline) on each piece it acts on; a magnetisation m as a moment |m| |B|
+    per length, and a dipole as a moment |m| |B|, |B| bounded by |B0| + |G| (L + |p0|)."""
     piece_len, C = arm[1], arm[2]
+    routes, mag, dipoles = arm[9], arm[12], arm[13]
     L = arm[6]
     fs, ms = scale[0], scale[3]
     flexibility = 0.0  # ∫ ds / EI, with each piece's largest rotational compliance
@@ -799,6 +1171,20 @@ def _load_size(arm, scale, start, end, tip_start, tip_end):
                 m += abs(loads[j, _LD + i]) + abs(loads[j, _LF + i])
                 jf += abs(loads[j, _JD + i]) + abs(loads[j, _JF + i])
                 jm += abs(loads[j, _JD + 3 + i]) + abs(loads[j, _JF + 3 + i])
+            field = 0.0
+            for i in range(3):
+                field += abs(loads[j, _FB + i])
+            for i in range(9):
+                field += abs(loads[j, _FG + i]) * 2.0 * L
+            dipole = abs(dipoles[j, 0]) + abs(dipoles[j, 1]) + abs(dipoles[j, 2])
+            if j == piece_len.size - 1:
+                dipole += abs(dipoles[j + 1, 0]) + abs(dipoles[j + 1, 1]) + abs(dipoles[j + 1, 2])
+            m += (abs(mag[j, 0]) + abs(mag[j, 1]) + abs(mag[j, 2])) * field
+            jm += dipole * field
+            for a in range(routes.shape[0]):
+                q = abs(loads[j, _ACT + a])
+                jf = max(jf, q)
+                jm += q * routes[a, _RHO]
             f_along += f * piece_len[j] + jf
             w = max(w, f_along / fs, m * piece_len[j] / ms, jm / ms)
             total += f * piece_len[j] * 0.5 * L + jf * L + m * piece_len[j] + jm
@@ -872,12 +1258,16 @@ def _chord(x, J_c, steps, base, arm, case, scratch, scale, threshold, max_iterat
 
 
 @_jit
-def _scratch(npieces):
-    """Work arrays of one integration (state, tangents, RK4 stages, loads at λ, a station's
-    own state and tangents)."""
-    return (np.empty(18), np.empty((7, NT)), np.empty((6, 24)), np.empty((5, 7, NT)),
-            np.empty((npieces, PIECE_LOADS)), np.empty(TIP_LOADS), np.empty(18),
-            np.empty((7, NT)))
+def _scratch(npieces, nact):
+    """Work arrays of one integration (state with the nact tendon lengths, tangents, RK4
+    stages, loads at λ, a station's own state and tangents, and the constitutive law's:
+    the 6 × 14 elimination matrix, per actuator (t, |w|, y, z, y', z'), small vectors)."""
+    width = 18 + nact
+    law = (np.empty((6, 14)), np.zeros((max(nact, 1), 8)), np.zeros((6, 6)),
+           np.zeros((6, 6)))
+    return (np.empty(width), np.empty((7, NT)), np.empty((6, width)), np.empty((5, 7, NT)),
+            np.empty((npieces, PIECE_LOADS + nact)), np.empty(TIP_LOADS), np.empty(width),
+            np.empty((7, NT)), law)
 
 
 @_jit
@@ -903,16 +1293,23 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, out):
     ----------
     base : (4, 4) base pose.
     arm : (piece_start (P,), piece_len (P,), C (P, 6, 6) compliance, f0 (P, 6) reference
-        strain, zero (P, 6), diag (bool: every C diagonal), length, scale (6,) residual scale)
-    loads : (piece (B, P, PIECE_LOADS), tip (B, TIP_LOADS)): each case's loads at λ = 1.
-    first : (piece (P, PIECE_LOADS), tip (TIP_LOADS,)): case 0's start loads when chained.
+        strain, zero (P, 6), diag (bool: every C diagonal), length, scale (6,) residual
+        scale, K (P, 6, 6) stiffness, routes (A, 4 + 2D) actuator paths, kinds (A,) TENDON or
+        CHAMBER, active (P, A) 1.0 where actuator a acts on piece j, mag (P, 3) magnetisation
+        (A m²/m, material), dipoles (P + 1, 3) dipole at each piece start and at the tip
+        (A m², material)); see README.md.
+    loads : (piece (B, P, PIECE_LOADS + A), tip (B, TIP_LOADS)): each case's loads at λ = 1.
+    first : (piece (P, PIECE_LOADS + A), tip (TIP_LOADS,)): case 0's start loads when
+        chained.
     options : (OPTIONS,) tol (m; inf with a fixed step count), max_iterations, max_load_step,
         fixed step count (0: from tol), largest step count, shootings budget, chained (0/1),
         jacobians (0/1), the ratio of the step counts of the solution and of the path.
     memory : (MEMORY,) the chained start (x at N, x at 2N, N, valid), read and rewritten.
     out : (poses (B, S, 4, 4), strains (B, S, 6), stresses (B, S, 6), info (B, 5) [residual,
         error estimate, load factor reached, shootings, N], status (B,), J (B, 6, 6) at the
-        solution (jacobians), E (B, S, 6, 6) station motion per unit x (jacobians)).
+        solution (jacobians), E (B, S, 6, 6) station motion per unit x (jacobians), x (B, 6)
+        the base reaction (total wrench at the clamp, spatial), lengths (B, A) each tendon's
+        length).
     """
     piece_loads, tip_loads = loads
     nb = piece_loads.shape[0]
@@ -929,9 +1326,10 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, out):
     nt_out = 6 if options[_O_JACOBIANS] > 0.0 else 0
     coarse_ratio = int(options[_O_COARSE])
     info, status, jac = out[3], out[4], out[5]
-    scratch = _scratch(npieces)
-    start = np.zeros((npieces, PIECE_LOADS))
-    rate = np.empty((npieces, PIECE_LOADS))
+    width = piece_loads.shape[2]
+    scratch = _scratch(npieces, width - PIECE_LOADS)
+    start = np.zeros((npieces, width))
+    rate = np.empty((npieces, width))
     tip_start = np.zeros(TIP_LOADS)
     tip_rate = np.empty(TIP_LOADS)
     case = (start, rate, tip_start, tip_rate)
@@ -954,12 +1352,12 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, out):
         # the homotopy of this case: start loads and their rate of change with λ
         if chained:
             for j in range(npieces):
-                for i in range(PIECE_LOADS):
+                for i in range(width):
                     start[j, i] = first[0][j, i] if b == 0 else piece_loads[b - 1, j, i]
             for i in range(TIP_LOADS):
                 tip_start[i] = first[1][i] if b == 0 else tip_loads[b - 1, i]
         for j in range(npieces):
-            for i in range(PIECE_LOADS):
+            for i in range(width):
                 rate[j, i] = piece_loads[b, j, i] - start[j, i]
         for i in range(TIP_LOADS):
             tip_rate[i] = tip_loads[b, i] - tip_start[i]
@@ -1122,7 +1520,7 @@ def shoot(x, lam, steps, base, arm, case, r, J, tip_state, tip_tangents):
     ``steps`` RK4 steps per piece; returns in place the residual r (6), its Jacobian J (6, 7)
     (columns: ∂r/∂x, then ∂r/∂λ), the tip state (18: p, R row-major, n, m spatial) and the
     tip tangents (7, 12) (per column: δp spatial, δθ material, δn, δm spatial)."""
-    scratch = _scratch(arm[1].size)
+    scratch = _scratch(arm[1].size, case[0].shape[1] - PIECE_LOADS)
     _integrate(x, lam, J.shape[1], steps, base, arm, case, scratch, r, J)
     _copy(scratch[0], tip_state)
     _copy(scratch[1], tip_tangents)

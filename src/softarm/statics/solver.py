@@ -110,6 +110,10 @@ class _ArmData:
                          "the arm's bending scale EI/L² and EI/L")
         self.scale = np.array([self.force_scale] * 3 + [bending / self.length] * 3)
         self.diag = bool(np.all(self.C[:, ~np.eye(6, dtype=bool)] == 0.0))
+        # hard magnets: the magnetisation per length of each segment, and the dipole at each
+        # segment's distal end (material components)
+        self.magnetization = np.array([_magnet(seg, "magnetization") for seg in segments])
+        self.dipoles = np.array([_magnet(seg, "tip_magnet") for seg in segments])
 
     @functools.lru_cache(maxsize=16)  # noqa: B019 (per arm data, itself cached per arm)
     def pieces(self, cuts: tuple[float, ...]) -> tuple:
@@ -121,8 +125,21 @@ class _ArmData:
         middle = starts + 0.5 * lengths
         segment = np.clip(np.searchsorted(self.bounds, middle) - 1, 0, len(self.K) - 1)
         f0 = np.ascontiguousarray(self.f0[segment])
+        dipoles = np.zeros((starts.size + 1, 3))
+        for k, end in enumerate(self.bounds[1:]):  # segment k's dipole at its distal end
+            dipoles[np.searchsorted(starts, end) if end < self.length else -1] += \
+                self.dipoles[k]
         return (starts, lengths, np.ascontiguousarray(self.C[segment]), f0,
-                np.zeros_like(f0), self.diag, self.length, self.scale, self.mu[segment])
+                np.zeros_like(f0), self.diag, self.length, self.scale,
+                np.ascontiguousarray(self.K[segment]),
+                np.ascontiguousarray(self.magnetization[segment]), dipoles,
+                self.mu[segment], segment)
+
+
+def _magnet(segment, name: str) -> np.ndarray:
+    """A segment's ``magnetization`` or ``tip_magnet`` (material components), zeros if None."""
+    value = getattr(segment, name, None)
+    return np.zeros(3) if value is None else np.asarray(value, dtype=np.float64)
 
 
 @functools.lru_cache(maxsize=64)
@@ -158,12 +175,16 @@ class _Channels:
         self.k = k
         self.arm = data.arm
         self.length = data.length
-        self.starts, self.lengths, self.mu = pieces[0], pieces[1], pieces[8]
+        self.pieces = pieces
+        self.starts, self.lengths, self.mu = pieces[0], pieces[1], pieces[11]
+        self.shape, self.count = shape, count
         P = self.starts.size
         self.piece = np.zeros((count, P, k.PIECE_LOADS))
         self.tip_loads = np.zeros((count, k.TIP_LOADS))
         self._piece = self.piece.reshape(*shape, P, k.PIECE_LOADS)
         self._tip = self.tip_loads.reshape(*shape, k.TIP_LOADS)
+        self.actuators = []  # (kind code, routing, active rows) per actuator column
+        self.has_field = False
 
     def _rows(self, span):
         if span is None:
@@ -199,6 +220,48 @@ class _Channels:
             self._tip[..., at:at + 3] += force
         if moment is not None:
             self._tip[..., at + 3:at + 6] += moment
+
+    def actuator(self, kind, magnitude, routing, span):
+        k = self.k
+        rows = self._rows(span)
+        # one more column (actuators are few; the batch's piece array grows by one column)
+        P = self.starts.size
+        self.piece = np.concatenate([self.piece, np.zeros((self.count, P, 1))], axis=2)
+        self._piece = self.piece.reshape(*self.shape, P, self.piece.shape[2])
+        column = self.piece.shape[2] - 1
+        self._piece[..., rows, column] = np.asarray(magnitude)[..., None]
+        active = np.zeros(P)
+        active[rows] = 1.0
+        self.actuators.append((k.TENDON if kind == "tendon" else k.CHAMBER, routing, active,
+                               (float(span[0]), float(span[1]))))
+
+    def field(self, field, gradient=None):
+        k = self.k
+        self.has_field = True
+        self._piece[..., :, k.FB:k.FB + 3] += np.asarray(field)[..., None, :]
+        if gradient is not None:
+            G = np.asarray(gradient).reshape(*np.shape(gradient)[:-2], 9)
+            self._piece[..., :, k.FG:k.FG + 9] += G[..., None, :]
+
+    def arm_tuple(self) -> tuple:
+        """The kernel's arm tuple: the pieces and the actuators' paths (see _kernels)."""
+        pieces = self.pieces
+        degree = max([1] + [routing.degree for _, routing, _, _ in self.actuators])
+        A = len(self.actuators)
+        routes = np.zeros((A, 4 + 2 * degree))
+        kinds = np.zeros(A, dtype=np.int64)
+        active = np.zeros((self.starts.size, A))
+        for a, (kind, routing, rows, _) in enumerate(self.actuators):
+            routes[a] = routing.kernel_row(degree)
+            routes[a, 0] = routing.bound(self.length)
+            kinds[a] = kind
+            active[:, a] = rows
+        return (*pieces[:8], pieces[8], routes, kinds, active, pieces[9], pieces[10])
+
+    def signature(self) -> tuple:
+        """What identifies the actuators (kinds, paths, where they act): a chained solve
+        continues from the last case only if this is unchanged."""
+        return tuple((kind, routing, span) for kind, routing, _, span in self.actuators)
 
 
 @dataclass(frozen=True)
@@ -394,9 +457,13 @@ class Solver:
         last = self._last if chained else None
         loads, shape, count, pieces, channels = self._prepare(
             loads, () if last is None else tuple(last[0]))
+        if last is not None and last[3] != channels.signature():
+            # other actuators than the last case's: no continuous path from it
+            self.reset()
+            last = None
         if last is None:  # from the unloaded arm
-            first_piece, first_tip = np.zeros((pieces[0].size, k.PIECE_LOADS)), np.zeros(
-                k.TIP_LOADS)
+            first_piece, first_tip = np.zeros((pieces[0].size, channels.piece.shape[2])), \
+                np.zeros(k.TIP_LOADS)
         else:
             first_piece, first_tip = _recut(last[0], last[1], pieces[0]), last[2]
         if self._memory is None or not chained:
@@ -413,21 +480,25 @@ class Solver:
         status = np.zeros(count, dtype=np.int64)
         jac = np.zeros((count, 6, 6) if jacobians else (0, 6, 6))
         motion = np.zeros((count, S, 6, 6) if jacobians else (1, S, 6, 6))
-        arm_tuple = pieces[:8]
-        k.solve_cases(self._base_kernel, arm_tuple, (channels.piece, channels.tip_loads),
-                      (first_piece, first_tip), self._options(chained, jacobians),
-                      self._s_kernel, memory, (poses, strains, stresses, info, status, jac,
-                                               motion))
+        base_wrench = np.empty((count, 6))
+        lengths = np.empty((count, len(channels.actuators)))
+        k.solve_cases(self._base_kernel, channels.arm_tuple(),
+                      (channels.piece, channels.tip_loads), (first_piece, first_tip),
+                      self._options(chained, jacobians), self._s_kernel, memory,
+                      (poses, strains, stresses, info, status, jac, motion, base_wrench,
+                       lengths))
         failed = np.flatnonzero(status != k.OK)
         if failed.size:
             if chained:
                 self.reset()
             raise _failure(k, failed[0], shape, status, info, self)
         if chained and count:
-            self._last = (pieces[0], channels.piece[-1].copy(), channels.tip_loads[-1].copy())
+            self._last = (pieces[0], channels.piece[-1].copy(), channels.tip_loads[-1].copy(),
+                          channels.signature())
         tip_compliance = compliance = None
         if jacobians:
             tip_compliance, compliance = _compliances(jac, motion, shape)
+        actuation = _actuation(channels, base_wrench, lengths, shape)
         # fresh arrays, frozen before reshaping: Equilibrium takes them without a copy
         for array in (poses, strains, stresses, info):
             array.setflags(write=False)
@@ -446,6 +517,7 @@ class Solver:
             error_estimate=estimate.reshape(shape) if shape else float(estimate[0]),
             tip_compliance=tip_compliance,
             compliance=compliance,
+            **actuation,
         )
 
     def shoot(self, loads, x, load_factor=1.0, *, steps=None) -> ShootResult:
@@ -468,9 +540,9 @@ class Solver:
         case = (np.zeros_like(channels.piece[0]), channels.piece[0].copy(),
                 np.zeros(k.TIP_LOADS), channels.tip_loads[0].copy())
         r, J = np.empty(6), np.empty((6, 7))
-        y, T = np.empty(18), np.empty((7, 12))
-        k.shoot(x.copy(), float(load_factor), counts, self._base_kernel, pieces[:8], case,
-                r, J, y, T)
+        y, T = np.empty(18 + len(channels.actuators)), np.empty((7, 12))
+        k.shoot(x.copy(), float(load_factor), counts, self._base_kernel, channels.arm_tuple(),
+                case, r, J, y, T)
         R = y[3:12].reshape(3, 3)
         pose = np.eye(4)
         pose[:3, :3], pose[:3, 3] = R, y[:3]
@@ -478,6 +550,49 @@ class Solver:
         motion[:3] = T[:6, :3].T
         motion[3:] = R @ T[:6, 3:6].T
         return ShootResult(r, J[:, :6].copy(), J[:, 6].copy(), pose, motion)
+
+
+def _actuation(channels, base_wrench, lengths, shape) -> dict:
+    """The Equilibrium's actuation fields: the total base wrench and, per tendon (in the
+    order given), its tension, length and length change from the unloaded arm."""
+    k = channels.k
+    tendons = [a for a, actuator in enumerate(channels.actuators) if actuator[0] == k.TENDON]
+    base_wrench.setflags(write=False)
+    out = {"base_wrench": base_wrench.reshape(*shape, 6)}
+    if not tendons:
+        return out
+    pieces = channels.pieces
+    unloaded = np.array([_unloaded_length(pieces, channels.actuators[a]) for a in tendons])
+    length = lengths[:, tendons]
+    tension = channels.piece[:, :, k.ACT + np.array(tendons)].max(axis=1)
+    for array in (length, tension):
+        array.setflags(write=False)
+    change = length - unloaded
+    change.setflags(write=False)
+    out.update(tendon_tensions=tension.reshape(*shape, len(tendons)),
+               tendon_lengths=length.reshape(*shape, len(tendons)),
+               tendon_length_changes=change.reshape(*shape, len(tendons)))
+    return out
+
+
+def _unloaded_length(pieces, actuator) -> float:
+    """A tendon's length in the unloaded arm, ∫ |e1 + κ⁰ × r + r'| ds over the pieces it
+    runs through (Gauss–Legendre, 24 nodes per piece and per quarter turn of a helix)."""
+    _, routing, active, _ = actuator
+    starts, lengths, f0 = pieces[0], pieces[1], pieces[3]
+    total = 0.0
+    for j in np.flatnonzero(active):
+        turns = abs(routing.helix[1]) * lengths[j]
+        nodes, weights = np.polynomial.legendre.leggauss(24)
+        parts = max(1, int(np.ceil(4 * turns)))
+        for q in range(parts):
+            a = starts[j] + lengths[j] * q / parts
+            h = lengths[j] / parts
+            s = a + 0.5 * h * (nodes + 1.0)
+            r, dr = routing.position(s), routing.derivative(s)
+            w = f0[j, :3] + np.cross(f0[j, 3:], r) + dr
+            total += 0.5 * h * float(weights @ np.linalg.norm(w, axis=-1))
+    return total
 
 
 def _largest(vector) -> float:
@@ -489,11 +604,12 @@ def _recut(old_starts, old_piece, new_starts) -> np.ndarray:
     contains every old cut): distributed channels from the old piece that contains the new
     piece, point wrenches where an old piece started."""
     k = _kernels()
-    out = np.zeros((new_starts.size, k.PIECE_LOADS))
+    out = np.zeros((new_starts.size, old_piece.shape[1]))
     inside = np.clip(np.searchsorted(old_starts, new_starts, side="right") - 1, 0, None)
     out[:, :k.JD] = old_piece[inside, :k.JD]
     same = np.isin(new_starts, old_starts)
-    out[same, k.JD:] = old_piece[inside[same], k.JD:]
+    out[same, k.JD:k.FB] = old_piece[inside[same], k.JD:k.FB]
+    out[:, k.FB:] = old_piece[inside, k.FB:]  # the field and the actuators: distributed
     return out
 
 

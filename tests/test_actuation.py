@@ -1,0 +1,429 @@
+"""Actuation: tendons (Rucker & Webster 2011 in total-wrench form), pneumatic chambers (the
+rigid-section fluid wrench) and hard magnets in a magnetic field, in the numerical solver.
+
+References, none of them the library's solver:
+
+- the constant-strain closed forms (the arm under its tendons or chambers alone carries no
+  total wrench, so the strain solves an algebraic equation, solved here with
+  ``scipy.optimize.root``; poses by ``scipy.linalg.expm`` of the SE(3) twist), including
+  tendons that end mid-arm (a product of exponentials) and the helical tendon's exact helix;
+- peer codes' outputs, run at stated commits (softarm/validation/data/actuation_benchmarks.json):
+  Till & Rucker's ContinuumRobotExamples (straight and helical 4-tendon robots under gravity)
+  and tdcr-modeling's two-segment Cosserat example;
+- the Mattiasson (1981) elastica table: a uniformly, axially magnetised rod in a uniform field
+  is exactly the inextensible elastica under the dead tip force m_l B;
+- global balance of the arm with its actuators (the total base wrench against the external
+  loads), and central finite differences of the shooting residual for every new tangent
+  term.
+"""
+
+from __future__ import annotations
+
+import json
+import warnings
+from importlib import resources
+
+import numpy as np
+import pytest
+from scipy.integrate import simpson
+from scipy.linalg import expm
+from scipy.optimize import root
+
+import softarm
+from softarm import Arm, Chamber, Gravity, MagneticField, SegmentedArm, Tendon, TipLoad
+from softarm.routing import Helix, Polynomial, Straight
+
+
+def _data(name):
+    return json.loads(resources.files("softarm.validation.data").joinpath(name).read_text())
+
+
+def hat(w):
+    return np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
+
+
+def twist(eps):
+    """The 4 × 4 matrix of the body strain (v; u)."""
+    X = np.zeros((4, 4))
+    X[:3, :3] = hat(eps[3:])
+    X[:3, 3] = eps[:3]
+    return X
+
+
+def constant_strain(K, f0, tendons, chambers=()):
+    """The root ε of K (ε - f0) + Σ τ (t; r × t) = Σ_c q (e1; r × e1), t = w/|w|, w = v + u × r
+    + r' (tendons: (τ, r, r'); chambers: (pA, r)), by scipy's root finder from f0."""
+    wrench = np.zeros(6)
+    for q, r in chambers:
+        wrench += q * np.concatenate([[1.0, 0.0, 0.0], np.cross(r, [1.0, 0.0, 0.0])])
+
+    def residual(eps):
+        out = K @ (eps - f0) - wrench
+        for tau, r, dr in tendons:
+            w = eps[:3] + np.cross(eps[3:], r) + dr
+            t = w / np.linalg.norm(w)
+            out += tau * np.concatenate([t, np.cross(r, t)])
+        return out
+
+    eps = root(residual, f0, method="lm", options={"xtol": 1e-15, "ftol": 1e-15}).x
+    assert np.max(np.abs(residual(eps))) < 1e-9 * np.max(np.abs(K))
+    return eps
+
+
+def numeric(arm, loads, **options):
+    return softarm.solve(arm, loads, method="numeric", **options)
+
+
+STEEL = dict(EA=67858.40131753951, GAy=26099.4, GAz=26099.4, GJ=0.0047, EIy=0.006107256118578555,
+             EIz=0.006107256118578555)
+
+
+# ============================================================================================
+# Closed forms: constant strain
+# ============================================================================================
+
+def test_straight_tendon_arc_from_the_reference_example():
+    # actuation_benchmarks.json, closed_forms[0].example_evaluated_here: EA, EI, L = 0.25 m,
+    # τ = 3 N at r = (0, 0, 0.008): u = (0, -3.92975..., 0), axial strain -4.42e-5
+    example = _data("actuation_benchmarks.json")["closed_forms"][0]["example_evaluated_here"]
+    EA, EI, L = example["EA"], example["EI"], example["L"]
+    arm = Arm.from_stiffness(L, EA=EA, GAy=EA, GAz=EA, GJ=EI, EIy=EI, EIz=EI)
+    eq = numeric(arm, Tendon(example["tension"], Straight(*example["offset_material"][1:])),
+                 tol=1e-10)
+    np.testing.assert_allclose(eq.tip_position, example["tip_position"], rtol=0, atol=1e-8 * L)
+    np.testing.assert_allclose(eq.poses[-1, :3, :3], example["tip_rotation"], atol=1e-8)
+    np.testing.assert_allclose(eq.strains[:, 4], example["curvature_u"][1], rtol=1e-9)
+    np.testing.assert_allclose(eq.strains[:, 0], example["axial_strain"], rtol=1e-7)
+
+
+def test_tendons_on_a_coupled_stiffness_have_constant_strain_at_every_station():
+    # a full symmetric positive-definite K (fibre-reinforced: extension-twist and
+    # shear-bending couplings): t is no longer e1, the root is found by scipy's root finder
+    K = np.diag([2.0e3, 8.0e2, 9.0e2, 2.0e-3, 3.0e-3, 3.5e-3])
+    K[0, 3] = K[3, 0] = 0.6
+    K[1, 5] = K[5, 1] = 0.2
+    K[2, 4] = K[4, 2] = -0.25
+    L = 0.2
+    arm = Arm.from_stiffness_matrix(L, K, curvature=(0.0, 1.0, 0.0))
+    tendons = [Tendon(1.5, Straight(0.004, 0.003)), Tendon(0.7, Straight(-0.005, 0.0))]
+    eq = numeric(arm, tendons, s=21, tol=1e-11)
+    f0 = arm.reference_strain
+    eps = constant_strain(K, f0, [(1.5, np.array([0.0, 0.004, 0.003]), np.zeros(3)),
+                                  (0.7, np.array([0.0, -0.005, 0.0]), np.zeros(3))])
+    expected = np.array([expm(s * twist(eps)) for s in eq.s])
+    np.testing.assert_allclose(eq.poses, expected, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(eq.strains, np.broadcast_to(eps - f0, (21, 6)), rtol=0,
+                               atol=1e-10 * np.max(np.abs(eps - f0)))
+    # no external load: the total wrench vanishes, the rod's own stress is K (ε - f0)
+    np.testing.assert_allclose(eq.base_wrench, 0.0, atol=1e-10)
+    np.testing.assert_allclose(eq.stresses, np.broadcast_to(K @ (eps - f0), (21, 6)),
+                               rtol=0, atol=1e-9 * 1.5)
+
+
+def test_tendons_ending_mid_arm_are_a_product_of_exponentials():
+    arm = SegmentedArm([Arm.from_stiffness(0.15, **STEEL), Arm.from_stiffness(0.1, **STEEL)])
+    loads = [Tendon(2.0, Straight(0.0, 0.008), end=0.15), Tendon(1.0, Straight(0.008, 0.0)),
+             Tendon(0.5, Straight(-0.004, -0.004), end=0.2)]
+    s = np.linspace(0.0, 0.25, 26)
+    eq = numeric(arm, loads, s=s, tol=1e-11)
+    K = np.diag(list(STEEL.values()))
+    f0 = np.array([1.0, 0, 0, 0, 0, 0])
+    all_ = [(2.0, np.array([0, 0, 0.008]), np.zeros(3)), (1.0, np.array([0, 0.008, 0]),
+                                                            np.zeros(3)),
+            (0.5, np.array([0, -0.004, -0.004]), np.zeros(3))]
+    pieces = [(0.0, 0.15, all_), (0.15, 0.2, all_[1:]), (0.2, 0.25, all_[1:2])]
+    start = np.eye(4)
+    expected = []
+    for s0, s1, active in pieces:
+        X = twist(constant_strain(K, f0, active))
+        for si in s:
+            if s0 <= si < s1 or (si == s1 == 0.25):
+                expected.append(start @ expm((si - s0) * X))
+        start = start @ expm((s1 - s0) * X)
+    np.testing.assert_allclose(eq.poses, np.array(expected), rtol=0, atol=1e-10)
+    # each tendon's length change: the integral of |w| - 1 (here t = e1, |w| = v1 + u × r)
+    change = eq.tendon_length_changes
+    assert change.shape == (3,)
+    eps0 = constant_strain(K, f0, all_)
+    w0 = eps0[0] + eps0[4] * 0.008  # tendon 0 on the first 0.15 m: v1 + u_y z
+    np.testing.assert_allclose(change[0], 0.15 * (w0 - 1.0), rtol=1e-9)
+
+
+def test_chambers_bend_the_arm_away_exactly_for_any_stiffness():
+    # ε = f0 + K⁻¹ Σ p A (e1; r × e1) on the chambers' spans, for a coupled K
+    K = np.diag([4.0e2, 1.5e2, 1.5e2, 4.0e-4, 6.0e-4, 6.0e-4])
+    K[0, 4] = K[4, 0] = 0.05
+    L = 0.3
+    arm = Arm.from_stiffness_matrix(L, K)
+    p, area = 2.0e4, 2.0e-5
+    loads = [Chamber(p, area, Straight(0.0, 0.006)),
+             Chamber(0.5 * p, area, Straight(0.006, 0.0), start=0.1, end=0.2)]
+    s = np.linspace(0.0, L, 31)
+    eq = numeric(arm, loads, s=s, tol=1e-11)
+    f0 = arm.reference_strain
+    W = [p * area * np.array([1, 0, 0, 0, 0.006, 0.0]),
+         0.5 * p * area * np.array([1, 0, 0, 0, 0.0, -0.006])]
+    eps = [f0 + np.linalg.solve(K, W[0]), f0 + np.linalg.solve(K, W[0] + W[1])]
+    expected, start = [], np.eye(4)
+    for s0, s1, e in ((0.0, 0.1, eps[0]), (0.1, 0.2, eps[1]), (0.2, L, eps[0])):
+        for si in s:
+            if s0 <= si < s1 or si == s1 == L:
+                expected.append(start @ expm((si - s0) * twist(e)))
+        start = start @ expm((s1 - s0) * twist(e))
+    np.testing.assert_allclose(eq.poses, np.array(expected), rtol=0, atol=1e-10)
+    assert eq.tip_position[2] < 0  # away from the chamber at +z
+    assert eq.tendon_lengths is None
+
+
+def test_helical_tendon_on_an_axisymmetric_rod_is_an_exact_helix():
+    # actuation_benchmarks.json closed_forms[4]: ε(s) = blockdiag(Q, Q) ε0, Q = exp(k s e1~);
+    # in the frame R Q the strain is constant (v0; u0 + k e1)
+    EA, GA, GJ, EI = 3.0e3, 1.2e3, 4.0e-3, 5.0e-3
+    L, rho, turns, tau = 0.25, 0.01, 2.0, 1.2
+    arm = Arm.from_stiffness(L, EA=EA, GAy=GA, GAz=GA, GJ=GJ, EIy=EI, EIz=EI)
+    routing = Helix(rho, turns)
+    eq = numeric(arm, Tendon(tau, routing), s=26, tol=1e-11)
+    k = 2 * np.pi * turns
+    K = np.diag([EA, GA, GA, GJ, EI, EI])
+    eps0 = constant_strain(K, arm.reference_strain,
+                           [(tau, routing.position(0.0), routing.derivative(0.0))])
+    xi = eps0 + np.array([0, 0, 0, k, 0, 0])
+    for si, pose in zip(eq.s, eq.poses, strict=True):
+        g = expm(si * twist(xi))
+        Q = expm(si * k * hat([1.0, 0, 0]))
+        np.testing.assert_allclose(pose[:3, 3], g[:3, 3], rtol=0, atol=1e-10)
+        np.testing.assert_allclose(pose[:3, :3], g[:3, :3] @ Q.T, rtol=0, atol=1e-9)
+
+
+# ============================================================================================
+# Peer codes
+# ============================================================================================
+
+def _till_arm(peer):
+    par = peer["parameters"]
+    E, G, r = par["E"], par["G"], par["radius"]
+    A, second = np.pi * r**2, np.pi * r**4 / 4
+    return Arm.from_stiffness(par["L"], EA=E * A, GAy=G * A, GAz=G * A, GJ=G * 2 * second,
+                              EIy=E * second, EIz=E * second, mass_per_length=par["rho"] * A)
+
+
+@pytest.mark.parametrize("name", ["till_tendon_robot_straight", "till_tendon_robot_helical"])
+def test_till_rucker_tendon_robots_under_gravity(name):
+    # JohnDTill/ContinuumRobotExamples at 064f593 (converged settings: 4001 grid points),
+    # mapped to softarm's axes (peer e3 = softarm e1): reproduced to 1e-11 m independently
+    peer = _data("actuation_benchmarks.json")["peer_code_outputs"][name]
+    arm = _till_arm(peer)
+    d = 0.01506
+    tensions = peer["parameters"]["tensions"]
+    if name.endswith("straight"):
+        routes = [Straight(d * np.cos(a), d * np.sin(a)) for a in np.arange(4) * np.pi / 2]
+    else:
+        routes = [Helix(d, 1.0 / peer["parameters"]["L"], phase=i * np.pi / 2)
+                  for i in range(4)]
+    loads = [Gravity([0.0, 9.81, 0.0])] + [Tendon(t, r) for t, r in zip(tensions, routes,
+                                                                         strict=True)]
+    eq = numeric(arm, loads, tol=1e-11)
+    ref = peer["converged_settings"]
+    np.testing.assert_allclose(eq.tip_position, ref["tip_position_softarm"], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(eq.poses[-1, :3, :3], ref["tip_rotation_softarm"], rtol=0,
+                               atol=1e-8)
+    # the printed base force n(0) = (0.12327, 0, -15) N in the peer's frame is the rod's own
+    # (the tendon's 15 N pull is not in it): softarm's rod stress at s = 0
+    nb0 = np.array(ref["base_guess_printed"]["nb0_peer_frame"])
+    np.testing.assert_allclose(eq.forces_spatial[0], nb0[[2, 0, 1]], rtol=0, atol=1e-7)
+
+
+def test_tdcr_modeling_two_segment_cosserat_example():
+    # SvenLilge/tdcr-modeling at 379d34a, its default example, 'Cosserat Rod' model (peer
+    # ODE tolerance rkf45 abs 1e-6 / rel 1e-3: equal to the closed form to 4.4e-8 m)
+    peer = _data("actuation_benchmarks.json")["peer_code_outputs"]["tdcr_modeling_default"]
+    E = 54e9
+    G = E / 2.6
+    r = 0.0007
+    A, second = np.pi * r**2, np.pi * r**4 / 4
+    seg = Arm.from_stiffness(0.2, EA=E * A, GAy=G * A, GAz=G * A, GJ=2 * G * second,
+                             EIy=E * second, EIz=E * second)
+    arm = SegmentedArm([seg, seg])
+    d = 0.01
+    angles = np.deg2rad([90.0, -30.0, 210.0])
+    routes = [Straight(d * np.cos(a), d * np.sin(a)) for a in angles]  # peer (x, y) -> (y, z)
+    tensions = peer["parameters"]["tensions_N"]
+    loads = [Tendon(t, routes[i % 3], end=0.2 if i < 3 else None)
+             for i, t in enumerate(tensions)]
+    eq = numeric(arm, loads, tol=1e-11)
+    np.testing.assert_allclose(eq.tip_position, peer["tip_position_softarm"]["Cosserat Rod"],
+                               rtol=0, atol=1e-7)
+
+
+# ============================================================================================
+# Magnetic actuation
+# ============================================================================================
+
+@pytest.mark.parametrize("k", [1.0, 2.0, 5.0])
+def test_axially_magnetised_rod_is_the_inextensible_elastica(k):
+    # a uniform field B ⟂ the rod, magnetisation m_l e1: the inextensible elastica under the
+    # dead tip force m_l B (shear and extension do not enter: n = 0); Mattiasson (1981) via
+    # the elliptic-integral table in mattiasson_cantilever.json (computed_here, 7 digits)
+    table = {row["k"]: row for row in _data("mattiasson_cantilever.json")["computed_here"][
+        "table"]}
+    row = table[k]
+    EI, L, m_l = 0.02, 0.5, 2.0
+    arm = Arm.from_stiffness(L, EA=50.0, GAy=30.0, GAz=30.0, GJ=0.015, EIy=EI, EIz=EI,
+                             magnetization=(m_l, 0.0, 0.0))
+    B = k * EI / (L**2 * m_l)
+    eq = numeric(arm, MagneticField([0.0, 0.0, B]), tol=1e-11)
+    np.testing.assert_allclose(eq.tip_position[2] / L, row["w_over_L"], rtol=0, atol=2e-8)
+    np.testing.assert_allclose(1 - eq.tip_position[0] / L, row["u_over_L"], rtol=0, atol=2e-7)
+    np.testing.assert_allclose(eq.strains[:, :3], 0.0, atol=1e-12)  # no stretch, no shear
+    # base wrench: n(0) = 0, m(0) = m_l p(L) × B
+    np.testing.assert_allclose(eq.base_wrench[:3], 0.0, atol=1e-12)
+    np.testing.assert_allclose(eq.base_wrench[3:], m_l * np.cross(eq.tip_position, [0, 0, B]),
+                               rtol=1e-9, atol=1e-15)
+
+
+def test_a_tip_dipole_in_a_uniform_field_is_a_tip_couple():
+    # the tip dipole m in a uniform B: the couple (R(L) m) × B, a "follower" couple whose
+    # moment depends on the tip's rotation; its equilibrium: the same arm under the dead tip
+    # moment (R(L) m) × B evaluated at the solution (a fixed-point check)
+    EI = 0.01
+    arm = Arm.from_stiffness(0.3, EA=1e3, GAy=1e3, GAz=1e3, GJ=0.008, EIy=EI, EIz=EI,
+                             tip_magnet=(0.05, 0.0, 0.0))
+    B = np.array([0.0, 0.1, 0.05])
+    eq = numeric(arm, MagneticField(B), tol=1e-11)
+    couple = np.cross(eq.poses[-1, :3, :3] @ [0.05, 0.0, 0.0], B)
+    again = numeric(arm, TipLoad(moment=couple), tol=1e-11)
+    np.testing.assert_allclose(eq.poses, again.poses, rtol=0, atol=1e-10)
+
+
+def test_magnetic_gradient_and_global_balance():
+    # a gradient field pulls the magnetised arm: the total base wrench balances the force
+    # ∫ Gᵀ R m ds and moment ∫ (p × Gᵀ R m + (R m) × B(p)) ds rebuilt from the stations
+    G = np.array([[0.2, 0.1, 0.0], [0.1, -0.5, 0.05], [0.0, 0.05, 0.3]])
+    mag = np.array([1.5, 0.3, -0.2])
+    arm = Arm.from_stiffness(0.4, EA=2e2, GAy=1e2, GAz=1e2, GJ=0.01, EIy=0.02, EIz=0.015,
+                             magnetization=tuple(mag))
+    field = MagneticField([0.01, -0.02, 0.03], gradient=G)
+    s = np.linspace(0.0, 0.4, 801)
+    eq = numeric(arm, field, s=s, tol=1e-11)
+    Rm = eq.rotations @ mag
+    p = eq.positions
+    B = field.field + p @ G.T
+    f = Rm @ G  # Gᵀ (R m)
+    torque = np.cross(Rm, B)
+    force = simpson(f, x=s, axis=0)
+    moment = simpson(np.cross(p, f) + torque, x=s, axis=0)
+    np.testing.assert_allclose(eq.base_wrench[:3], force, rtol=0, atol=1e-9 * np.abs(f).max())
+    np.testing.assert_allclose(eq.base_wrench[3:], moment, rtol=0,
+                               atol=1e-9 * np.abs(torque).max())
+
+
+def test_a_gradient_that_no_current_free_field_has_warns():
+    with pytest.warns(UserWarning, match="symmetric and traceless"):
+        MagneticField([0, 0, 0.01], gradient=np.eye(3))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        MagneticField([0, 0, 0.01], gradient=np.diag([1.0, -0.5, -0.5]))
+
+
+# ============================================================================================
+# Tangents: finite differences of the shooting residual
+# ============================================================================================
+
+def test_every_new_tangent_term_matches_central_differences():
+    # tendons (straight, helical, polynomial, ending mid-arm), a chamber, a magnetised arm
+    # with a tip dipole in a gradient field, and gravity: ∂r/∂x and ∂r/∂λ of the shooting
+    # residual against central differences (fixed steps: enough that the R projection's
+    # effect, which the tangents do not differentiate, is below the differences' error)
+    G = np.array([[0.1, 0.2, 0.0], [0.2, -0.3, 0.1], [0.0, 0.1, 0.2]])
+    arm = SegmentedArm([
+        Arm.from_stiffness(0.2, EA=40.0, GAy=20.0, GAz=25.0, GJ=0.004, EIy=0.006, EIz=0.005,
+                           mass_per_length=0.05, magnetization=(0.3, 0.1, 0.0),
+                           tip_magnet=(0.0, 0.02, 0.0)),
+        Arm.from_stiffness(0.15, EA=30.0, GAy=15.0, GAz=15.0, GJ=0.003, EIy=0.004,
+                           EIz=0.004, mass_per_length=0.04, curvature=(0.0, 1.0, 0.5),
+                           tip_magnet=(0.01, 0.0, 0.01))])
+    loads = [Gravity(), Tendon(0.4, Straight(0.0, 0.01)),
+             Tendon(0.3, Helix(0.008, 3.0, phase=0.4), end=0.25),
+             Tendon(0.2, Polynomial(y=[0.01, -0.02, 0.05], z=[-0.005, 0.01])),
+             Chamber(3e3, 1e-5, Straight(0.006, -0.004), start=0.05, end=0.3),
+             MagneticField([0.01, 0.02, -0.01], gradient=G), TipLoad(force=[0.0, 0.05, 0.0])]
+    solver = softarm.statics.Solver(arm)
+    x = np.array([0.02, -0.1, 0.05, 0.01, -0.02, 0.015])
+    lam = 0.7
+    base = solver.shoot(loads, x, lam, steps=256)
+    h = 1e-6
+    for d in range(6):
+        dx = np.zeros(6)
+        dx[d] = h
+        fd = (solver.shoot(loads, x + dx, lam, steps=256).residual
+              - solver.shoot(loads, x - dx, lam, steps=256).residual) / (2 * h)
+        np.testing.assert_allclose(base.jacobian_x[:, d], fd, rtol=0,
+                                   atol=1e-8 * np.abs(base.jacobian_x).max())
+    fd = (solver.shoot(loads, x, lam + h, steps=256).residual
+          - solver.shoot(loads, x, lam - h, steps=256).residual) / (2 * h)
+    np.testing.assert_allclose(base.jacobian_load, fd, rtol=0,
+                               atol=1e-8 * np.abs(base.jacobian_load).max())
+
+
+def test_tip_compliance_with_tendons_matches_finite_differences():
+    arm = Arm.from_stiffness(0.3, EA=50.0, GAy=25.0, GAz=25.0, GJ=0.005, EIy=0.008,
+                             EIz=0.008, mass_per_length=0.05)
+    loads = [Gravity(), Tendon(0.6, Straight(0.0, 0.01)), Tendon(0.3, Helix(0.01, 1.5))]
+    eq = numeric(arm, loads, jacobians=True, steps=96)
+    h = 1e-5
+    for d in range(6):
+        w = np.zeros(6)
+        w[d] = h
+        plus = numeric(arm, [*loads, TipLoad(w[:3], w[3:])], steps=96)
+        minus = numeric(arm, [*loads, TipLoad(-w[:3], -w[3:])], steps=96)
+        dp = (plus.tip_position - minus.tip_position) / (2 * h)
+        dR = (plus.poses[-1, :3, :3] - minus.poses[-1, :3, :3]) / (2 * h)
+        W = dR @ eq.poses[-1, :3, :3].T
+        dtheta = np.array([W[2, 1], W[0, 2], W[1, 0]])
+        np.testing.assert_allclose(eq.tip_compliance[:3, d], dp, rtol=1e-6,
+                                   atol=1e-6 * np.abs(eq.tip_compliance).max())
+        np.testing.assert_allclose(eq.tip_compliance[3:, d], dtheta, rtol=1e-6,
+                                   atol=1e-6 * np.abs(eq.tip_compliance).max())
+
+
+# ============================================================================================
+# Batches, inputs
+# ============================================================================================
+
+def test_batched_tensions_and_pressures_equal_looped():
+    arm = Arm.from_stiffness(0.25, EA=40.0, GAy=20.0, GAz=20.0, GJ=0.004, EIy=0.006,
+                             EIz=0.006, mass_per_length=0.05)
+    tension = np.array([[0.0, 0.5], [1.0, 0.2], [0.3, 0.0]])
+    pressure = np.array([1e3, 0.0])
+    loads = [Gravity(), Tendon(tension, Straight(0.0, 0.008)),
+             Chamber(pressure, 2e-5, Straight(0.008, 0.0), end=0.2)]
+    batch = numeric(arm, loads, s=11, tol=1e-9)
+    assert batch.poses.shape == (3, 2, 11, 4, 4)
+    for i, j in np.ndindex(3, 2):
+        one = numeric(arm, [Gravity(), Tendon(tension[i, j], Straight(0.0, 0.008)),
+                            Chamber(pressure[j], 2e-5, Straight(0.008, 0.0), end=0.2)],
+                      s=11, tol=1e-9)
+        np.testing.assert_allclose(batch.poses[i, j], one.poses, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(batch.tendon_lengths[i, j], one.tendon_lengths, rtol=0,
+                                   atol=1e-14)
+    np.testing.assert_array_equal(batch.tendon_tensions[..., 0], tension)
+
+
+def test_bad_actuation_input_is_named():
+    with pytest.raises(ValueError, match=r"Tendon.tension must be >= 0 N"):
+        Tendon(-1.0, Straight(0.0, 0.01))
+    with pytest.raises(TypeError, match=r"Tendon\.routing"):
+        Tendon(1.0, (0.0, 0.01))
+    with pytest.raises(ValueError, match=r"Helix\.radius"):
+        Helix(0.0, 1.0)
+    with pytest.raises(ValueError, match=r"Chamber\.area"):
+        Chamber(1e3, 0.0, Straight(0, 0.01))
+    with pytest.raises(ValueError, match="positive definite"):
+        Arm.from_stiffness_matrix(1.0, -np.eye(6))
+    with pytest.raises(ValueError, match="symmetric"):
+        K = np.eye(6)
+        K[0, 1] = 1.0
+        Arm.from_stiffness_matrix(1.0, K)
+    arm = Arm.from_stiffness(0.2, EA=1, GAy=1, GAz=1, GJ=1, EIy=1, EIz=1)
+    with pytest.raises(ValueError, match=r"Tendon\.end must lie on the arm"):
+        softarm.solve(arm, Tendon(1.0, Straight(0, 0.01), end=0.5))
