@@ -427,3 +427,140 @@ def test_bad_actuation_input_is_named():
     arm = Arm.from_stiffness(0.2, EA=1, GAy=1, GAz=1, GJ=1, EIy=1, EIz=1)
     with pytest.raises(ValueError, match=r"Tendon\.end must lie on the arm"):
         softarm.solve(arm, Tendon(1.0, Straight(0, 0.01), end=0.5))
+
+
+# ============================================================================================
+# The closed form in softarm.analytic, and method="auto"
+# ============================================================================================
+
+def test_the_actuated_closed_form_agrees_with_the_numerical_route_station_by_station():
+    K = np.diag([2.0e3, 8.0e2, 9.0e2, 2.0e-3, 3.0e-3, 3.5e-3])
+    K[0, 3] = K[3, 0] = 0.6
+    K[2, 4] = K[4, 2] = -0.25
+    arm = SegmentedArm([Arm.from_stiffness_matrix(0.15, K, curvature=(0.0, 0.5, 0.0)),
+                        Arm.from_stiffness(0.1, **STEEL)])
+    tension = np.array([0.0, 0.8, 1.6])
+    loads = [Tendon(tension, Straight(0.0, 0.006), end=0.2),
+             Tendon(0.5, Straight(-0.005, 0.002)),
+             Chamber(np.array([[1e4], [3e4]]), 1e-5, Straight(0.004, -0.004), start=0.05,
+                     end=0.12)]
+    s = np.linspace(0.0, 0.25, 51)
+    exact = softarm.analytic.actuated(arm, loads, s=s)
+    auto = softarm.solve(arm, loads, s=s)
+    assert exact.method == auto.method == "analytic.actuated"
+    num = numeric(arm, loads, s=s, tol=1e-11)
+    assert exact.poses.shape == num.poses.shape == (2, 3, 51, 4, 4)
+    np.testing.assert_allclose(exact.poses, num.poses, rtol=0, atol=1e-8 * 0.25)
+    np.testing.assert_allclose(exact.strains, num.strains, rtol=0,
+                               atol=1e-8 * np.abs(num.strains).max())
+    np.testing.assert_allclose(exact.stresses, num.stresses, rtol=0,
+                               atol=1e-8 * np.abs(num.stresses).max())
+    np.testing.assert_allclose(exact.tendon_lengths, num.tendon_lengths, rtol=0, atol=1e-10)
+    np.testing.assert_allclose(exact.tendon_length_changes, num.tendon_length_changes,
+                               rtol=0, atol=1e-10)
+    np.testing.assert_allclose(num.base_wrench, 0.0, atol=1e-10)
+
+
+def test_no_closed_form_for_curved_paths_or_other_loads():
+    arm = Arm.from_stiffness(0.2, **STEEL, mass_per_length=0.02)
+    assert softarm.analytic.actuated(arm, [Tendon(1.0, Helix(0.01, 1.0))]) is None
+    assert softarm.analytic.actuated(arm, [Tendon(1.0, Straight(0, 0.01)), Gravity()]) is None
+    assert softarm.solve(arm, [Tendon(1.0, Straight(0, 0.01)), Gravity()]).method == \
+        "numeric.shooting"
+
+
+# ============================================================================================
+# Case files
+# ============================================================================================
+
+CASE = """
+name = "three actuators"
+
+[[segment]]
+length = 0.2
+magnetization = [0.5, 0.0, 0.0]
+stiffness_matrix = [[40.0, 0, 0, 0.01, 0, 0], [0, 20.0, 0, 0, 0, 0], [0, 0, 20.0, 0, 0, 0],
+                    [0.01, 0, 0, 0.004, 0, 0], [0, 0, 0, 0, 0.006, 0], [0, 0, 0, 0, 0, 0.006]]
+
+[[segment]]
+length = 0.1
+tip_magnet = [0.0, 0.01, 0.0]
+[segment.stiffness]
+EA = 30.0
+GAy = 15.0
+GAz = 15.0
+GJ = 0.003
+EIy = 0.004
+EIz = 0.004
+
+[[load]]
+kind = "tendon"
+tension = 0.4
+end = 0.25
+[load.routing]
+kind = "helix"
+radius = 0.008
+turns_per_metre = 2.0
+
+[[load]]
+kind = "chamber"
+pressure = 2000.0
+area = 1e-5
+start = 0.05
+[load.routing]
+kind = "polynomial"
+y = [0.005, -0.01]
+z = [0.0]
+
+[[load]]
+kind = "magnetic"
+field = [0.0, 0.02, 0.01]
+gradient = [[0.1, 0.0, 0.0], [0.0, -0.05, 0.0], [0.0, 0.0, -0.05]]
+"""
+
+
+def test_actuators_in_a_case_file_round_trip_and_solve_as_in_python():
+    import tomllib
+
+    from softarm.case import arm_to_dict, loads_to_dict, parse_case
+
+    case = parse_case(tomllib.loads(CASE))
+    K = np.diag([40.0, 20.0, 20.0, 0.004, 0.006, 0.006])
+    K[0, 3] = K[3, 0] = 0.01
+    arm = SegmentedArm([
+        Arm.from_stiffness_matrix(0.2, K, magnetization=(0.5, 0.0, 0.0)),
+        Arm.from_stiffness(0.1, EA=30.0, GAy=15.0, GAz=15.0, GJ=0.003, EIy=0.004, EIz=0.004,
+                           tip_magnet=(0.0, 0.01, 0.0))])
+    loads = [Tendon(0.4, Helix(0.008, 2.0), end=0.25),
+             Chamber(2000.0, 1e-5, Polynomial(y=[0.005, -0.01], z=[0.0]), start=0.05),
+             MagneticField([0.0, 0.02, 0.01], gradient=np.diag([0.1, -0.05, -0.05]))]
+    assert case.arm == arm
+    again = parse_case({"name": "again", **arm_to_dict(case.arm),
+                        "load": loads_to_dict(case.loads)})
+    assert loads_to_dict(again.loads) == loads_to_dict(case.loads)
+    a = numeric(case.arm, case.loads, s=11, tol=1e-9)
+    b = numeric(arm, loads, s=11, tol=1e-9)
+    np.testing.assert_array_equal(a.poses, b.poses)
+    np.testing.assert_array_equal(numeric(again.arm, again.loads, s=11, tol=1e-9).poses,
+                                  b.poses)
+
+
+@pytest.mark.parametrize(("change", "message"), [
+    (("tension = 0.4", "tension = -0.4"), r"load\[1\]\.tension: must be >= 0 N"),
+    (('kind = "helix"', 'kind = "helics"'), r"load\[1\]\.routing\.kind: unknown value "
+                                             r"'helics'.*did you mean 'helix'"),
+    (("radius = 0.008", "radius = -0.008"), r"load\[1\]\.routing\.radius: must be > 0"),
+    (("area = 1e-5", 'area = "big"'), r"load\[2\]\.area: must be a number"),
+    (("y = [0.005, -0.01]", "y = []"), r"load\[2\]\.routing\.y: must be a non-empty list"),
+    (("[0.0, 0.0, -0.05]]", "[0.0, 0.0]]"), r"load\[3\]\.gradient: must be a 3 × 3 list"),
+    (("[0, 0, 0, 0, 0, 0.006]]", "[0, 0, 0, 0, 0, -0.006]]"),
+     r"segment\[1\]\.stiffness_matrix: must be positive definite"),
+])
+def test_bad_actuator_keys_are_named_by_key_path(change, message):
+    import tomllib
+
+    from softarm import CaseError
+    from softarm.case import parse_case
+
+    with pytest.raises(CaseError, match=message):
+        parse_case(tomllib.loads(CASE.replace(*change)), "case.toml")

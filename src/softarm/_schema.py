@@ -33,12 +33,24 @@ import numpy as np
 from ._validate import as_array
 from .errors import CaseError, CaseTypeError
 from .loads import Key, as_loads
-from .model import Arm, Circle, Material, Rectangle, Rigidities, Section, SegmentedArm, Tube
+from .model import (
+    Arm,
+    Circle,
+    Material,
+    Rectangle,
+    Rigidities,
+    Section,
+    SegmentedArm,
+    StiffnessMatrix,
+    Tube,
+)
+from .routing import ROUTINGS
 from .sweep import COMPONENTS, Sweep
 
 __all__ = [
     "ARM",
     "MATERIAL",
+    "ROUTING",
     "SECTIONS",
     "SOLVE",
     "STIFFNESS",
@@ -146,11 +158,25 @@ STIFFNESS = Schema("", Rigidities, (
     Key("EIy", "number", "N m²", required=True), Key("EIz", "number", "N m²", required=True)))
 
 #: ``[arm]`` or one ``[[segment]]``: its own keys. Its sub-tables, ``stiffness`` or
-#: ``section`` and ``material`` (one or the other), are the schemas above.
+#: ``section`` and ``material`` (one or the other), are the schemas above; a full 6 × 6
+#: stiffness is the key ``stiffness_matrix`` instead.
 ARM = Schema("", Arm, (
     Key("length", "number", "m", required=True),
     Key("curvature", "vector", "1/m"),
-    Key("mass_per_length", "number", "kg/m")))
+    Key("mass_per_length", "number", "kg/m"),
+    Key("magnetization", "vector", "A m²/m"),
+    Key("tip_magnet", "vector", "A m²")))
+
+#: A tendon's or chamber's ``routing`` table, by its ``kind``.
+ROUTING: dict[str, Schema] = {
+    "straight": Schema("straight", ROUTINGS["straight"], (
+        Key("y", "number", _LENGTH), Key("z", "number", _LENGTH))),
+    "helix": Schema("helix", ROUTINGS["helix"], (
+        Key("radius", "number", _LENGTH, required=True),
+        Key("turns_per_metre", "number", "1/m", required=True), Key("phase", "number", "rad"))),
+    "polynomial": Schema("polynomial", ROUTINGS["polynomial"], (
+        Field("y", "numbers", "m/m^k"), Field("z", "numbers", "m/m^k"))),
+}
 
 #: ``[solve]``: the keys of :class:`softarm.case.SolveOptions` (which checks the values).
 SOLVE = (Field("method", "text", choices=("auto", "numeric")),
@@ -177,6 +203,8 @@ def _arm_table(arm: Arm) -> dict:
     out = {"length": rest.pop("length")}  # the file's order: length, the sub-tables, the rest
     if isinstance(arm.section, Rigidities):
         out["stiffness"] = STIFFNESS.write(arm.section)
+    elif isinstance(arm.section, StiffnessMatrix):
+        out["stiffness_matrix"] = [list(row) for row in arm.section.matrix]
     else:
         out["section"] = _SECTION_OF[type(arm.section)].write(arm.section)
         out["material"] = MATERIAL.write(arm.material)
@@ -286,6 +314,17 @@ class Table:
             return self.string(key.name, key.choices or None)
         if kind == "numbers":
             return self.numbers(key.name)
+        if kind == "magnitude":  # a number, or (result files) a nested list of them
+            if not self.batched:
+                return self.number(key.name, key.unit)
+            return self.array(key.name, key.unit, ())
+        if kind == "matrix":
+            return self.array(key.name, key.unit, (3, 3))
+        if kind == "routing":
+            table = self.table(key.name)
+            schema = ROUTING[table.string("kind", tuple(ROUTING))]
+            values = schema.read(table)
+            return table.build(schema.keys, lambda: schema.cls(**values))
         if kind == "span":  # two numbers in m
             raw = self.raw(key.name)
             if not (isinstance(raw, list) and len(raw) == 2 and not _has_bool(raw)
@@ -386,6 +425,22 @@ class Table:
         except ValueError:
             raise self.error(key, what) from None
         if not (array.ndim >= 1 and array.shape[-1] == 3 and (self.batched or array.ndim == 1)):
+            raise self.error(key, what)
+        return array
+
+    def array(self, key: str, unit: str, shape: tuple[int, ...]) -> np.ndarray:
+        """Finite numbers of trailing shape ``shape`` (batch axes only in result files)."""
+        value = self.raw(key)
+        what = (f"must be {'a number' if not shape else f'a {shape[0]} × {shape[1]} list'} "
+                f"of finite numbers in {unit}, got {value!r}")
+        try:
+            array = as_array(value, key)
+        except TypeError:
+            raise self.type_error(key, what) from None
+        except ValueError:
+            raise self.error(key, what) from None
+        n = len(shape)
+        if array.shape[array.ndim - n:] != shape or (not self.batched and array.ndim != n):
             raise self.error(key, what)
         return array
 

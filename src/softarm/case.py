@@ -35,7 +35,7 @@ from ._schema import Table, arm_to_dict, loads_to_dict
 from ._validate import check_allocation, count
 from .errors import CaseError, CaseTypeError
 from .loads import LOAD_KINDS
-from .model import Arm, SegmentedArm
+from .model import Arm, SegmentedArm, StiffnessMatrix
 from .statics.solver import check_tol
 from .sweep import Sweep, solve_case
 
@@ -142,7 +142,19 @@ def _arm(table: Table) -> Arm:
     """One ``[arm]`` or ``[[segment]]`` table: its keys, then ``stiffness`` or ``section`` and
     ``material``."""
     values = _schema.ARM.read(table)
-    if table.has("stiffness"):
+    if table.has("stiffness_matrix"):
+        for other in ("stiffness", "section", "material"):
+            if table.has(other):
+                raise table.error("stiffness_matrix", f"give either 'stiffness_matrix' or "
+                                  f"'{other}', not both")
+        matrix = table.raw("stiffness_matrix")
+        try:
+            values["section"] = StiffnessMatrix(matrix)
+        except (TypeError, ValueError) as error:
+            raise table.error("stiffness_matrix", str(error).removeprefix(
+                "the stiffness matrix K ")) from None
+        values["material"] = None
+    elif table.has("stiffness"):
         if table.has("section") or table.has("material"):
             raise table.error("stiffness", "give either 'stiffness' or 'section' and "
                               "'material', not both")

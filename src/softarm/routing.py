@@ -127,7 +127,7 @@ class Straight(Routing):
         return f"straight at (y, z) = ({self.y:.4g}, {self.z:.4g}) m"
 
     def to_case(self) -> dict:
-        return {"path": "straight", "y": self.y, "z": self.z}
+        return {"kind": "straight", "y": self.y, "z": self.z}
 
 
 @dataclass(frozen=True)
@@ -166,7 +166,7 @@ class Helix(Routing):
                 f"phase {self.phase:.4g} rad")
 
     def to_case(self) -> dict:
-        return {"path": "helix", "radius": self.radius,
+        return {"kind": "helix", "radius": self.radius,
                 "turns_per_metre": self.turns_per_metre, "phase": self.phase}
 
 
@@ -177,8 +177,8 @@ class Polynomial(Routing):
 
     Examples
     --------
-    >>> Polynomial(y=[0.01, -0.02], z=[0.0]).position(0.5)   # tapering towards the axis
-    array([0.  , 0.  , 0.  ])
+    >>> float(Polynomial(y=[0.01, -0.02], z=[0.0]).position(0.25)[1])  # tapering inwards
+    0.005
     """
 
     y: tuple[float, ...] = (0.0,)
@@ -210,8 +210,8 @@ class Polynomial(Routing):
         return f"polynomial y = {list(self.y)}, z = {list(self.z)} (m/m^k)"
 
     def to_case(self) -> dict:
-        return {"path": "polynomial", "y": list(self.y), "z": list(self.z)}
+        return {"kind": "polynomial", "y": list(self.y), "z": list(self.z)}
 
 
-#: Routing kinds by their case-file name (``path = ...``).
+#: Routing kinds by their case-file name (``kind = ...`` in a ``routing`` table).
 ROUTINGS = {"straight": Straight, "helix": Helix, "polynomial": Polynomial}

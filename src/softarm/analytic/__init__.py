@@ -5,6 +5,7 @@ solves the full Cosserat model for its loads. See docs/closed-forms.md for the f
 corrections to the paper and the domains of exactness.
 """
 
+from .actuation import actuated
 from .elastica import elastica
 from .exact import exact_closed_form
 from .force import axial_force, shear_force
@@ -12,6 +13,7 @@ from .linear import linear
 from .moment import tip_moment
 
 __all__ = [
+    "actuated",
     "axial_force",
     "elastica",
     "exact_closed_form",

@@ -9,6 +9,7 @@ import numpy as np
 from ..loads import as_loads, batch_shape
 from ..model import SegmentedArm
 from ._common import check_arm, checked_stations, moment_is_principal
+from .actuation import actuated
 from .elastica import solve_elastica
 from .force import axial_force
 from .moment import helix_applies, solve_tip_moment
@@ -64,7 +65,9 @@ def exact_closed_form(arm, loads, s=None):
       :func:`axial_force` (the straight state, exact though unstable beyond the Euler load);
     * dead tip force only, on a straight arm, in a principal plane (any plane if EIy = EIz and
       GAy = GAz): the extensible, shearable :func:`elastica`;
-    * a zero tip wrench: the undeformed arm (an empty list of loads gives None).
+    * a zero tip wrench: the undeformed arm (an empty list of loads gives None);
+    * straight tendons and straight chambers alone, on any arm (segmented, curved, any K):
+      :func:`~softarm.analytic.actuation.actuated` (piecewise constant strain).
 
     Several tip wrenches in the same frame are summed (through each load's
     :meth:`~softarm.Load.apply`, so a point load at s = L counts as one); any other load
@@ -99,6 +102,9 @@ def exact_closed_form(arm, loads, s=None):
     >>> exact_closed_form(arm, [TipLoad(force=[0.0, 0.0, 1.0]), Gravity()]) is None
     True
     """
+    result = actuated(arm, loads, s)
+    if result is not None:
+        return result
     if isinstance(arm, SegmentedArm):
         return None
     arm = check_arm(arm, "exact_closed_form")
