@@ -438,6 +438,16 @@ def _summary(case: Case, result, seconds: float) -> str:
         lines.append("maximum   " + "\n          ".join(
             f"{name:<22} {value:.4g} {unit:<3} at s = {where:.4g} m"
             for name, values, unit in rows for value, where in [_peak(values, s)]))
+        if result.tendon_tensions is not None:
+            lines.append("tendons   " + "\n          ".join(
+                f"{k + 1}: tension {t:.4g} N, length {length:.6g} m, change "
+                f"{1e3 * change:+.4g} mm" for k, (t, length, change) in enumerate(zip(
+                    result.tendon_tensions, result.tendon_lengths,
+                    result.tendon_length_changes, strict=True))))
+        if result.base_wrench is not None:
+            lines.append(f"base      total wrench (clamp and actuators) force "
+                         f"{_vector(result.base_wrench[:3])} N, moment "
+                         f"{_vector(result.base_wrench[3:])} N m")
     lines.append(f"time      {seconds:.3g} s")
     return "\n".join(lines)
 

@@ -163,6 +163,35 @@ def load_arrows(loads, poses, s, arm, count: int = 6) -> list[Arrow]:
     return arrows
 
 
+@dataclass(frozen=True)
+class ActuatorPath:
+    """The drawn path of one actuator (a tendon or a chamber's centroid): ``points`` (k, 3)
+    in the spatial frame, p(s) + R(s) r(s) at the stations on its span."""
+
+    label: str
+    kind: str
+    points: np.ndarray
+    key: int = 0
+
+
+def actuator_paths(loads, poses, s) -> list[ActuatorPath]:
+    """The paths of the loads that run along a routing (tendons, chambers) on the drawn
+    equilibrium (``poses`` (N, 4, 4) at stations ``s`` (N,))."""
+    poses = np.asarray(poses, dtype=float)
+    s = np.asarray(s, dtype=float)
+    paths = []
+    for index, load in enumerate(loads):
+        routing = getattr(load, "routing", None)
+        if routing is None:
+            continue
+        s0, s1 = load.path_span(float(s[-1]))
+        on = (s >= s0 - 1e-12) & (s <= s1 + 1e-12)
+        r = routing.position(s[on])
+        points = poses[on, :3, 3] + np.einsum("nij,nj->ni", poses[on, :3, :3], r)
+        paths.append(ActuatorPath(load.describe(), load.kind, points, index))
+    return paths
+
+
 def sweep_axis(steps: int, sweep=None, values=None, label=None) -> tuple[np.ndarray, str]:
     """The parameter values (shape (steps,)) and axis label of a sweep result's batch axis:
     ``values``/``label`` as given, else the sweep's (a :class:`softarm.sweep.Sweep`), else the

@@ -615,9 +615,12 @@ class Tendon(Load):
     def cuts(self, arm) -> tuple[float, ...]:
         return () if self.end is None or self.end >= arm.length else (self.end,)
 
+    def path_span(self, length: float) -> tuple[float, float]:
+        """Where the tendon runs, (0, end) in m, on an arm of this length."""
+        return 0.0, length if self.end is None else min(self.end, length)
+
     def apply(self, target: LoadTarget) -> None:
-        end = target.length if self.end is None else min(self.end, target.length)
-        target.actuator("tendon", self.tension, self.routing, (0.0, end))
+        target.actuator("tendon", self.tension, self.routing, self.path_span(target.length))
 
     def in_base_frame(self, R, origin=None) -> Tendon:
         return self  # material frame throughout
@@ -688,9 +691,13 @@ class Chamber(Load):
     def cuts(self, arm) -> tuple[float, ...]:
         return tuple(c for c in (self.start, self.end) if c is not None and 0.0 < c < arm.length)
 
+    def path_span(self, length: float) -> tuple[float, float]:
+        """Where the chamber is, (start, end) in m, on an arm of this length."""
+        return self.start, length if self.end is None else min(self.end, length)
+
     def apply(self, target: LoadTarget) -> None:
-        end = target.length if self.end is None else min(self.end, target.length)
-        target.actuator("chamber", self.pressure * self.area, self.routing, (self.start, end))
+        target.actuator("chamber", self.pressure * self.area, self.routing,
+                        self.path_span(target.length))
 
     def in_base_frame(self, R, origin=None) -> Chamber:
         return self

@@ -17,7 +17,14 @@ from pathlib import Path
 
 import numpy as np
 
-from .geometry import cube_limits, silhouette, station_radii, sweep_axis, tube_surface
+from .geometry import (
+    actuator_paths,
+    cube_limits,
+    silhouette,
+    station_radii,
+    sweep_axis,
+    tube_surface,
+)
 
 __all__ = ["describe_loads", "plot_equilibrium", "plot_result_file", "plot_sweep"]
 
@@ -27,6 +34,9 @@ DPI = 100
 
 _TUBE_COLOR = "tab:orange"
 _LINE_COLOR = "tab:blue"
+#: How actuator paths are drawn: tendons as thin dark lines, chambers as wide blue bands.
+_PATH_STYLE = {"tendon": dict(color="0.15", linewidth=1.0),
+               "chamber": dict(color="tab:blue", linewidth=3.0, alpha=0.6)}
 _PLANES = (("x", 0), ("z", 2)), (("x", 0), ("y", 1))  # side views: x–z and x–y
 
 
@@ -67,6 +77,17 @@ def describe_loads(loads, sweep=None) -> str:
 def _range(sweep) -> str:
     values = sweep.values
     return f"{min(values):.4g} … {max(values):.4g} {sweep.unit} ({len(values)} steps)"
+
+
+def _wrapped(text: str, width: int = 130, lines: int = 3) -> str:
+    """A title on at most ``lines`` lines of ``width`` characters (the last one cut with …)."""
+    import textwrap
+
+    out = textwrap.wrap(text, width)
+    if len(out) > lines:
+        out = out[:lines]
+        out[-1] = out[-1][:width - 1] + "…"
+    return "\n".join(out)
 
 
 def _layout(fig):
@@ -163,6 +184,9 @@ def plot_equilibrium(result, *, fig=None, path: str | os.PathLike | None = None,
                          linewidth=0, antialiased=True, shade=True)
         extent = np.concatenate([p, surface.reshape(3, -1).T])
     ax3.plot(*p.T, color=_LINE_COLOR if radii is None else "tab:red", linewidth=1.5)
+    routes = actuator_paths(result.loads, poses, result.s)
+    for route in routes:
+        ax3.plot(*route.points.T, **_PATH_STYLE[route.kind])
     ax3.scatter(*p[-1], color="k", s=12, depthshade=False)
     ax3.scatter([0.0], [0.0], [0.0], color="0.3", marker="s", s=20, depthshade=False)
     _equal_3d(ax3, extent)
@@ -172,11 +196,13 @@ def plot_equilibrium(result, *, fig=None, path: str | os.PathLike | None = None,
             ax.fill(outline[:, 0], outline[:, 1], color=_TUBE_COLOR, alpha=0.35, linewidth=0)
         ax.plot(p[:, i], p[:, j], color=_LINE_COLOR if radii is None else "tab:red",
                 linewidth=1.2)
+        for route in routes:
+            ax.plot(route.points[:, i], route.points[:, j], **_PATH_STYLE[route.kind])
         ax.plot(p[-1, i], p[-1, j], "k.", markersize=6)
     _side_axes(side)
     tip = p[-1]
     fig.suptitle(title if title is not None else
-                 f"{name or 'softarm'}: {describe_loads(result.loads)}", fontsize=11)
+                 _wrapped(f"{name or 'softarm'}: {describe_loads(result.loads)}"), fontsize=11)
     fig.text(0.02, 0.02, f"tip at {_fmt(tip, 'm')}; method {result.method}"
              f"{'' if result.exact else ' (approximate)'}", fontsize=8, color="0.3")
     return _finish(fig, path)
@@ -231,7 +257,8 @@ def plot_sweep(result, values=None, *, label: str | None = None, fig=None,
     bar = fig.colorbar(mappable, ax=[ax3, *side], fraction=0.03, pad=0.02, aspect=30)
     bar.set_label(label)
     fig.suptitle(title if title is not None else
-                 f"{name or 'softarm'}: {describe_loads(result.loads, sweep)}", fontsize=11)
+                 _wrapped(f"{name or 'softarm'}: {describe_loads(result.loads, sweep)}"),
+                 fontsize=11)
     return _finish(fig, path)
 
 

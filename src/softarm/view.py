@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from .geometry import (
+    actuator_paths,
     cube_limits,
     load_arrows,
     station_radii,
@@ -150,6 +151,13 @@ def _scene_traces(result, arrows, scales, radii) -> list[dict]:
                    "z": p[:, 2], "customdata": custom, "hovertemplate": _HOVER,
                    "line": {"color": _LINE, "width": 4}, "marker": {"size": 2, "color": _LINE},
                    "name": "centreline"})
+    for path in actuator_paths(result.loads, poses, result.s):
+        tendon = path.kind == "tendon"
+        traces.append({"type": "scatter3d", "mode": "lines", "x": path.points[:, 0],
+                       "y": path.points[:, 1], "z": path.points[:, 2],
+                       "line": {"color": "rgb(30,30,30)" if tendon else "rgb(40,110,200)",
+                                "width": 3 if tendon else 8},
+                       "name": path.label, "hovertemplate": f"{path.label}<extra></extra>"})
     frame = tip_frame(poses, 0.15 * length)
     for k, axis in enumerate(("e1", "e2", "e3")):
         traces.append({"type": "scatter3d", "mode": "lines", "x": frame[k, :, 0],

@@ -102,12 +102,13 @@ def exact_closed_form(arm, loads, s=None):
     >>> exact_closed_form(arm, [TipLoad(force=[0.0, 0.0, 1.0]), Gravity()]) is None
     True
     """
+    if not isinstance(arm, SegmentedArm):
+        arm = check_arm(arm, "exact_closed_form")
     result = actuated(arm, loads, s)
     if result is not None:
         return result
     if isinstance(arm, SegmentedArm):
         return None
-    arm = check_arm(arm, "exact_closed_form")
     K = arm.stiffness
     if np.any(K != np.diag(np.diagonal(K))):  # coupled stiffness: no closed form here
         return None

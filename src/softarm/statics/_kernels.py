@@ -196,10 +196,13 @@ def _law(arm, j, s, now, law, s0, s1, s2, s3, s4, s5):
     σ the total wrench (rod, tendons, fluid) in material components, r(s) each actuator's
     path in the section. For τ ≥ 0 the left side is the gradient of a strictly convex
     function, so Newton from the tendons-along-d1 guess (exact for straight tendons on a
-    diagonal K) converges to the unique root. On return ``law[0][:, :6]`` holds the
-    Jacobian H = K + Σ τ Jᵀ (I - t tᵀ) J / |w|, J = [I, -r~] (the tangents' linear map is
-    H⁻¹), ``law[1][a]`` = (t, |w|, y, z, dy, dz) of every active actuator. NaN strains if
-    Newton fails (|w| → 0: a tendon path folded onto itself).
+    diagonal K) converges to the unique root, to round-off: the last correction is at most
+    ``_LAW_TOL`` (strain, curvature × L), so the error left is of its square. On return
+    ``law[0][:, :6]`` holds the Jacobian H = K + Σ τ Jᵀ (I - t tᵀ) J / |w|, J = [I, -r~]
+    (the tangents' linear map is H⁻¹) and ``law[1][a]`` = (t, |w|, y, z, dy, dz) of every
+    active actuator, both at the point before that last correction (so within ``_LAW_TOL``
+    relative of their values at the root). NaN strains if Newton fails (|w| → 0: a tendon
+    path folded onto itself).
     """
     f0, C, K = arm[3], arm[2], arm[8]
     routes, kinds, active = arm[9], arm[10], arm[11]
@@ -238,15 +241,14 @@ def _law(arm, j, s, now, law, s0, s1, s2, s3, s4, s5):
             M[i, k] = K[j, i, k]
     if tendons == 0:
         return eps[0], eps[1], eps[2], eps[3], eps[4], eps[5]
-    F = vec[1]
-    previous = np.inf
-    for it in range(_LAW_ITER + 1):
+    F, H = vec[1], jw
+    for it in range(_LAW_ITER):
         v0, v1, v2, u0, u1, u2 = eps[0], eps[1], eps[2], eps[3], eps[4], eps[5]
         for i in range(6):
             acc = -rhs[i]
             for k in range(6):
                 acc += K[j, i, k] * (eps[k] - f0[j, k])
-                M[i, k] = K[j, i, k]
+                H[i, k] = K[j, i, k]
             F[i] = acc
         for a in range(routes.shape[0]):
             if active[j, a] == 0.0 or kinds[a] == CHAMBER:
@@ -261,44 +263,58 @@ def _law(arm, j, s, now, law, s0, s1, s2, s3, s4, s5):
             q = now[j, _ACT + a]
             if q == 0.0:
                 continue
-            F[0] += q * t0
-            F[1] += q * t1
-            F[2] += q * t2
-            F[3] += q * (y * t2 - z * t1)  # r × t, r = (0, y, z)
-            F[4] += q * z * t0
-            F[5] -= q * y * t0
-            # H += Jᵀ P J, P = τ (I - t tᵀ)/|w|, J = [I | -r~] = [I | (0 z -y; -z 0 0; y 0 0)]
-            for i in range(3):
-                for k in range(6):
-                    jw[i, k] = 0.0
-                jw[i, i] = 1.0
-            jw[0, 4], jw[0, 5] = z, -y
-            jw[1, 3] = -z
-            jw[2, 3] = y
+            # g = Jᵀ t = (t; r × t), r = (0, y, z)
+            g0, g1, g2, g3, g4, g5 = t0, t1, t2, y * t2 - z * t1, z * t0, -y * t0
+            F[0] += q * g0
+            F[1] += q * g1
+            F[2] += q * g2
+            F[3] += q * g3
+            F[4] += q * g4
+            F[5] += q * g5
+            # H += τ/|w| Jᵀ (I - t tᵀ) J = c (JᵀJ - g gᵀ), J = [I | N], N = -r~ =
+            # (0 z -y; -z 0 0; y 0 0): JᵀJ = (I N; Nᵀ NᵀN), NᵀN = |r|² I - r rᵀ
             c = q / nw
-            for k in range(6):
-                tj = t0 * jw[0, k] + t1 * jw[1, k] + t2 * jw[2, k]
-                jw[3, k] = c * (jw[0, k] - t0 * tj)
-                jw[4, k] = c * (jw[1, k] - t1 * tj)
-                jw[5, k] = c * (jw[2, k] - t2 * tj)
+            H[0, 0] += c
+            H[1, 1] += c
+            H[2, 2] += c
+            H[0, 4] += c * z
+            H[4, 0] += c * z
+            H[0, 5] -= c * y
+            H[5, 0] -= c * y
+            H[1, 3] -= c * z
+            H[3, 1] -= c * z
+            H[2, 3] += c * y
+            H[3, 2] += c * y
+            H[3, 3] += c * (y * y + z * z)
+            H[4, 4] += c * z * z
+            H[5, 5] += c * y * y
+            H[4, 5] -= c * y * z
+            H[5, 4] -= c * y * z
+            g = (g0, g1, g2, g3, g4, g5)
             for i in range(6):
+                ci = c * g[i]
                 for k in range(6):
-                    M[i, k] += jw[0, i] * jw[3, k] + jw[1, i] * jw[4, k] + jw[2, i] * jw[5, k]
-        if previous <= _LAW_TOL:
-            break  # ε converged with the last correction: M holds H at ε
-        if it == _LAW_ITER:
-            return np.nan, np.nan, np.nan, np.nan, np.nan, np.nan
+                    H[i, k] -= ci * g[k]
         for i in range(6):
+            for k in range(6):
+                M[i, k] = H[i, k]
             M[i, 6] = -F[i]
         if _eliminate_columns(M, 1) == 0.0:
             return np.nan, np.nan, np.nan, np.nan, np.nan, np.nan
-        previous = 0.0
+        size = 0.0
         for i in range(6):
             eps[i] += M[i, 6]
-            previous = max(previous, abs(M[i, 6]) * (length if i >= 3 else 1.0))
-        if not math.isfinite(previous):
+            size = max(size, abs(M[i, 6]) * (length if i >= 3 else 1.0))
+        if not math.isfinite(size):
             return np.nan, np.nan, np.nan, np.nan, np.nan, np.nan
-    return eps[0], eps[1], eps[2], eps[3], eps[4], eps[5]
+        if size <= _LAW_TOL:
+            # converged (the next correction would be ~ size²); H is the Jacobian before
+            # this last correction, within ~size of the one at ε (t and |w| likewise)
+            for i in range(6):
+                for k in range(6):
+                    M[i, k] = H[i, k]
+            return eps[0], eps[1], eps[2], eps[3], eps[4], eps[5]
+    return np.nan, np.nan, np.nan, np.nan, np.nan, np.nan
 
 
 @_jit
@@ -1142,8 +1158,9 @@ def _load_size(arm, scale, start, end, tip_start, tip_end):
     the homotopy) and an upper estimate of the total turning of the arm (rad), the largest
     load moment about the base times ∫ ds/EI with each piece's softest bending
     compliance (bending; the pieces of a very soft segment need as many steps as its
-    turning). An actuator counts as a force |q| and a moment |q| ρ (ρ its largest distance
-    from the centreline) on each piece it acts on; a magnetisation m as a moment |m| |B|
+    turning). An actuator's tension or pressure force is internal (no net force on the arm)
+    but bends it: it counts as a moment |q| ρ (ρ its largest distance from the centreline)
+    on each piece it acts on; a magnetisation m as a moment |m| |B|
     per length, and a dipole as a moment |m| |B|, |B| bounded by |B0| + |G| (L + |p0|)."""
     piece_len, C = arm[1], arm[2]
     routes, mag, dipoles = arm[9], arm[12], arm[13]
@@ -1164,6 +1181,7 @@ def _load_size(arm, scale, start, end, tip_start, tip_end):
         w = max(w, f_tip / fs, m_tip / ms)
         total = f_tip * L + m_tip
         f_along = 0.0
+        actuators = 0.0
         for j in range(piece_len.size):
             f, m, jf, jm = 0.0, 0.0, 0.0, 0.0
             for i in range(3):
@@ -1181,15 +1199,15 @@ def _load_size(arm, scale, start, end, tip_start, tip_end):
                 dipole += abs(dipoles[j + 1, 0]) + abs(dipoles[j + 1, 1]) + abs(dipoles[j + 1, 2])
             m += (abs(mag[j, 0]) + abs(mag[j, 1]) + abs(mag[j, 2])) * field
             jm += dipole * field
+            actuated = 0.0  # internal: a moment along the piece, no net force
             for a in range(routes.shape[0]):
-                q = abs(loads[j, _ACT + a])
-                jf = max(jf, q)
-                jm += q * routes[a, _RHO]
+                actuated += abs(loads[j, _ACT + a]) * routes[a, _RHO]
+            actuators = max(actuators, actuated)
             f_along += f * piece_len[j] + jf
-            w = max(w, f_along / fs, m * piece_len[j] / ms, jm / ms)
+            w = max(w, f_along / fs, m * piece_len[j] / ms, jm / ms, actuated / ms)
             total += f * piece_len[j] * 0.5 * L + jf * L + m * piece_len[j] + jm
         w = max(w, f_along / fs)
-        moment = max(moment, total)
+        moment = max(moment, total + actuators)
     return w, moment * flexibility
 
 

@@ -579,19 +579,26 @@ def _unloaded_length(pieces, actuator) -> float:
     """A tendon's length in the unloaded arm, ∫ |e1 + κ⁰ × r + r'| ds over the pieces it
     runs through (Gauss–Legendre, 24 nodes per piece and per quarter turn of a helix)."""
     _, routing, active, _ = actuator
-    starts, lengths, f0 = pieces[0], pieces[1], pieces[3]
+    on = np.flatnonzero(active)
+    return _unloaded_length_cached(routing, pieces[0][on].tobytes(), pieces[1][on].tobytes(),
+                                   pieces[3][on].tobytes())
+
+
+_NODES, _WEIGHTS = np.polynomial.legendre.leggauss(24)
+
+
+@functools.lru_cache(maxsize=256)
+def _unloaded_length_cached(routing, starts, lengths, f0) -> float:
+    starts, lengths = np.frombuffer(starts), np.frombuffer(lengths)
+    f0 = np.frombuffer(f0).reshape(-1, 6)
     total = 0.0
-    for j in np.flatnonzero(active):
-        turns = abs(routing.helix[1]) * lengths[j]
-        nodes, weights = np.polynomial.legendre.leggauss(24)
-        parts = max(1, int(np.ceil(4 * turns)))
-        for q in range(parts):
-            a = starts[j] + lengths[j] * q / parts
-            h = lengths[j] / parts
-            s = a + 0.5 * h * (nodes + 1.0)
-            r, dr = routing.position(s), routing.derivative(s)
-            w = f0[j, :3] + np.cross(f0[j, 3:], r) + dr
-            total += 0.5 * h * float(weights @ np.linalg.norm(w, axis=-1))
+    for j in range(starts.size):
+        parts = max(1, int(np.ceil(4 * abs(routing.helix[1]) * lengths[j])))
+        h = lengths[j] / parts
+        a = starts[j] + h * np.arange(parts)
+        s = (a[:, None] + 0.5 * h * (_NODES + 1.0)).ravel()
+        w = f0[j, :3] + np.cross(f0[j, 3:], routing.position(s)) + routing.derivative(s)
+        total += 0.5 * h * float(np.tile(_WEIGHTS, parts) @ np.linalg.norm(w, axis=-1))
     return total
 
 
