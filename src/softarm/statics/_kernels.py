@@ -242,7 +242,7 @@ def _law(arm, j, s, now, law, s0, s1, s2, s3, s4, s5):
     if tendons == 0:
         return eps[0], eps[1], eps[2], eps[3], eps[4], eps[5]
     F, H = vec[1], jw
-    for it in range(_LAW_ITER):
+    for _ in range(_LAW_ITER):
         v0, v1, v2, u0, u1, u2 = eps[0], eps[1], eps[2], eps[3], eps[4], eps[5]
         for i in range(6):
             acc = -rhs[i]
