@@ -570,12 +570,36 @@ def test_bad_actuator_keys_are_named_by_key_path(change, message):
 # Global balance with the actuators' shares rebuilt from the solution
 # ============================================================================================
 
-def test_rod_stress_plus_actuator_shares_balances_the_external_loads():
-    # The returned stresses are the rod's own, K (ε - f0). Adding each tendon's pull
-    # τ (t; r × t) (t = w/|w| from the returned strains) and removing each chamber's fluid
-    # wrench p A (e1; r × e1) must give the total wrench, which balances the external loads
-    # on [s, L] (rebuilt from the returned poses by tests/_equilibrium_checks.py). Actuators
-    # start and end at segment joints, where the balance check cuts its quadrature.
+def total_wrench_stresses(eq, actuators):
+    """The total wrench (material, per station) of an unbatched actuated equilibrium: the
+    returned rod stresses plus each tendon's pull τ (t; r × t), t = w/|w| from the returned
+    strains, minus each chamber's fluid wrench p A (e1; r × e1). A station where an actuator
+    ends belongs to the tip side (the kernel's convention)."""
+    s = np.asarray(eq.s)
+    total = np.array(eq.stresses)
+    f0 = np.array([seg.reference_strain for seg in eq.arm.segments])
+    bounds = np.array(eq.arm.boundaries)
+    segment = np.clip(np.searchsorted(bounds, s, side="right") - 1, 0, len(f0) - 1)
+    strains = eq.strains + f0[segment]
+    length = float(eq.arm.length)
+    e1 = np.array([1.0, 0.0, 0.0])
+    for load in actuators:
+        start, end = load.path_span(length)
+        on = (s >= start) & ((s < end) | (end >= length))
+        r = load.routing.position(s)
+        if isinstance(load, Tendon):
+            w = strains[:, :3] + np.cross(strains[:, 3:], r) + load.routing.derivative(s)
+            t = w / np.linalg.norm(w, axis=-1, keepdims=True)
+            share = load.tension * np.concatenate([t, np.cross(r, t)], axis=-1)
+        else:
+            share = -load.pressure * load.area * np.concatenate(
+                [np.broadcast_to(e1, r.shape), np.cross(r, e1)], axis=-1)
+        total[on] += share[on]
+    return total
+
+
+def assert_actuated_balance(arm, external, actuators, rel=1e-9):
+    """Global balance of the arm with its actuators at the balance check's own stations."""
     import dataclasses
     import sys
     from pathlib import Path
@@ -583,6 +607,19 @@ def test_rod_stress_plus_actuator_shares_balances_the_external_loads():
     sys.path.insert(0, str(Path(__file__).parent))
     from _equilibrium_checks import balance_errors, fine_stations
 
+    eq = numeric(arm, [*external, *actuators], s=fine_stations(arm, external), tol=1e-11)
+    total = dataclasses.replace(eq, stresses=total_wrench_stresses(eq, actuators),
+                                loads=tuple(external))
+    force, moment, force_scale, moment_scale = balance_errors(total)
+    assert force <= rel * force_scale and moment <= rel * moment_scale, (force, moment)
+
+
+def test_rod_stress_plus_actuator_shares_balances_the_external_loads():
+    # The returned stresses are the rod's own, K (ε - f0). Adding each tendon's pull and
+    # removing each chamber's fluid wrench must give the total wrench, which balances the
+    # external loads on [s, L] (rebuilt from the returned poses by
+    # tests/_equilibrium_checks.py). Actuators start and end at segment joints, where the
+    # balance check cuts its quadrature.
     seg = dict(EA=40.0, GAy=20.0, GAz=20.0, GJ=0.004, EIy=0.006, EIz=0.005,
                mass_per_length=0.05)
     arm = SegmentedArm([Arm.from_stiffness(0.15, **seg),
@@ -590,28 +627,4 @@ def test_rod_stress_plus_actuator_shares_balances_the_external_loads():
     actuators = [Tendon(0.5, Helix(0.008, 2.0, phase=0.3), end=0.15),
                  Tendon(0.3, Polynomial(y=[0.006, 0.01], z=[0.0, -0.02])),
                  Chamber(4e3, 1e-5, Straight(0.0, -0.006), start=0.15)]
-    external = [Gravity(), TipLoad(force=[0.0, 0.05, -0.02])]
-    s = fine_stations(arm, external)
-    eq = numeric(arm, external + actuators, s=s, tol=1e-11)
-    total = eq.stresses.copy()
-    strains = eq.strains + np.array([1.0, 0, 0, 0, 0, 0])
-    strains[s >= 0.15, 4] += 1.0  # f0 of the second segment (its station 0.15 included)
-    for load in actuators:
-        end = load.end if load.end is not None else 0.3
-        start = getattr(load, "start", 0.0)
-        on = (s >= start) & (s <= end)
-        r = load.routing.position(s)
-        if isinstance(load, Tendon):
-            w = strains[:, :3] + np.cross(strains[:, 3:], r) + load.routing.derivative(s)
-            t = w / np.linalg.norm(w, axis=-1, keepdims=True)
-            share = load.tension * np.concatenate([t, np.cross(r, t)], axis=-1)
-        else:
-            e1 = np.array([1.0, 0.0, 0.0])
-            share = -load.pressure * load.area * np.concatenate(
-                [np.broadcast_to(e1, r.shape), np.cross(r, e1)], axis=-1)
-        # at a station where an actuator ends, the returned state is the tip side's
-        on &= ~((s == end) & (end < 0.3))
-        total[on] += share[on]
-    eq_total = dataclasses.replace(eq, stresses=total, loads=tuple(external))
-    force, moment, force_scale, moment_scale = balance_errors(eq_total)
-    assert force <= 1e-9 * force_scale and moment <= 1e-9 * moment_scale, (force, moment)
+    assert_actuated_balance(arm, [Gravity(), TipLoad(force=[0.0, 0.05, -0.02])], actuators)

@@ -23,7 +23,39 @@ def solve(name: str):
 
 def test_the_examples_are_there():
     assert {"demo", "fig2_pure_bending", "fig2_sweep", "fig3_shear_load",
-            "mattiasson_cantilever", "precurved"} <= set(CASES)
+            "mattiasson_cantilever", "precurved", "tendon_robot", "pneumatic_actuator",
+            "magnetic_catheter"} <= set(CASES)
+
+
+@pytest.mark.parametrize("name", ["tendon_robot", "pneumatic_actuator"])
+def test_actuated_examples_balance(name):
+    """The arm with its tendons or chambers: the rod's stress plus the actuators' shares
+    balances gravity and the payload on every [s, L] (tests/test_actuation.py)."""
+    sys.path.insert(0, str(Path(__file__).parent))
+    from test_actuation import assert_actuated_balance
+
+    import softarm
+
+    case = load_case(EXAMPLES / f"{name}.toml")
+    actuators = [load for load in case.loads if isinstance(load, (softarm.Tendon,
+                                                                  softarm.Chamber))]
+    external = [load for load in case.loads if load not in actuators]
+    assert actuators and external
+    assert_actuated_balance(case.arm, external, actuators)
+
+
+def test_magnetic_catheter_tip_is_turned_by_the_dipole_couple():
+    """A tip dipole m in a uniform field B is the tip couple (R(L) m) × B: the same arm under
+    that dead couple, evaluated at the returned tip frame, has the same shape."""
+    import softarm
+
+    case, result = solve("magnetic_catheter")
+    couple = np.cross(result.tip[:3, :3] @ case.arm.tip_magnet, case.loads[0].field)
+    again = softarm.solve(case.arm, softarm.TipLoad(moment=couple), method="numeric",
+                          s=case.solve.stations)
+    np.testing.assert_allclose(result.poses, again.poses, rtol=0, atol=1e-7 * case.arm.length)
+    # the field turns the magnet towards it: the tip axis gains a +y component
+    assert result.tip[1, 0] > 0.5
 
 
 @pytest.mark.parametrize("name", CASES)

@@ -46,7 +46,8 @@ __all__ = ["Input", "LiveCase", "inputs", "make_server", "serve"]
 @dataclass(frozen=True)
 class Input:
     """One control of the app: a slider for a component of a load vector (``component`` 0, 1,
-    2) or a switch turning a whole load on and off (``component`` None, values 0 and 1)."""
+    2), a slider for a load's magnitude (a tension, a pressure: ``component`` -1), or a switch
+    turning a whole load on and off (``component`` None, values 0 and 1)."""
 
     name: str
     label: str
@@ -94,6 +95,19 @@ def inputs(case: Case) -> list[Input]:
     for i, load in enumerate(case.loads):
         kind = load.kind
         out.append(Input(f"l{i + 1}.on", f"{i + 1}: {load.describe()}", "", 0.0, 1.0, 1.0, i))
+        for name, unit, shape in load.arrays:
+            if shape != ():
+                continue
+            value = float(np.asarray(getattr(load, name), dtype=float))
+            if value != 0.0:
+                half = _nice(2.0 * abs(value))
+            else:  # about a radian of bending: τ ρ L / EI ≈ 1 (p A for a chamber)
+                reach = load.routing.bound(float(case.arm.length)) or 1.0
+                half = _nice(_bending(case.arm) / (float(case.arm.length) * reach
+                                                   * getattr(load, "area", 1.0)))
+            low = 0.0 if value >= 0.0 else -half
+            out.append(Input(f"l{i + 1}.{name}", f"{kind} {name}", unit, low, half, value, i,
+                             name, -1))
         for name, unit in load.vectors:
             vector = np.asarray(getattr(load, name), dtype=float)
             norm = float(np.linalg.norm(vector))
@@ -173,9 +187,7 @@ class LiveCase:
         for i, load in enumerate(self.case.loads):
             if not self.values[f"l{i + 1}.on"]:
                 continue
-            fields = {}
-            for name, _ in load.vectors:
-                fields[name] = [self.values[f"l{i + 1}.{name}.{axis}"] for axis in "xyz"]
+            fields = _fields(load, i, self.values, 1.0)
             out.append(load.replace(**fields) if fields else load)
         return tuple(out)
 
@@ -230,11 +242,18 @@ def _with_all_loads(result, loads, values):
 
     full = []
     for i, load in enumerate(loads):
-        on = values[f"l{i + 1}.on"]
-        fields = {name: [values[f"l{i + 1}.{name}.{axis}"] * on for axis in "xyz"]
-                  for name, _ in load.vectors}
+        fields = _fields(load, i, values, values[f"l{i + 1}.on"])
         full.append(load.replace(**fields) if fields else load)
     return dataclasses.replace(result, loads=tuple(full))
+
+
+def _fields(load, i: int, values: dict, on: float) -> dict:
+    """Load i's slider-controlled fields at the current values (times ``on``)."""
+    fields = {name: [values[f"l{i + 1}.{name}.{axis}"] * on for axis in "xyz"]
+              for name, _ in load.vectors}
+    fields.update({name: values[f"l{i + 1}.{name}"] * on for name, _, shape in load.arrays
+                   if shape == ()})
+    return fields
 
 
 def _title(case: Case, loads) -> str:

@@ -16,8 +16,9 @@ from functools import partial
 
 import numpy as np
 
-from ..loads import TipLoad
-from ..model import Arm
+from ..loads import Gravity, MagneticField, Tendon, TipLoad
+from ..model import Arm, SegmentedArm
+from ..routing import Helix, Straight
 from . import references as ref
 from ._checks import CaseResult, DataTables, finding, gate, skipped
 from ._routes import (
@@ -46,6 +47,7 @@ RIGID = 1e9
 _MATTIASSON = "mattiasson_cantilever.json"
 _PRINCETON = "princeton_beam.json"
 _RODS = "rod_benchmarks.json"
+_ACTUATION = "actuation_benchmarks.json"
 
 
 @dataclass(frozen=True)
@@ -668,6 +670,112 @@ def helix(tables: DataTables) -> CaseResult:
     return result
 
 
+# ------------------------------------------------------------------------------------------
+# Actuation: tendons (peer codes and the closed form), magnets (the elastica)
+# ------------------------------------------------------------------------------------------
+def _till_arm(parameters) -> Arm:
+    E, G, r = parameters["E"], parameters["G"], parameters["radius"]
+    area, second = math.pi * r**2, math.pi * r**4 / 4
+    return Arm.from_stiffness(parameters["L"], EA=E * area, GAy=G * area, GAz=G * area,
+                              GJ=2 * G * second, EIy=E * second, EIz=E * second,
+                              mass_per_length=parameters["rho"] * area)
+
+
+def tendon_robots(tables: DataTables) -> CaseResult:
+    case = "tendon_robots"
+    data, result = _table_or_skip(tables, _ACTUATION, case, "Till/Rucker, tdcr-modeling",
+                                  "tip position", f"{_ACTUATION}: peer_code_outputs")
+    if data is None:
+        return result
+    peers = data["peer_code_outputs"]
+    d = 0.01506
+    for name, helical in (("till_tendon_robot_straight", False),
+                          ("till_tendon_robot_helical", True)):
+        peer = peers[name]
+        par = peer["parameters"]
+        arm = _till_arm(par)
+        routes = [Helix(d, 1.0 / par["L"], phase=i * math.pi / 2) if helical else
+                  Straight(d * math.cos(i * math.pi / 2), d * math.sin(i * math.pi / 2))
+                  for i in range(4)]
+        loads = [Gravity((0.0, 9.81, 0.0))] + [
+            Tendon(t, r) for t, r in zip(par["tensions"], routes, strict=True)]
+        eq, note = attempt(numeric, arm, loads)
+        source = (f"{_ACTUATION}: {name}.converged_settings ({peer['repository']} at "
+                  f"{peer['commit'][:7]}, 4001 grid points; reproduced independently to "
+                  "1e-11 m)")
+        reference = peer["converged_settings"]["tip_position_softarm"]
+        for axis in range(3):
+            result.checks.append(gate(case, name.removeprefix("till_") + ", τ = 15 N",
+                                      NUMERIC, f"tip {'xyz'[axis]} [m]", reference[axis],
+                                      value(eq, tip, axis), TOL_NUMERIC * par["L"], source,
+                                      note=note))
+    peer = peers["tdcr_modeling_default"]
+    E, r = 54e9, 0.0007
+    G = E / 2.6
+    area, second = math.pi * r**2, math.pi * r**4 / 4
+    segment = Arm.from_stiffness(0.2, EA=E * area, GAy=G * area, GAz=G * area,
+                                 GJ=2 * G * second, EIy=E * second, EIz=E * second)
+    arm = SegmentedArm([segment, segment])
+    angles = np.deg2rad([90.0, -30.0, 210.0])
+    routes = [Straight(0.01 * math.cos(a), 0.01 * math.sin(a)) for a in angles]
+    loads = [Tendon(t, routes[i % 3], end=0.2 if i < 3 else None)
+             for i, t in enumerate(peer["parameters"]["tensions_N"])]
+    source = (f"{_ACTUATION}: tdcr_modeling_default ({peer['repository'].split(' ')[0]} at "
+              f"{peer['commit'][:7]}, 'Cosserat Rod' model, its ODE tolerance 1e-6/1e-3)")
+    reference = peer["tip_position_softarm"]["Cosserat Rod"]
+    for method, (eq, note) in ((NUMERIC, attempt(numeric, arm, loads)),
+                               ("analytic.actuated", attempt(closed_form, "actuated", arm,
+                                                             loads))):
+        for axis in range(3):
+            result.checks.append(gate(case, "tdcr-modeling two segments, 4 N and 2 N", method,
+                                      f"tip {'xyz'[axis]} [m]", reference[axis],
+                                      value(eq, tip, axis), 1e-7, source,
+                                      note="tolerance: the peer's ODE tolerance"
+                                      + (f"; {note}" if note else "")))
+    example = data["closed_forms"][0]["example_evaluated_here"]
+    EA, EI, L = example["EA"], example["EI"], example["L"]
+    arm = Arm.from_stiffness(L, EA=EA, GAy=EA, GAz=EA, GJ=EI, EIy=EI, EIz=EI)
+    loads = [Tendon(example["tension"], Straight(*example["offset_material"][1:]))]
+    source = f"{_ACTUATION}: closed_forms[0].example_evaluated_here (the arc formula)"
+    for method, (eq, note), tol in (
+            (NUMERIC, attempt(numeric, arm, loads), TOL_NUMERIC),
+            ("analytic.actuated", attempt(closed_form, "actuated", arm, loads), TOL_CLOSED)):
+        for axis in range(3):
+            result.checks.append(gate(case, "one straight tendon, τ = 3 N", method,
+                                      f"tip {'xyz'[axis]}/L", example["tip_position"][axis] / L,
+                                      value(eq, tip, axis, L), tol, source, note=note))
+    return result
+
+
+def magnetic_elastica(tables: DataTables) -> CaseResult:
+    case = "magnetic_elastica"
+    key = f"{_MATTIASSON}: computed_here.table"
+    data, result = _table_or_skip(tables, _MATTIASSON, case, "k = m_l B L²/EI", "w/L, u/L",
+                                  key)
+    if data is None:
+        return result
+    L, EI, m_l = 0.5, 0.02, 2.0
+    # soft in extension and shear: the magnetic rod carries no force resultant, so it is the
+    # inextensible elastica whatever EA and GA are
+    arm = Arm.from_stiffness(L, EA=50.0, GAy=30.0, GAz=30.0, GJ=0.015, EIy=EI, EIz=EI,
+                             magnetization=(m_l, 0.0, 0.0))
+    source = (f"{key}: a uniformly, axially magnetised rod in a uniform perpendicular field is "
+              "the inextensible elastica under the dead tip force m_l B "
+              f"({_ACTUATION}: closed_forms[5])")
+    for row in data["computed_here"]["table"]:
+        k = float(row["k"])
+        if k > 10:
+            continue
+        eq, note = attempt(numeric, arm, MagneticField((0.0, 0.0, k * EI / (L**2 * m_l))))
+        item = f"k = {k:g}"
+        result.checks += [
+            gate(case, item, NUMERIC, "w/L", row["w_over_L"], value(eq, tip, 2, L),
+                 TOL_NUMERIC, source, note=note),
+            gate(case, item, NUMERIC, "u/L", row["u_over_L"], 1.0 - value(eq, tip, 0, L),
+                 TOL_NUMERIC, source, note=note)]
+    return result
+
+
 CASES: tuple[ValidationCase, ...] = (
     ValidationCase(
         "fig2_pure_bending", "Paper Fig. 2: pure bending",
@@ -725,4 +833,15 @@ CASES: tuple[ValidationCase, ...] = (
         "paper's constant-strain formula (eqs. 30-34, with an ApproximationWarning), exact "
         "only for a moment about a principal axis (C2 and C4): its tip against "
         "the exact solver is reported as a finding.", helix),
+    ValidationCase(
+        "tendon_robots", "Tendon-driven robots: peer codes and the closed form",
+        "Till & Rucker's ContinuumRobotExamples (straight and helical 4-tendon robots under "
+        "gravity, one tendon at 15 N) and tdcr-modeling's two-segment Cosserat example, run "
+        "at stated commits; a straight tendon's exact arc. Axes mapped from the peers' e3 to "
+        "softarm's e1.", tendon_robots),
+    ValidationCase(
+        "magnetic_elastica", "A magnetised rod in a uniform field: the elastica",
+        "L = 0.5 m, EI = 0.02 N m², axial magnetisation 2 A m²/m, field B ⟂ the rod: the "
+        "inextensible elastica under the dead tip force m_l B (k = m_l B L²/EI), though the "
+        "rod is extensible and shearable (EA = 50 N, GA = 30 N).", magnetic_elastica),
 )
