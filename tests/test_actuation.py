@@ -628,3 +628,82 @@ def test_rod_stress_plus_actuator_shares_balances_the_external_loads():
                  Tendon(0.3, Polynomial(y=[0.006, 0.01], z=[0.0, -0.02])),
                  Chamber(4e3, 1e-5, Straight(0.0, -0.006), start=0.15)]
     assert_actuated_balance(arm, [Gravity(), TipLoad(force=[0.0, 0.05, -0.02])], actuators)
+
+
+# ============================================================================================
+# Actuation Jacobians (issue 16): exact, by the implicit function theorem
+# ============================================================================================
+
+def _tip_motion(plus, minus, eq, h):
+    """Central differences of the tip's (δp; δθ), spatial, δR = δθ~ R."""
+    dp = (plus.tip_position - minus.tip_position) / (2 * h)
+    W = (plus.poses[-1, :3, :3] - minus.poses[-1, :3, :3]) / (2 * h) @ eq.poses[-1, :3, :3].T
+    return np.r_[dp, W[2, 1], W[0, 2], W[1, 0]]
+
+
+def test_actuation_jacobian_matches_central_differences_for_every_kind_of_input():
+    arm = Arm.from_stiffness(0.3, EA=50.0, GAy=25.0, GAz=25.0, GJ=0.005, EIy=0.008, EIz=0.008,
+                             mass_per_length=0.05, magnetization=(0.5, 0.0, 0.0),
+                             tip_magnet=(0.0, 0.01, 0.0))
+
+    def loads(q):
+        return [Gravity(), Tendon(q[0], Straight(0.0, 0.01)),
+                Tendon(q[1], Helix(0.01, 1.5), end=0.2), Chamber(q[2], 1e-5, Straight(0.006, 0)),
+                MagneticField(q[3:6])]
+
+    q = np.array([0.6, 0.3, 2e3, 0.01, 0.02, -0.01])  # N, N, Pa, T, T, T
+    eq = numeric(arm, loads(q), jacobians=True, steps=96)
+    A = eq.actuation_jacobian
+    assert A.shape == (6, 6) and eq.station_actuation_jacobian.shape == (101, 6, 6)
+    np.testing.assert_array_equal(eq.station_actuation_jacobian[-1], A)
+    errors = []
+    for i in range(6):
+        h = 1e-6 * max(abs(q[i]), 1e-2)
+        dq = np.zeros(6)
+        dq[i] = h
+        fd = _tip_motion(numeric(arm, loads(q + dq), steps=96),
+                         numeric(arm, loads(q - dq), steps=96), eq, h)
+        errors.append(np.abs(A[:, i] - fd).max() / np.abs(fd).max())
+    assert max(errors) <= 1e-6 and np.median(errors) <= 1e-7, errors
+
+
+def test_actuation_jacobian_of_a_tendon_arc_equals_the_closed_form_derivative():
+    # one straight tendon at z on a straight arm: u_y = -τ z/EI, v1 = 1 - τ/EA, the tip
+    # p = v1 (sin θ, 0, 1 - cos θ)/|u| with θ = -u_y L, rotation θ about -y... differentiated
+    # in τ by the complex step (exact to round-off)
+    EA, EI, L, z, tau = 2e3, 4e-3, 0.25, 0.006, 0.8
+    arm = Arm.from_stiffness(L, EA=EA, GAy=EA, GAz=EA, GJ=EI, EIy=EI, EIz=EI)
+
+    def tip(t):
+        u = -t * z / EI  # curvature about y
+        v1 = 1.0 - t / EA
+        return np.array([v1 * np.sin(u * L) / u, 0.0 * t, -v1 * (1 - np.cos(u * L)) / u,
+                         0.0 * t, u * L, 0.0 * t])
+
+    h = 1e-30
+    exact = np.imag(tip(tau + 1j * h)) / h  # (dp/dτ; dθ/dτ): θ = u_y L about +y
+    eq = numeric(arm, Tendon(tau, Straight(0.0, z)), jacobians=True, tol=1e-11)
+    np.testing.assert_allclose(eq.actuation_jacobian[:, 0], exact, rtol=0,
+                               atol=1e-9 * np.abs(exact).max())
+
+
+def test_reciprocity_of_tip_motion_per_tension_and_tendon_length_per_tip_force():
+    # Maxwell–Betti for the potential U + Σ τ ℓ - F·p(L): ∂p(L)/∂τ = -∂ℓ/∂F, two independent
+    # columns (the exact actuation Jacobian; central differences of the tendon's length)
+    arm = Arm.from_stiffness(0.3, EA=60.0, GAy=30.0, GAz=30.0, GJ=0.005, EIy=0.008,
+                             EIz=0.006, mass_per_length=0.05)
+    base = [Gravity(), Tendon(0.5, Helix(0.008, 2.0, phase=0.3))]
+    eq = numeric(arm, [*base, TipLoad(force=[0.0, 0.02, 0.0])], jacobians=True, steps=128)
+    dp_dtau = eq.actuation_jacobian[:3, 0]
+    h = 1e-5
+    dl_dF = []
+    for k in range(3):
+        f = np.array([0.0, 0.02, 0.0])
+        f_plus, f_minus = f.copy(), f.copy()
+        f_plus[k] += h
+        f_minus[k] -= h
+        plus = numeric(arm, [*base, TipLoad(force=f_plus)], steps=128).tendon_lengths[0]
+        minus = numeric(arm, [*base, TipLoad(force=f_minus)], steps=128).tendon_lengths[0]
+        dl_dF.append((plus - minus) / (2 * h))
+    np.testing.assert_allclose(dp_dtau, -np.array(dl_dF), rtol=0,
+                               atol=1e-6 * np.abs(dp_dtau).max())

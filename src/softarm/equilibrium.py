@@ -87,6 +87,14 @@ class Equilibrium:
         on the rod plus what the actuators pull or push on the base (tendons' motors, the
         chambers' fluid). The rod's own share is ``forces_spatial[..., 0, :]`` and
         ``moments_spatial[..., 0, :]``. Numerical route only (None from closed forms).
+    actuation_jacobian : ndarray, shape (B..., 6, n), or None
+        With ``solve(..., jacobians=True)`` and actuators: the tip's (δp; δθ) (spatial,
+        δR(L) = δθ~ R(L)) per unit change of each actuation input, in the order of the loads:
+        each tendon's tension (per N), each chamber's pressure (per Pa), each component of
+        each magnetic field's B0 (per T). Exact (implicit function theorem on the shooting
+        problem, one tangent column per input), not finite differences.
+    station_actuation_jacobian : ndarray, shape (B..., N, 6, n), or None
+        The same for every station's (δp(s); δθ(s)).
     tendon_tensions, tendon_lengths, tendon_length_changes : ndarray, shape (B..., T), or None
         Per :class:`~softarm.Tendon`, in the order given: its tension (N), its length from
         the base to its anchor (m), and that length less the unloaded arm's (m; negative
@@ -106,6 +114,8 @@ class Equilibrium:
     tip_compliance: np.ndarray | None = None
     compliance: np.ndarray | None = None
     base_wrench: np.ndarray | None = None
+    actuation_jacobian: np.ndarray | None = None
+    station_actuation_jacobian: np.ndarray | None = None
     tendon_tensions: np.ndarray | None = None
     tendon_lengths: np.ndarray | None = None
     tendon_length_changes: np.ndarray | None = None

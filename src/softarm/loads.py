@@ -173,6 +173,9 @@ class Load(abc.ABC):
     #: Every batchable field, (name, unit, object shape): vectors (3,), magnitudes (),
     #: matrices (3, 3); derived from ``schema``.
     arrays: ClassVar[tuple[tuple[str, str, tuple[int, ...]], ...]] = ()
+    #: The fields that are actuation inputs (a tendon's tension, a chamber's pressure, a
+    #: field's B0): every component is one column of an actuation Jacobian, in load order.
+    inputs: ClassVar[tuple[str, ...]] = ()
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
@@ -589,6 +592,7 @@ class Tendon(Load):
     """
 
     kind: ClassVar[str] = "tendon"
+    inputs: ClassVar = ("tension",)
     schema: ClassVar = (Key("tension", "magnitude", "N", required=True),
                         Key("routing", "routing", required=True), Key("end", "number", "m"))
 
@@ -654,6 +658,7 @@ class Chamber(Load):
     """
 
     kind: ClassVar[str] = "chamber"
+    inputs: ClassVar = ("pressure",)
     schema: ClassVar = (Key("pressure", "magnitude", "Pa", required=True),
                         Key("area", "number", "m²", required=True),
                         Key("routing", "routing", required=True), Key("start", "number", "m"),
@@ -727,6 +732,7 @@ class MagneticField(Load):
     """
 
     kind: ClassVar[str] = "magnetic"
+    inputs: ClassVar = ("field",)
     schema: ClassVar = (Key("field", "vector", "T", required=True),
                         Key("gradient", "matrix", "T/m"))
 

@@ -411,7 +411,7 @@ def _deriv(work, twork, nt, stage, s, arm, j, now, rate, law):
     ma0, ma1, ma2 = mag[j, 0], mag[j, 1], mag[j, 2]
     magnetic = ma0 != 0.0 or ma1 != 0.0 or ma2 != 0.0
     if magnetic:
-        _dipole(work[Y], twork[Y], 0, ma0, ma1, ma2, now[j], rate[j], law[2][3])
+        _dipole(work[Y], twork[Y], 0, ma0, ma1, ma2, now[j], rate[0, j], law[2][3])
         for i in range(3):
             w[_N + i] -= law[2][3, i]
             w[_M + i] -= law[2][3, 3 + i]
@@ -442,10 +442,10 @@ def _deriv(work, twork, nt, stage, s, arm, j, now, rate, law):
             (M[0, 6 + d], M[1, 6 + d], M[2, 6 + d], M[3, 6 + d], M[4, 6 + d],
              M[5, 6 + d]) = _strain(C, zero, j, diag, d0, d1, d2, d3, d4, d5)
     if actuated:
-        if nt > LAM:
-            _actuator_rates(arm, j, rate, law, law[2][4])
+        for d in range(LAM, nt):
+            _actuator_rates(arm, j, rate[d - LAM], law, law[2][4])
             for i in range(6):
-                M[i, 6 + LAM] += law[2][4, i]
+                M[i, 6 + d] += law[2][4, i]
                 law[2][4, i] = 0.0
         if _eliminate_columns(M, nt) == 0.0:
             for d in range(nt):
@@ -471,28 +471,29 @@ def _deriv(work, twork, nt, stage, s, arm, j, now, rate, law):
         e0 = -(th1 * lf2 - th2 * lf1)
         e1 = -(th2 * lf0 - th0 * lf2)
         e2 = -(th0 * lf1 - th1 * lf0)
-        if d == LAM:  # the loads' own change with λ
-            b0 -= rate[j, _FF]
-            b1 -= rate[j, _FF + 1]
-            b2 -= rate[j, _FF + 2]
-            e0 -= rate[j, _LF]
-            e1 -= rate[j, _LF + 1]
-            e2 -= rate[j, _LF + 2]
+        rr = max(d - LAM, 0)  # columns from LAM on: the loads' own change along rate[d - LAM]
+        if d >= LAM:
+            b0 -= rate[rr, j, _FF]
+            b1 -= rate[rr, j, _FF + 1]
+            b2 -= rate[rr, j, _FF + 2]
+            e0 -= rate[rr, j, _LF]
+            e1 -= rate[rr, j, _LF + 1]
+            e2 -= rate[rr, j, _LF + 2]
         g0 = R00 * b0 + R01 * b1 + R02 * b2
         g1 = R10 * b0 + R11 * b1 + R12 * b2
         g2 = R20 * b0 + R21 * b1 + R22 * b2
         k0 = R00 * e0 + R01 * e1 + R02 * e2
         k1 = R10 * e0 + R11 * e1 + R12 * e2
         k2 = R20 * e0 + R21 * e1 + R22 * e2
-        if d == LAM:
-            g0 -= rate[j, _FD]
-            g1 -= rate[j, _FD + 1]
-            g2 -= rate[j, _FD + 2]
-            k0 -= rate[j, _LD]
-            k1 -= rate[j, _LD + 1]
-            k2 -= rate[j, _LD + 2]
+        if d >= LAM:
+            g0 -= rate[rr, j, _FD]
+            g1 -= rate[rr, j, _FD + 1]
+            g2 -= rate[rr, j, _FD + 2]
+            k0 -= rate[rr, j, _LD]
+            k1 -= rate[rr, j, _LD + 1]
+            k2 -= rate[rr, j, _LD + 2]
         if magnetic:  # the magnetic force and torque densities' variations
-            _dipole(work[Y], twork[Y], d + 1, ma0, ma1, ma2, now[j], rate[j], law[2][3])
+            _dipole(work[Y], twork[Y], d + 1, ma0, ma1, ma2, now[j], rate[rr, j], law[2][3])
             g0 -= law[2][3, 0]
             g1 -= law[2][3, 1]
             g2 -= law[2][3, 2]
@@ -521,7 +522,8 @@ def _dipole(y, T, which, m0, m1, m2, now, rate, out):
     density) carried by the section of state y in the field B(x) = B0 + G x of the load row
     ``now``: out = (Gᵀ (R m); (R m) × B(p)), spatial. With ``which`` = d + 1 instead its
     variation along tangent column d of T: R (δθ × m) = δ(R m) in both terms, G δp in the
-    torque, and in the load-factor column the field's own change (``rate``)."""
+    torque, and in a load column (d >= LAM) the field's own change (``rate``: that column's
+    rate row of this piece)."""
     R = y[_R:_R + 9]
     a0 = R[0] * m0 + R[1] * m1 + R[2] * m2  # R m, spatial
     a1 = R[3] * m0 + R[4] * m1 + R[5] * m2
@@ -557,7 +559,7 @@ def _dipole(y, T, which, m0, m1, m2, now, rate, out):
     f0 = G[0] * e0 + G[3] * e1 + G[6] * e2
     f1 = G[1] * e0 + G[4] * e1 + G[7] * e2
     f2 = G[2] * e0 + G[5] * e1 + G[8] * e2
-    if d == LAM:
+    if d >= LAM:
         Gr, Br = rate[_FG:_FG + 9], rate[_FB:_FB + 3]
         f0 += Gr[0] * a0 + Gr[3] * a1 + Gr[6] * a2
         f1 += Gr[1] * a0 + Gr[4] * a1 + Gr[7] * a2
@@ -614,7 +616,7 @@ def _jump(y, T, nt, now, rate, j, arm, law):
     """The point wrench at the start of piece j: n and m drop by W_d + R W_f (and their
     tangents by R (δθ × W_f), plus ∂_λ W in the load-factor column), and by the wrench of a
     magnetic dipole there (a segment's ``tip_magnet``)."""
-    _dipole_jump(y, T, nt, arm[13], j, now[j], rate[j], law[2][5], y, T, -1.0)
+    _dipole_jump(y, T, nt, arm[13], j, now[j], rate, j, law[2][5], y, T, -1.0)
     for half in range(2):
         at = 3 * half
         W0, W1, W2 = now[j, _JF + at], now[j, _JF + at + 1], now[j, _JF + at + 2]
@@ -626,34 +628,35 @@ def _jump(y, T, nt, now, rate, j, arm, law):
             c0 = th1 * W2 - th2 * W1
             c1 = th2 * W0 - th0 * W2
             c2 = th0 * W1 - th1 * W0
-            if d == LAM:
-                c0 += rate[j, _JF + at]
-                c1 += rate[j, _JF + at + 1]
-                c2 += rate[j, _JF + at + 2]
+            if d >= LAM:
+                c0 += rate[d - LAM, j, _JF + at]
+                c1 += rate[d - LAM, j, _JF + at + 1]
+                c2 += rate[d - LAM, j, _JF + at + 2]
             for i in range(3):
                 T[d, _TN + at + i] -= (y[_R + 3 * i] * c0 + y[_R + 3 * i + 1] * c1
                                        + y[_R + 3 * i + 2] * c2)
-                if d == LAM:
-                    T[d, _TN + at + i] -= rate[j, _JD + at + i]
+                if d >= LAM:
+                    T[d, _TN + at + i] -= rate[d - LAM, j, _JD + at + i]
 
 
 @_jit
-def _dipole_jump(y, T, nt, dipoles, at, now, rate, out, ydst, Tdst, sign):
+def _dipole_jump(y, T, nt, dipoles, at, now, rate, j, out, ydst, Tdst, sign):
     """Add ``sign`` × the wrench of dipole ``dipoles[at]`` (A m², material) to n, m of
     ``ydst`` and its variations to the first nt tangent columns of ``Tdst`` (rows 6:12), or
-    with ``ydst`` the residual r (6) and ``Tdst`` the Jacobian J (6, 7) (see callers)."""
+    with ``ydst`` the residual r (6) and ``Tdst`` the Jacobian J (6, nt) (see callers); the
+    field and its rates are piece j's (``now``, ``rate[:, j]``)."""
     m0, m1, m2 = dipoles[at, 0], dipoles[at, 1], dipoles[at, 2]
     if m0 == 0.0 and m1 == 0.0 and m2 == 0.0:
         return
     off = _N if ydst.size >= 18 else 0
     for d in range(nt):
-        _dipole(y, T, d + 1, m0, m1, m2, now, rate, out)
+        _dipole(y, T, d + 1, m0, m1, m2, now, rate[max(d - LAM, 0), j], out)
         for i in range(6):
             if off:
                 Tdst[d, _TN + i] += sign * out[i]
             else:
                 Tdst[i, d] += sign * out[i]
-    _dipole(y, T, 0, m0, m1, m2, now, rate, out)
+    _dipole(y, T, 0, m0, m1, m2, now, rate[0, j], out)
     for i in range(6):
         ydst[off + i] += sign * out[i]
 
@@ -691,17 +694,17 @@ def _tip_residual(y, T, nt, tip_now, tip_rate, r, J, arm, now, rate, law):
             c0 = th1 * F2 - th2 * F1
             c1 = th2 * F0 - th0 * F2
             c2 = th0 * F1 - th1 * F0
-            if d == LAM:
-                c0 += tip_rate[_TF + at]
-                c1 += tip_rate[_TF + at + 1]
-                c2 += tip_rate[_TF + at + 2]
+            if d >= LAM:
+                c0 += tip_rate[d - LAM, _TF + at]
+                c1 += tip_rate[d - LAM, _TF + at + 1]
+                c2 += tip_rate[d - LAM, _TF + at + 2]
             for i in range(3):
                 J[at + i, d] = T[d, _TN + at + i] - (
                     y[_R + 3 * i] * c0 + y[_R + 3 * i + 1] * c1 + y[_R + 3 * i + 2] * c2)
-                if d == LAM:
-                    J[at + i, d] -= tip_rate[_TD + at + i]
+                if d >= LAM:
+                    J[at + i, d] -= tip_rate[d - LAM, _TD + at + i]
     last = now.shape[0] - 1
-    _dipole_jump(y, T, nt, arm[13], last + 1, now[last], rate[last], law[2][5], r, J, -1.0)
+    _dipole_jump(y, T, nt, arm[13], last + 1, now[last], rate, last, law[2][5], r, J, -1.0)
 
 
 @_jit
@@ -710,9 +713,9 @@ def _set_loads(lam, case, now, tip_now):
     start, rate, tip_start, tip_rate = case
     for j in range(start.shape[0]):
         for i in range(start.shape[1]):
-            now[j, i] = start[j, i] + lam * rate[j, i]
+            now[j, i] = start[j, i] + lam * rate[0, j, i]
     for i in range(TIP_LOADS):
-        tip_now[i] = tip_start[i] + lam * tip_rate[i]
+        tip_now[i] = tip_start[i] + lam * tip_rate[0, i]
 
 
 @_jit
@@ -1050,8 +1053,8 @@ def _follow(x, steps, base, arm, case, scratch, scale, dscale, length, threshold
 def _write(y, T, nt, j, s, arm, now, law, pose, strain, stress, E):
     """One station's outputs: pose, the rod's own material strain ε - f⁰ and stress
     K (ε - f⁰) (with actuators, the total wrench less the tendons' and the fluid's share),
-    and (nt = 6) the station's motion per unit base reaction, E = ∂(δp; δθ)/∂x with both
-    rows in spatial components."""
+    and (nt >= 6) the station's motion per unit base reaction, E[:, :6] = ∂(δp; δθ)/∂x,
+    and per unit input (E[:, 6:nt], the input columns), both rows in spatial components."""
     for i in range(4):
         for k in range(4):
             pose[i, k] = 0.0
@@ -1082,7 +1085,7 @@ def _write(y, T, nt, j, s, arm, now, law, pose, strain, stress, E):
             for k in range(6):
                 acc += C[j, i, k] * stress[k]
             strain[i] = acc
-    for d in range(min(nt, 6)):
+    for d in range(nt):
         for i in range(3):
             E[i, d] = T[d, _TP + i]
             E[3 + i, d] = (y[_R + 3 * i] * T[d, _TT] + y[_R + 3 * i + 1] * T[d, _TT + 1]
@@ -1090,11 +1093,11 @@ def _write(y, T, nt, j, s, arm, now, law, pose, strain, stress, E):
 
 
 @_jit
-def _record(x, nt, steps, base, arm, case, scratch, s_out, out, b, r, J):
-    """Integrate the solution x at λ = 1 once more and write every station's outputs (the
-    same steps as :func:`_integrate`, so the same numbers), the tip residual r and, with
-    nt = 6, the Jacobian J and the station tangents; and the case's base reaction and
-    tendon lengths.
+def _record(x, nt, steps, base, arm, case, lam, scratch, s_out, out, b, r, J):
+    """Integrate the solution x at load factor ``lam`` once more and write every station's
+    outputs (the same steps as :func:`_integrate`, so the same numbers), the tip residual r
+    and, with nt >= 6, the Jacobian J and the station tangents (columns 6.. along the
+    case's rate rows: the inputs); and the case's base reaction and tendon lengths.
 
     A station inside a step is reached by its own RK4 step from the start of that step, so
     the stations never change the steps of the solution. A station at a piece start gets the
@@ -1106,7 +1109,7 @@ def _record(x, nt, steps, base, arm, case, scratch, s_out, out, b, r, J):
     E = out[6][b if nt > 0 else 0]  # a (1, S, 6, 6) placeholder without tangents
     rate, tip_rate = case[1], case[3]
     piece_start, piece_len = arm[0], arm[1]
-    _set_loads(1.0, case, now, tip_now)
+    _set_loads(lam, case, now, tip_now)
     _start(y, T, nt, base, x)
     k = 0
     ns = s_out.size
@@ -1276,16 +1279,17 @@ def _chord(x, J_c, steps, base, arm, case, scratch, scale, threshold, max_iterat
 
 
 @_jit
-def _scratch(npieces, nact):
-    """Work arrays of one integration (state with the nact tendon lengths, tangents, RK4
-    stages, loads at λ, a station's own state and tangents, and the constitutive law's:
-    the 6 × 14 elimination matrix, per actuator (t, |w|, y, z, y', z'), small vectors)."""
+def _scratch(npieces, nact, ncols):
+    """Work arrays of one integration (state with the nact tendon lengths, ncols tangent
+    columns, RK4 stages, loads at λ, a station's own state and tangents, and the
+    constitutive law's: the 6 × (6 + ncols) elimination matrix, per actuator (t, |w|, y, z,
+    y', z'), small vectors)."""
     width = 18 + nact
-    law = (np.empty((6, 14)), np.zeros((max(nact, 1), 8)), np.zeros((6, 6)),
+    law = (np.empty((6, 6 + ncols)), np.zeros((max(nact, 1), 8)), np.zeros((6, 6)),
            np.zeros((6, 6)))
-    return (np.empty(width), np.empty((7, NT)), np.empty((6, width)), np.empty((5, 7, NT)),
-            np.empty((npieces, PIECE_LOADS + nact)), np.empty(TIP_LOADS), np.empty(width),
-            np.empty((7, NT)), law)
+    return (np.empty(width), np.empty((ncols, NT)), np.empty((6, width)),
+            np.empty((5, ncols, NT)), np.empty((npieces, PIECE_LOADS + nact)),
+            np.empty(TIP_LOADS), np.empty(width), np.empty((ncols, NT)), law)
 
 
 @_jit
@@ -1295,7 +1299,23 @@ def _copy(src, dst):
 
 
 @_jit
-def solve_cases(base, arm, loads, first, options, s_out, memory, out):
+def _output(x, nt, steps, base, arm, case, piece_loads, tip_loads, inputs, scratch, s_out,
+            out, b, r, J, J_out):
+    """The output pass of case b (:func:`_record` at λ = 1); with tangents (nt = 6) and
+    actuation inputs, also one tangent column per input: the pass then runs on the case's
+    final loads with the inputs as its rate rows (at λ = 0, the same loads), J_out gets the
+    6 + n columns."""
+    n_inputs = inputs[0].shape[0]
+    if nt == 0 or n_inputs == 0:
+        _record(x, nt, steps, base, arm, case, 1.0, scratch, s_out, out, b, r, J)
+        return
+    at_inputs = (piece_loads, inputs[0], tip_loads, inputs[1])
+    _record(x, 6 + n_inputs, steps, base, arm, at_inputs, 0.0, scratch, s_out, out, b, r,
+            J_out)
+
+
+@_jit
+def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
     """Solve every load case of a flattened batch.
 
     Each case follows its own homotopy from λ = 0 to 1 (see the module docstring): from the
@@ -1323,6 +1343,9 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, out):
         fixed step count (0: from tol), largest step count, shootings budget, chained (0/1),
         jacobians (0/1), the ratio of the step counts of the solution and of the path.
     memory : (MEMORY,) the chained start (x at N, x at 2N, N, valid), read and rewritten.
+    inputs : (piece (n, P, PIECE_LOADS + A), tip (n, TIP_LOADS)): the load channels per unit
+        of each actuation input (n = 0: none); with jacobians the output pass integrates
+        one more tangent column per input, J and E then have 6 + n columns.
     out : (poses (B, S, 4, 4), strains (B, S, 6), stresses (B, S, 6), info (B, 5) [residual,
         error estimate, load factor reached, shootings, N], status (B,), J (B, 6, 6) at the
         solution (jacobians), E (B, S, 6, 6) station motion per unit x (jacobians), x (B, 6)
@@ -1345,12 +1368,14 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, out):
     coarse_ratio = int(options[_O_COARSE])
     info, status, jac = out[3], out[4], out[5]
     width = piece_loads.shape[2]
-    scratch = _scratch(npieces, width - PIECE_LOADS)
+    n_inputs = inputs[0].shape[0]
+    scratch = _scratch(npieces, width - PIECE_LOADS, 7 + n_inputs)
     start = np.zeros((npieces, width))
-    rate = np.empty((npieces, width))
+    rate = np.empty((1, npieces, width))
     tip_start = np.zeros(TIP_LOADS)
-    tip_rate = np.empty(TIP_LOADS)
+    tip_rate = np.empty((1, TIP_LOADS))
     case = (start, rate, tip_start, tip_rate)
+    J_out = np.empty((6, 6 + n_inputs))  # the output pass's Jacobian: x, then the inputs
     r = np.empty(6)
     J = np.empty((6, 7))
     J_c = np.empty((6, 7))
@@ -1376,9 +1401,9 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, out):
                 tip_start[i] = first[1][i] if b == 0 else tip_loads[b - 1, i]
         for j in range(npieces):
             for i in range(width):
-                rate[j, i] = piece_loads[b, j, i] - start[j, i]
+                rate[0, j, i] = piece_loads[b, j, i] - start[j, i]
         for i in range(TIP_LOADS):
-            tip_rate[i] = tip_loads[b, i] - tip_start[i]
+            tip_rate[0, i] = tip_loads[b, i] - tip_start[i]
         w, turning = _load_size(arm, scale, start, piece_loads[b], tip_start, tip_loads[b])
         threshold = 1e-12 * w + 1e-300
         for i in range(6):
@@ -1476,8 +1501,8 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, out):
             if estimate <= tol or n_fixed > 0:
                 if fine == 2:
                     # the output pass integrates the last chord step: it must converge
-                    _record(x_f, nt_out, steps, base, arm, case, scratch, s_out, out, b, r,
-                            J)
+                    _output(x_f, nt_out, steps, base, arm, case, piece_loads[b], tip_loads[b],
+                            inputs, scratch, s_out, out, b, r, J, J_out)
                     counter[0] += 1
                     if _norm_scaled(r, scale) <= threshold:
                         recorded = True
@@ -1511,7 +1536,8 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, out):
             continue
         if not recorded:
             _fill_steps(length, arm[1], N, 2, steps)
-            _record(x_f, nt_out, steps, base, arm, case, scratch, s_out, out, b, r, J)
+            _output(x_f, nt_out, steps, base, arm, case, piece_loads[b], tip_loads[b],
+                    inputs, scratch, s_out, out, b, r, J, J_out)
             counter[0] += 1
         residual = 0.0
         for i in range(6):
@@ -1522,8 +1548,8 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, out):
         if not math.isfinite(residual):
             status[b] = NOT_FINITE
         for i in range(6):
-            for k in range(nt_out):
-                jac[b, i, k] = J[i, k]
+            for k in range(jac.shape[2] if nt_out else 0):
+                jac[b, i, k] = J_out[i, k] if n_inputs else J[i, k]
         if chained:
             for i in range(6):
                 memory[_MXC + i] = x[i]
@@ -1535,10 +1561,12 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, out):
 @_jit
 def shoot(x, lam, steps, base, arm, case, r, J, tip_state, tip_tangents):
     """The shooting primitive: integrate from the base reaction x (6) at load factor λ with
-    ``steps`` RK4 steps per piece; returns in place the residual r (6), its Jacobian J (6, 7)
-    (columns: ∂r/∂x, then ∂r/∂λ), the tip state (18: p, R row-major, n, m spatial) and the
-    tip tangents (7, 12) (per column: δp spatial, δθ material, δn, δm spatial)."""
-    scratch = _scratch(arm[1].size, case[0].shape[1] - PIECE_LOADS)
+    ``steps`` RK4 steps per piece; returns in place the residual r (6), its Jacobian J
+    (6, 6 + R) (columns: ∂r/∂x, then the derivative along each of the case's R rate rows:
+    ∂r/∂λ for the homotopy's own), the tip state (18 + A: p, R row-major, n, m spatial, the
+    tendon lengths) and the tip tangents (6 + R, 12) (per column: δp spatial, δθ material,
+    δn, δm spatial)."""
+    scratch = _scratch(arm[1].size, case[0].shape[1] - PIECE_LOADS, J.shape[1])
     _integrate(x, lam, J.shape[1], steps, base, arm, case, scratch, r, J)
     _copy(scratch[0], tip_state)
     _copy(scratch[1], tip_tangents)

@@ -478,15 +478,20 @@ class Solver:
         stresses = np.empty((count, S, 6))
         info = np.zeros((count, 5))
         status = np.zeros(count, dtype=np.int64)
-        jac = np.zeros((count, 6, 6) if jacobians else (0, 6, 6))
-        motion = np.zeros((count, S, 6, 6) if jacobians else (1, S, 6, 6))
+        inputs = _input_channels(loads, pieces, self._data, channels.piece.shape[2]) \
+            if jacobians else (np.zeros((0, *channels.piece.shape[1:])),
+                               np.zeros((0, k.TIP_LOADS)))
+        n_in = inputs[0].shape[0]
+        jac = np.zeros((count, 6, 6 + n_in) if jacobians else (0, 6, 6))
+        motion = np.zeros((count, S, 6, 6 + n_in) if jacobians else (1, S, 6, 6))
         base_wrench = np.empty((count, 6))
         lengths = np.empty((count, len(channels.actuators)))
         k.solve_cases(self._base_kernel, channels.arm_tuple(),
                       (channels.piece, channels.tip_loads), (first_piece, first_tip),
-                      self._options(chained, jacobians), self._s_kernel, memory,
+                      self._options(chained, jacobians), self._s_kernel, memory, inputs,
                       (poses, strains, stresses, info, status, jac, motion, base_wrench,
                        lengths))
+        actuation = _actuation(channels, base_wrench, lengths, shape)
         failed = np.flatnonzero(status != k.OK)
         if failed.size:
             if chained:
@@ -497,8 +502,10 @@ class Solver:
                           channels.signature())
         tip_compliance = compliance = None
         if jacobians:
-            tip_compliance, compliance = _compliances(jac, motion, shape)
-        actuation = _actuation(channels, base_wrench, lengths, shape)
+            tip_compliance, compliance, tip_inputs, station_inputs = _compliances(
+                jac, motion, shape)
+            actuation.update(actuation_jacobian=tip_inputs,
+                             station_actuation_jacobian=station_inputs)
         # fresh arrays, frozen before reshaping: Equilibrium takes them without a copy
         for array in (poses, strains, stresses, info):
             array.setflags(write=False)
@@ -537,8 +544,8 @@ class Solver:
             raise ValueError(f"x must be 6 finite numbers (n(0); m(0)), got {x!r}")
         n = 200 if steps is None else count(steps, "steps", 1)
         counts = np.maximum(1, np.floor(n * pieces[1] / self.length + 0.5)).astype(np.int64)
-        case = (np.zeros_like(channels.piece[0]), channels.piece[0].copy(),
-                np.zeros(k.TIP_LOADS), channels.tip_loads[0].copy())
+        case = (np.zeros_like(channels.piece[0]), channels.piece[0][None].copy(),
+                np.zeros(k.TIP_LOADS), channels.tip_loads[0][None].copy())
         r, J = np.empty(6), np.empty((6, 7))
         y, T = np.empty(18 + len(channels.actuators)), np.empty((7, 12))
         k.shoot(x.copy(), float(load_factor), counts, self._base_kernel, channels.arm_tuple(),
@@ -621,15 +628,54 @@ def _recut(old_starts, old_piece, new_starts) -> np.ndarray:
 
 
 def _compliances(jac, motion, shape):
-    """Tip and station compliances C(s) = E(s) J_x⁻¹ (dead tip wrench → (δp; δθ) spatial):
-    a dead tip wrench δW changes the residual by -δW, so the base reaction by J_x⁻¹ δW."""
-    inverse = np.linalg.inv(jac)
-    station = np.einsum("bsij,bjk->bsik", motion, inverse)
+    """Tip and station compliances C(s) = E_x(s) J_x⁻¹ (dead tip wrench → (δp; δθ)
+    spatial): a dead tip wrench δW changes the residual by -δW, so the base reaction by
+    J_x⁻¹ δW. And the actuation Jacobians (implicit function theorem): an input change δq
+    moves the residual by J_q δq at fixed x, so x by -J_x⁻¹ J_q δq and the stations by
+    (E_q - E_x J_x⁻¹ J_q) δq. Returns (tip compliance, station compliances, tip actuation
+    Jacobian, station actuation Jacobians); the last two None without inputs."""
+    inverse = np.linalg.inv(jac[:, :, :6])
+    station = np.einsum("bsij,bjk->bsik", motion[..., :6], inverse)
     tip = station[:, -1].copy()
-    for array in (station, tip):
-        array.setflags(write=False)
     S = motion.shape[1]
-    return tip.reshape(*shape, 6, 6), station.reshape(*shape, S, 6, 6)
+    n = jac.shape[2] - 6
+    out = [tip.reshape(*shape, 6, 6), station.reshape(*shape, S, 6, 6)]
+    if n:
+        through_x = np.einsum("bij,bjk->bik", inverse, jac[:, :, 6:])
+        inputs = motion[..., 6:] - np.einsum("bsij,bjk->bsik", motion[..., :6], through_x)
+        out += [inputs[:, -1].copy().reshape(*shape, 6, n), inputs.reshape(*shape, S, 6, n)]
+    else:
+        out += [None, None]
+    for array in out:
+        if array is not None:
+            array.setflags(write=False)
+    return tuple(out)
+
+
+def _input_channels(loads, pieces, data, width) -> tuple[np.ndarray, np.ndarray]:
+    """The load channels per unit of each actuation input (each load's ``inputs`` fields,
+    every component, in the order of the loads): (piece (n, P, W), tip (n, TIP_LOADS)).
+    The channels are linear in the inputs, so each is the channels of all loads zeroed but
+    that one component at 1 (all loads applied, so that the actuator columns line up)."""
+    k = _kernels()
+    zeroed = [load.take((0,) * len(load.batch_shape)).scaled(0.0) for load in loads]
+    piece, tip = [], []
+    for i, load in enumerate(loads):
+        for name in load.inputs:
+            value = np.asarray(getattr(zeroed[i], name))
+            for c in range(max(value.size, 1)):
+                unit = np.zeros(value.shape)
+                unit.flat[c] = 1.0
+                one = list(zeroed)
+                one[i] = zeroed[i].replace(**{name: unit})
+                channels = _Channels(data, pieces, (), 1)
+                for item in one:
+                    item.apply(channels)
+                piece.append(channels.piece[0])
+                tip.append(channels.tip_loads[0])
+    if not piece:
+        return np.zeros((0, pieces[0].size, width)), np.zeros((0, k.TIP_LOADS))
+    return np.ascontiguousarray(piece), np.ascontiguousarray(tip)
 
 
 def _failure(k, b, shape, status, info, solver) -> ConvergenceError:
