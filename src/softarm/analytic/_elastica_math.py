@@ -1,6 +1,7 @@
 """Exact planar cantilever under a dead tip force: elliptic-integral closed form.
 
-Pure mathematics, non-dimensional, no softarm imports. A straight cantilever of length L and
+Pure mathematics, non-dimensional, no softarm imports (but its compiled twin for one load,
+``_compiled``, imported on first use). A straight cantilever of length L and
 bending stiffness EI is clamped at s = 0 with its tangent along +x and carries at s = L a dead
 force P (cos φ, sin φ) in the (x, z) plane. ``planar_elastica`` returns the large-deflection
 equilibrium on the fundamental (stable, no interior inflection point) branch:
@@ -74,7 +75,7 @@ cancellation).
 
 Two routes evaluate this. A batch of loads (``_batch``) runs every step on arrays of shape
 (B..., N). One load (``lone_rows``, what ``softarm.solve`` meets most) runs the same steps in
-compiled scalar code (``_elastica_kernel``, numba, imported on first use): the tip condition
+compiled scalar code (``_compiled``, numba, imported on first use): the tip condition
 and every station by the same safeguarded Newton iteration with the same stopping rules, the
 stations from the same starts, with Carlson's R_F, R_D and Jacobi's sn, cn written out there.
 The two routes agree to a few units of 1e-15 of each field's scale
@@ -584,22 +585,22 @@ def _cumulative_chebyshev_direct(values, s):
 
 
 # --------------------------------------------------------------------------------------------
-# One load: the compiled route (``_elastica_kernel``, numba, imported on first use), the same
+# One load: the compiled route (``_compiled``, numba, imported on first use), the same
 # algorithm with scalar loops; _batch stays the route for batches
 # (tests/analytic/test_elastica_math.py checks that the two agree).
 # --------------------------------------------------------------------------------------------
-def kernel():
-    """The compiled module ``_elastica_kernel``, imported on first use (``import softarm``
-    does not import numba)."""
-    global _KERNEL
-    if _KERNEL is None:
-        from . import _elastica_kernel as module
+def compiled():
+    """The compiled module ``_compiled`` of this package, imported on first use (``import
+    softarm`` does not import numba)."""
+    global _COMPILED
+    if _COMPILED is None:
+        from . import _compiled as module
 
-        _KERNEL = module
-    return _KERNEL
+        _COMPILED = module
+    return _COMPILED
 
 
-_KERNEL = None
+_COMPILED = None
 #: Placeholders of the quadrature's points and weights where it is not used (the kernel's
 #: argument types stay the same, so numba compiles one version).
 _NO_POINTS = np.zeros(0)
@@ -640,7 +641,7 @@ def lone_rows(k, phi, s, a_r, g_r):
             return None
         points, weights = _chebyshev_points(n_cheb), _chebyshev_weights(n_cheb, s.tobytes())
     rows = np.empty((6, n))
-    tip = kernel().solve(k, a, sign, a_r, g_r, s, points, weights, rows)
+    tip = compiled().solve(k, a, sign, a_r, g_r, s, points, weights, rows)
     return rows, tip
 
 

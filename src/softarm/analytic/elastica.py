@@ -16,7 +16,7 @@ from ._common import (
     stiffness_diagonal,
     vectors,
 )
-from ._elastica_math import K_MAX, kernel, lone_rows, planar_elastica
+from ._elastica_math import K_MAX, compiled, lone_rows, planar_elastica
 
 __all__ = ["elastica", "elastica_plane", "solve_elastica"]
 
@@ -151,7 +151,7 @@ def solve_elastica(arm, force: np.ndarray, s: np.ndarray, extensible: bool, load
     """:func:`elastica` for checked arguments: ``force`` (B..., 3) finite, stations ``s`` (N,)
     from ``_validate.stations``; the result carries ``loads`` as given (exact_closed_form
     passes the caller's). A lone force (shape (3,)) takes the compiled route of
-    ``_elastica_math`` (``lone_rows`` and ``_elastica_kernel.fields``, a fraction of the time
+    ``_elastica_math`` (``lone_rows`` and ``_compiled.fields``, a fraction of the time
     of the batch route for one case).
     """
     if any(c != 0.0 for c in arm.curvature):
@@ -187,7 +187,7 @@ def solve_elastica(arm, force: np.ndarray, s: np.ndarray, extensible: bool, load
         one = lone_rows(k, phi, s / L, axial_ratio, shear_ratio)
     if one is not None:  # one load, compiled: (N, 28) fields written by the kernel
         fields = np.empty((s.shape[0], 28))
-        kernel().fields(b[1], b[2], L, stiffness_diagonal(arm), one[0], fields)
+        compiled().fields(b[1], b[2], L, stiffness_diagonal(arm), one[0], fields)
     else:  # a batch, or a load planar_elastica refuses (with its message)
         sol = planar_elastica(k, phi, s / L, axial_ratio=axial_ratio, shear_ratio=shear_ratio)
         fields = _fields(sol, *((b[1], b[2]) if lone else (b[..., 1], b[..., 2])), L, r)

@@ -19,8 +19,10 @@ from ._common import (
     rotational_stiffness,
     screw_poses,
     stiffness_diagonal,
+    thread_setting,
     vectors,
 )
+from ._elastica_math import compiled
 
 __all__ = ["helix_applies", "solve_tip_moment", "tip_moment"]
 
@@ -60,14 +62,34 @@ def _helix(arm, moment, follower, s):
     stress[..., 2, 4] = moment[..., 2]
     stress[..., 2, 5] = -moment[..., 1]
     fields[..., :6] = stress / k
-    poses, extra = screw_poses(E1, moment / B, s, twist=c, fields=fields)
+    if moment.ndim == 1:  # one load: the compiled screw
+        poses, extra = _screw_one(moment / B, float(c), s, fields)
+    else:
+        poses, extra = screw_poses(E1, moment / B, s, twist=c, fields=fields)
     return poses, extra[..., :6], extra[..., 6:]
+
+
+def _screw_one(omega, twist, s, extra):
+    """:func:`screw_poses` (u = e1) for one arm, compiled: poses (N, 4, 4) and the fields
+    (N, C), read-only views of one fresh (N, 16 + C) buffer."""
+    thread_setting()  # a bad $SOFTARM_NUM_THREADS is reported for one load as for a batch
+    out = np.empty((s.shape[0], 16 + extra.shape[1]))
+    s = s if s.flags.writeable else s.copy()  # one argument type: numba compiles one version
+    compiled().screw(E1, omega, twist, s, extra, out)
+    out.setflags(write=False)
+    return out[:, :16].reshape(-1, 4, 4), out[:, 16:]
 
 
 def _constant_strain(arm, moment, s):
     """Eqs. 30-34: ε = K⁻¹ (0; moment), constant, and H(s) = exp_SE3(s (f⁰ + ε))."""
     k = stiffness_diagonal(arm)
     kappa = moment / k[3:]
+    if moment.ndim == 1:  # one load: the compiled screw, the fields as its constant columns
+        fields = np.zeros((3, 12))
+        fields[0, 3:6] = kappa
+        fields[0, 9:] = kappa * k[3:]
+        poses, extra = _screw_one(np.asarray(arm.curvature) + kappa, 0.0, s, fields)
+        return poses, extra[:, :6], extra[:, 6:]
     poses, _ = screw_poses(E1, np.asarray(arm.curvature) + kappa, s)
     strain = np.zeros((*moment.shape[:-1], 1, 6))
     strain[..., 0, 3:] = kappa

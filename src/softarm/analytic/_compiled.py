@@ -1,7 +1,13 @@
-"""Compiled evaluation of the elastica closed form for one load (numba).
+"""Compiled closed forms for one load (numba): the elastica and the screw poses.
 
-The same algorithm as ``_elastica_math._batch`` (see that module's docstring for the
-derivation and the notation), written for one load with scalar loops over the stations:
+The one compiled module of ``softarm.analytic`` (numba's cache does not see changes in
+callees defined in other files, so every compiled function of the package lives here).
+``softarm.analytic`` imports it on first use (``import softarm`` does not import numba); it
+never imports ``softarm.statics``.
+
+:func:`solve` and :func:`fields` evaluate the elastica for one load: the same algorithm
+as ``_elastica_math._batch`` (see that module's docstring for the derivation and the
+notation), written for one load with scalar loops over the stations:
 the tip condition and every station are solved by the same safeguarded Newton iteration in
 ρ = log tan χ with the same stopping rules, the stations from the same starts (Jacobi's
 amplitude, or its asymptotic form near χ = π/2). Two fields take product forms that need no
@@ -11,8 +17,9 @@ sin²(δ_L/2) + cos²(δ_L/2) cos²χ_s (from tan(d/2) = tan(δ_L/2)/cos χ_s), 
 (sin χ_0 − sin χ_s)(sin χ_0 + sin χ_s)/(cos χ_s + cos χ_0). Carlson's R_F and R_D and
 Jacobi's sn, cn are written out here (numba has no scipy.special).
 
-``softarm.analytic`` imports this module on first use (``import softarm`` does not import
-numba); it never imports ``softarm.statics``.
+:func:`screw` writes the poses H(s) = exp_SE3(s (u; ω)) · exp_SE3(s (0; τ e1)) of one arm and
+fields linear in (1, 1 − cos τs, sin τs): the helix and the constant-strain closed forms of
+``moment.py``, as ``_common.screw_poses`` does for batches.
 
 References
 ----------
@@ -31,7 +38,7 @@ import numpy as np
 from .._jit import jit
 from ._elastica_math import _MAX_STEPS, _RHO_MAX
 
-__all__ = ["fields", "solve"]
+__all__ = ["carlson_rd", "carlson_rf", "fields", "jacobi_sn_cn", "screw", "solve"]
 
 _EPS = 2.220446049250313e-16
 #: Carlson's stopping constants (3r)^(-1/6) for R_F and (r/4)^(-1/6) for R_D, r = 2^-53: the
@@ -39,7 +46,7 @@ _EPS = 2.220446049250313e-16
 _Q_RF = (3.0 * 2.0**-53) ** (-1.0 / 6.0)
 _Q_RD = (0.25 * 2.0**-53) ** (-1.0 / 6.0)
 
-_jit = jit(what="softarm's compiled elastica", error_model="numpy", fastmath=False)
+_jit = jit(what="softarm's compiled closed forms", error_model="numpy", fastmath=False)
 
 
 @_jit
@@ -349,3 +356,60 @@ def fields(by, bz, length, stiffness, solution, out):
         row[25] = 0.0
         row[26] = (-bz / length * ei_y) * curvature
         row[27] = (by / length * ei_z) * curvature
+
+
+@_jit
+def screw(u, omega, twist, s, extra, out):
+    """Poses of H(s) = exp_SE3(s (u; ω)) · exp_SE3(s (0; τ e1)) and fields linear in ψ = τ s.
+
+    One arm: u, ω (3,) in 1 and 1/m (material frame), τ = ``twist`` in 1/m, stations s (N,)
+    in m. Writes row j of ``out`` (N, 16 + C): the pose (flattened 4×4) and Σ_y b_y(ψ)
+    extra[y] with b = (1, 1 − cos ψ, sin ψ) (``extra`` (3, C)). With θ = |ω|, a = ω/θ (a = e1
+    for θ = 0) and φ = θ s: R = exp(φ a~) exp(ψ e1~), exp(φ a~) = I + sin φ a~ + (1 − cos φ)
+    (a aᵀ − I), and p = s (a·u) a + (sin φ/θ) u⊥ + ((1 − cos φ)/θ) a × u, u⊥ = u − (a·u) a
+    (p = s u for θ = 0); 1 − cos x is written 2 sin²(x/2) (no cancellation). The same closed
+    form as ``_common.screw_poses``.
+    """
+    theta = math.sqrt(omega[0] * omega[0] + omega[1] * omega[1] + omega[2] * omega[2])
+    if theta == 0.0:
+        a0, a1, a2 = 1.0, 0.0, 0.0
+    else:
+        a0, a1, a2 = omega[0] / theta, omega[1] / theta, omega[2] / theta
+    dot = a0 * u[0] + a1 * u[1] + a2 * u[2]
+    along = (dot * a0, dot * a1, dot * a2)
+    perp = (u[0] - along[0], u[1] - along[1], u[2] - along[2])
+    cross = (a1 * u[2] - a2 * u[1], a2 * u[0] - a0 * u[2], a0 * u[1] - a1 * u[0])
+    columns = extra.shape[1]
+    for j in range(s.shape[0]):
+        row = out[j]
+        sj = s[j]
+        phi = theta * sj
+        half = math.sin(0.5 * phi)
+        sin_phi, vers_phi = math.sin(phi), 2.0 * half * half
+        # exp(φ a~), row-major
+        r00 = 1.0 + vers_phi * (a0 * a0 - 1.0)
+        r01 = -sin_phi * a2 + vers_phi * a0 * a1
+        r02 = sin_phi * a1 + vers_phi * a0 * a2
+        r10 = sin_phi * a2 + vers_phi * a1 * a0
+        r11 = 1.0 + vers_phi * (a1 * a1 - 1.0)
+        r12 = -sin_phi * a0 + vers_phi * a1 * a2
+        r20 = -sin_phi * a1 + vers_phi * a2 * a0
+        r21 = sin_phi * a0 + vers_phi * a2 * a1
+        r22 = 1.0 + vers_phi * (a2 * a2 - 1.0)
+        psi = twist * sj
+        half = math.sin(0.5 * psi)
+        sin_psi, vers_psi = math.sin(psi), 2.0 * half * half
+        cos_psi = 1.0 - vers_psi
+        # times exp(ψ e1~) = [[1, 0, 0], [0, cos ψ, -sin ψ], [0, sin ψ, cos ψ]]
+        row[0], row[1], row[2] = r00, cos_psi * r01 + sin_psi * r02, cos_psi * r02 - sin_psi * r01
+        row[4], row[5], row[6] = r10, cos_psi * r11 + sin_psi * r12, cos_psi * r12 - sin_psi * r11
+        row[8], row[9], row[10] = r20, cos_psi * r21 + sin_psi * r22, cos_psi * r22 - sin_psi * r21
+        if theta == 0.0:
+            row[3], row[7], row[11] = sj * u[0], sj * u[1], sj * u[2]
+        else:
+            f_sin, f_vers = sin_phi / theta, vers_phi / theta
+            for i in range(3):
+                row[4 * i + 3] = sj * along[i] + f_sin * perp[i] + f_vers * cross[i]
+        row[12], row[13], row[14], row[15] = 0.0, 0.0, 0.0, 1.0
+        for c in range(columns):
+            row[16 + c] = extra[0, c] + vers_psi * extra[1, c] + sin_psi * extra[2, c]
