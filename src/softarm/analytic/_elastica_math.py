@@ -564,6 +564,15 @@ def _chebyshev_weights(n, stations):
     return weights
 
 
+@functools.lru_cache(maxsize=16)
+def _chebyshev_rule(n, stations):
+    """The points (n,) and the weights (n, N) of the cumulative rule, read-only (the same
+    stations come back call after call); ``stations`` is ``s.tobytes()``."""
+    points = _chebyshev_points(n)
+    points.setflags(write=False)
+    return points, _chebyshev_weights(n, stations)
+
+
 def _cumulative_chebyshev_direct(values, s):
     """∫_0^s f for f sampled at ``_chebyshev_points(n)`` on the last axis (Clenshaw-Curtis).
 
@@ -604,6 +613,7 @@ _COMPILED = None
 #: Placeholders of the quadrature's points and weights where it is not used (the kernel's
 #: argument types stay the same, so numba compiles one version).
 _NO_POINTS = np.zeros(0)
+_NO_POINTS.setflags(write=False)
 _NO_WEIGHTS = np.zeros((0, 0))
 _NO_WEIGHTS.setflags(write=False)
 
@@ -639,7 +649,7 @@ def lone_rows(k, phi, s, a_r, g_r):
         n_cheb = _N_CHEB + _N_CHEB_PER_ROOT_K * math.ceil(math.sqrt(k))
         if n_cheb * n > _CACHED_WEIGHTS:
             return None
-        points, weights = _chebyshev_points(n_cheb), _chebyshev_weights(n_cheb, s.tobytes())
+        points, weights = _chebyshev_rule(n_cheb, s.tobytes())
     rows = np.empty((6, n))
     tip = compiled().solve(k, a, sign, a_r, g_r, s, points, weights, rows)
     return rows, tip
