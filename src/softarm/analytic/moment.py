@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import warnings
 
 import numpy as np
@@ -10,12 +11,12 @@ from ..errors import ApproximationWarning
 from ..loads import TipLoad
 from ._common import (
     E1,
+    ROUNDOFF,
     build,
     check_arm,
     check_follower,
     checked_stations,
     moment_is_principal,
-    negligible,
     rotational_stiffness,
     screw_poses,
     stiffness_diagonal,
@@ -33,9 +34,9 @@ def helix_applies(arm) -> bool:
     Then the helix solution (docs/closed-forms.md, C4) is exact for every end moment, dead or
     follower.
     """
-    _, EIy, EIz = rotational_stiffness(arm)
+    r = arm.rigidities
     _, ky, kz = arm.curvature
-    return bool(negligible(EIy - EIz, max(EIy, EIz))) and ky == 0.0 and kz == 0.0
+    return abs(r.EIy - r.EIz) <= ROUNDOFF * max(r.EIy, r.EIz) and ky == 0.0 and kz == 0.0
 
 
 def _helix(arm, moment, follower, s):
@@ -47,6 +48,8 @@ def _helix(arm, moment, follower, s):
     H(s) = exp_SE3(s (e1; M/B)) · exp_SE3(s (0; c e1)). Since exp(s M/B) fixes M,
     m(s) = exp(-s c e1) M = M + (1 - cos cs) (0, -M₂, -M₃) + sin(cs) (0, M₃, -M₂).
     """
+    if moment.ndim == 1:
+        return _helix_one(arm, moment.tolist(), follower, s)
     k = stiffness_diagonal(arm)
     GJ, B = k[3], k[4]
     c = arm.curvature[0] + moment[..., 0] * (1.0 / GJ - 1.0 / B)
@@ -62,11 +65,27 @@ def _helix(arm, moment, follower, s):
     stress[..., 2, 4] = moment[..., 2]
     stress[..., 2, 5] = -moment[..., 1]
     fields[..., :6] = stress / k
-    if moment.ndim == 1:  # one load: the compiled screw
-        poses, extra = _screw_one(moment / B, float(c), s, fields)
-    else:
-        poses, extra = screw_poses(E1, moment / B, s, twist=c, fields=fields)
+    poses, extra = screw_poses(E1, moment / B, s, twist=c, fields=fields)
     return poses, extra[..., :6], extra[..., 6:]
+
+
+def _helix_one(arm, moment, follower, s):
+    """:func:`_helix` for one moment (three floats), by the compiled screw: the same
+    arithmetic on floats."""
+    r = arm.rigidities
+    k = (r.EA, r.GAy, r.GAz, r.GJ, r.EIy, r.EIz)
+    B = r.EIy
+    m1, m2, m3 = moment
+    c = arm.curvature[0] + m1 * (1.0 / r.GJ - 1.0 / B)
+    if follower:
+        cos, sin = math.cos(arm.length * c), math.sin(arm.length * c)
+        m2, m3 = cos * m2 - sin * m3, sin * m2 + cos * m3
+    stress = ((0.0, 0.0, 0.0, m1, m2, m3), (0.0, 0.0, 0.0, 0.0, -m2, -m3),
+              (0.0, 0.0, 0.0, 0.0, m3, -m2))
+    fields = np.array([[*(value / stiffness for value, stiffness in zip(row, k, strict=True)),
+                        *row] for row in stress])
+    poses, extra = _screw_one(np.array([m1 / B, m2 / B, m3 / B]), c, s, fields)
+    return poses, extra[:, :6], extra[:, 6:]
 
 
 def _screw_one(omega, twist, s, extra):
