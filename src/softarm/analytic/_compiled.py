@@ -45,6 +45,9 @@ _EPS = 2.220446049250313e-16
 #: truncated series then errs by less than r relative.
 _Q_RF = (3.0 * 2.0**-53) ** (-1.0 / 6.0)
 _Q_RD = (0.25 * 2.0**-53) ** (-1.0 / 6.0)
+#: Largest step in u = F(χ | m') from the last station solved for which the next one starts
+#: from the Taylor series of am (error ~ h⁵ m'/120: a Newton step or two), else from am.
+_STEP = 0.25
 
 _jit = jit(what="softarm's compiled closed forms", error_model="numpy", fastmath=False)
 
@@ -231,6 +234,8 @@ def solve(k, a, sign, a_r, g_r, s, cheb, weights, out):
     u0 = sqrt_k * math.sqrt(f_l)
     quadrature = e != 0.0
     ratios = np.empty(17)
+    last = np.empty(3)  # (u, sin χ, cos χ) of the last station solved: the clamp at first
+    last[0], last[1], last[2] = u0, s_chi, c_chi
 
     theta, x, z, kappa, axial, shear = out[0], out[1], out[2], out[3], out[4], out[5]
     xi = out[1]  # the position along the force line, before the rotation into x and z
@@ -238,7 +243,7 @@ def solve(k, a, sign, a_r, g_r, s, cheb, weights, out):
         for j in range(n):
             xi[j] = 0.0
         for i in range(cheb.shape[0]):
-            sn, cn = _station_angles(cheb[i], u0, mc, rho_tip, s_chi, c_chi, ratios)
+            sn, cn = _station_angles(cheb[i], u0, mc, rho_tip, s_chi, c_chi, ratios, last)
             hd = math.hypot(s_dl, c_dl * cn)
             s_dn, c_dn = s_dl / hd, c_dl * cn / hd
             value = (c_dn - s_dn) * (c_dn + s_dn) + ka - e * (2.0 * s_dn * c_dn) ** 2
@@ -256,7 +261,7 @@ def solve(k, a, sign, a_r, g_r, s, cheb, weights, out):
         j_tip = s_chi * s_chi * s_chi * carlson_rd(cc, 1.0, cc + m1 * s_chi * s_chi) / 3.0
         cos_dl = cos_a * math.cos(tip) + sin_a * math.sin(tip)  # cos(a − θ_L)
     for j in range(n):
-        sn, cn = _station_angles(s[j], u0, mc, rho_tip, s_chi, c_chi, ratios)
+        sn, cn = _station_angles(s[j], u0, mc, rho_tip, s_chi, c_chi, ratios, last)
         cd = c_dl * cn
         h = math.hypot(s_dl, cd)
         s_d, c_d = s_dl / h, cd / h  # sin and cos of δ(s)/2
@@ -287,27 +292,55 @@ def solve(k, a, sign, a_r, g_r, s, cheb, weights, out):
 
 
 @_jit
-def _station_angles(s, u0, mc, rho_tip, s_chi, c_chi, ratios):
+def _station_angles(s, u0, mc, rho_tip, s_chi, c_chi, ratios, last):
     """(sin χ_s, cos χ_s) at the station s ∈ [0, 1]: exact at the clamp and the tip, else
-    from Jacobi's amplitude am(u0 (1 − s) | m') or, once cos³χ < ε, its asymptotic form
-    2 e^(−u) − m' e^u/8 (``_solve_stations``), polished by :func:`_station`."""
-    if s == 0.0:
-        return s_chi, c_chi
-    if s == 1.0:
-        return 0.0, 1.0
+    polished by :func:`_station` from a start: once cos³χ < ε the asymptotic form 2 e^(−u) −
+    m' e^u/8 of Jacobi's amplitude (as ``_solve_stations``); within ``_STEP`` in u of the
+    last station solved, ``last`` = (u, sin χ, cos χ), the Taylor series of am about it;
+    else am(u0 (1 − s) | m') itself. The start only sets how many Newton steps the root
+    takes. Updates ``last`` to this station."""
     target = u0 * (1.0 - s)
-    asymptotic = 2.0 * math.exp(-target) - mc * math.exp(target) / 8.0
-    if asymptotic > 0.0 and asymptotic**3 < _EPS:
-        start = -math.log(asymptotic)
+    if s == 0.0:
+        sn, cn = s_chi, c_chi
+    elif s == 1.0:
+        sn, cn = 0.0, 1.0
     else:
-        sn, cn = jacobi_sn_cn(target, mc, ratios)
-        if sn > 0.0 and cn > 0.0:
-            start = math.log(sn) - math.log(cn)
-        elif cn > 0.0:  # sn = 0: ρ = −∞
-            start = -_RHO_MAX
-        else:
-            start = rho_tip
-    return _station(target, mc, rho_tip, start)
+        start = math.nan
+        if target > 12.0:  # below, 2 e^(-u) >= 1.2e-5: the asymptotic form is never used
+            asymptotic = 2.0 * math.exp(-target) - mc * math.exp(target) / 8.0
+            if asymptotic > 0.0 and asymptotic**3 < _EPS:
+                start = -math.log(asymptotic)
+        if start != start and abs(target - last[0]) <= _STEP:
+            start = _taylor_start(target - last[0], last[1], last[2], mc)
+        if start != start:
+            sn, cn = jacobi_sn_cn(target, mc, ratios)
+            if sn > 0.0 and cn > 0.0:
+                start = math.log(sn) - math.log(cn)
+            elif cn > 0.0:  # sn = 0: ρ = −∞
+                start = -_RHO_MAX
+            else:
+                start = rho_tip
+        sn, cn = _station(target, mc, rho_tip, start)
+    last[0], last[1], last[2] = target, sn, cn
+    return sn, cn
+
+
+@_jit
+def _taylor_start(h, sn, cn, mc):
+    """ρ = log tan χ at u + h from χ = am(u | m') (its sine and cosine given), by the Taylor
+    series of am to order 4: the derivatives of χ are dn, −m' sn cn, −m' cos 2χ dn and
+    2 m' sin 2χ dn² + m'² cos 2χ sn cn (sn' = cn dn, cn' = −sn dn, dn' = −m' sn cn, DLMF
+    22.13.1-3). NaN if the prediction leaves (0, π/2)."""
+    m = 1.0 - mc
+    dn = math.sqrt(cn * cn + mc * sn * sn)
+    sc = sn * cn
+    c2 = (cn - sn) * (cn + sn)
+    d4 = 4.0 * m * sc * dn * dn + m * m * c2 * sc
+    chi = math.atan2(sn, cn) + h * (dn + h / 2.0 * (-m * sc + h / 3.0 * (
+        -m * c2 * dn + h / 4.0 * d4)))
+    if 0.0 < chi < 0.5 * math.pi:
+        return math.log(math.tan(chi))
+    return math.nan
 
 
 @_jit
