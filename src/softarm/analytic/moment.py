@@ -73,17 +73,16 @@ def _helix_one(arm, moment, follower, s):
     """:func:`_helix` for one moment (three floats), by the compiled screw: the same
     arithmetic on floats."""
     r = arm.rigidities
-    k = (r.EA, r.GAy, r.GAz, r.GJ, r.EIy, r.EIz)
-    B = r.EIy
+    GJ, B, Bz = r.GJ, r.EIy, r.EIz  # B = EIy = EIz to roundoff; σ/K divides by each
     m1, m2, m3 = moment
-    c = arm.curvature[0] + m1 * (1.0 / r.GJ - 1.0 / B)
+    c = arm.curvature[0] + m1 * (1.0 / GJ - 1.0 / B)
     if follower:
         cos, sin = math.cos(arm.length * c), math.sin(arm.length * c)
         m2, m3 = cos * m2 - sin * m3, sin * m2 + cos * m3
-    stress = ((0.0, 0.0, 0.0, m1, m2, m3), (0.0, 0.0, 0.0, 0.0, -m2, -m3),
-              (0.0, 0.0, 0.0, 0.0, m3, -m2))
-    fields = np.array([[*(value / stiffness for value, stiffness in zip(row, k, strict=True)),
-                        *row] for row in stress])
+    # rows b = (1, 1 - cos, sin): strains K⁻¹ σ, then stresses σ = (0; m)
+    fields = np.array([(0.0, 0.0, 0.0, m1 / GJ, m2 / B, m3 / Bz, 0.0, 0.0, 0.0, m1, m2, m3),
+                       (0.0, 0.0, 0.0, 0.0, -m2 / B, -m3 / Bz, 0.0, 0.0, 0.0, 0.0, -m2, -m3),
+                       (0.0, 0.0, 0.0, 0.0, m3 / B, -m2 / Bz, 0.0, 0.0, 0.0, 0.0, m3, -m2)])
     poses, extra = _screw_one(np.array([m1 / B, m2 / B, m3 / B]), c, s, fields)
     return poses, extra[:, :6], extra[:, 6:]
 
