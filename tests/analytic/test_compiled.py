@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 from scipy.linalg import expm
 
-from softarm.analytic import _compiled
+from softarm.analytic import _compiled, _elastica_math
 from softarm.analytic._elastica_math import planar_elastica
 
 mp.mp.dps = 40
@@ -110,6 +110,13 @@ def test_station_order_does_not_matter(rng):
         for got, want in zip(mixed[:-1], ahead[:-1], strict=True):
             scale = max(1.0, float(np.max(np.abs(want))))
             np.testing.assert_allclose(got, want[order], rtol=0, atol=2e-14 * scale)
+
+
+def test_constants_agree_with_the_batch_route():
+    # restated in _compiled.py (numba's cache sees that file only)
+    assert _compiled._RHO_MAX == _elastica_math._RHO_MAX
+    assert _compiled._MAX_STEPS == _elastica_math._MAX_STEPS
+    assert _compiled._EPS == np.finfo(np.float64).eps
 
 
 def test_import_softarm_does_not_import_numba():

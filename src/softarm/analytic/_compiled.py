@@ -24,9 +24,10 @@ fields linear in (1, 1 − cos τs, sin τs): the helix and the constant-strain 
 References
 ----------
 B. C. Carlson, "Numerical computation of real or complex elliptic integrals", Numer.
-Algorithms 10 (1995) 13-26: the duplication algorithms for R_F (eqs. 2.2-2.4) and R_D (eqs.
-2.28-2.30); DLMF 19.36.1-2. Jacobi's sn, cn by the arithmetic-geometric mean and descending
-Landen transformation: DLMF 22.20.1, Abramowitz & Stegun 16.4.
+Algorithms 10 (1995) 13-26: the duplication algorithms for R_F and R_D, with their stopping
+rules; DLMF §19.36 (the series after the duplications). Jacobi's sn, cn by the
+arithmetic-geometric mean and the descending Landen transformation: DLMF §22.20, Abramowitz &
+Stegun 16.4; their derivatives: DLMF §22.13.
 """
 
 from __future__ import annotations
@@ -36,11 +37,15 @@ import math
 import numpy as np
 
 from .._jit import jit
-from ._elastica_math import _MAX_STEPS, _RHO_MAX
 
 __all__ = ["carlson_rd", "carlson_rf", "fields", "jacobi_sn_cn", "screw", "solve"]
 
 _EPS = 2.220446049250313e-16
+#: ``_elastica_math``'s bracket of ρ = log tan χ and Newton step limit, restated here: numba
+#: caches compiled code by this file alone, so a constant imported from another file could
+#: go stale in the cache (tests/analytic/test_compiled.py checks that they agree).
+_RHO_MAX = 700.0
+_MAX_STEPS = 100
 #: Carlson's stopping constants (3r)^(-1/6) for R_F and (r/4)^(-1/6) for R_D, r = 2^-53: the
 #: truncated series then errs by less than r relative.
 _Q_RF = (3.0 * 2.0**-53) ** (-1.0 / 6.0)
@@ -54,7 +59,7 @@ _jit = jit(what="softarm's compiled closed forms", error_model="numpy", fastmath
 
 @_jit
 def carlson_rf(x, y, z):
-    """R_F(x, y, z) for x, y, z ≥ 0, at most one of them zero (DLMF 19.36.1)."""
+    """Carlson's R_F(x, y, z) for x, y, z ≥ 0, at most one of them zero (DLMF §19.36)."""
     a0 = (x + y + z) / 3.0
     q = _Q_RF * max(abs(a0 - x), abs(a0 - y), abs(a0 - z))
     a, scale = a0, 1.0  # scale = 4^-n
@@ -77,7 +82,7 @@ def carlson_rf(x, y, z):
 
 @_jit
 def carlson_rd(x, y, z):
-    """R_D(x, y, z) for x, y ≥ 0 (at most one zero), z > 0 (DLMF 19.36.2)."""
+    """Carlson's R_D(x, y, z) for x, y ≥ 0 (at most one zero), z > 0 (DLMF §19.36)."""
     a0 = (x + y + 3.0 * z) / 5.0
     q = _Q_RD * max(abs(a0 - x), abs(a0 - y), abs(a0 - z))
     a, scale, total = a0, 1.0, 0.0
@@ -330,7 +335,7 @@ def _taylor_start(h, sn, cn, mc):
     """ρ = log tan χ at u + h from χ = am(u | m') (its sine and cosine given), by the Taylor
     series of am to order 4: the derivatives of χ are dn, −m' sn cn, −m' cos 2χ dn and
     2 m' sin 2χ dn² + m'² cos 2χ sn cn (sn' = cn dn, cn' = −sn dn, dn' = −m' sn cn, DLMF
-    22.13.1-3). NaN if the prediction leaves (0, π/2)."""
+    §22.13). NaN if the prediction leaves (0, π/2)."""
     m = 1.0 - mc
     dn = math.sqrt(cn * cn + mc * sn * sn)
     sc = sn * cn
