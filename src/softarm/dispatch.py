@@ -10,7 +10,7 @@ import dataclasses
 
 import numpy as np
 
-from . import analytic
+from .analytic.exact import closed_form
 from .equilibrium import Equilibrium
 from .statics import Solver
 
@@ -25,11 +25,15 @@ def _in_base_frame(loads, R: np.ndarray) -> tuple:
     return tuple(load.in_base_frame(R) for load in loads)
 
 
-def _closed_form(arm, loads, s, H0) -> Equilibrium | None:
-    """An exact closed form for these loads on the arm clamped at H0, or None."""
-    identity = np.array_equal(H0, np.eye(4))
-    result = analytic.exact_closed_form(
-        arm, loads if identity else _in_base_frame(loads, H0[:3, :3]), s=s)
+_EYE4 = np.eye(4)
+
+
+def _closed_form(arm, loads, shape, s, H0) -> Equilibrium | None:
+    """An exact closed form for these checked loads (batch shape ``shape``) on the arm
+    clamped at H0, at the checked stations s, or None."""
+    identity = bool((H0 == _EYE4).all())
+    result = closed_form(arm, loads if identity else _in_base_frame(loads, H0[:3, :3]), s,
+                         shape)
     if result is None or identity:
         return result
     # the same arm clamped at H0: rigidly move the solution; material strains are unchanged
@@ -133,8 +137,8 @@ def solve_prepared(solver: Solver, loads, method="auto") -> Equilibrium:
     """
     _check_method(method)
     if method != "numeric":  # the solver validates the loads itself
-        loads, _ = solver.check_loads(loads)
-        result = _closed_form(solver.arm, loads, solver.s, solver.base)
+        loads, shape = solver.check_loads(loads)
+        result = _closed_form(solver.arm, loads, shape, solver.s, solver.base)
         if result is not None:
             return result
         if method == "analytic":

@@ -35,6 +35,7 @@ __all__ = [
     "screw_poses",
     "stiffness_diagonal",
     "thread_count",
+    "thread_setting",
     "vectors",
 ]
 
@@ -149,21 +150,29 @@ def thread_count(elements: int) -> int:
     At most ``$SOFTARM_NUM_THREADS`` (a positive integer) or, unset, the CPUs available to the
     process; at least ``_PER_THREAD`` elements per thread.
     """
-    setting = os.environ.get(THREADS_VARIABLE, "").strip()
-    if setting:
-        try:
-            limit = int(setting)
-        except ValueError:
-            limit = 0
-        if limit < 1:
-            raise ValueError(
-                f"environment variable {THREADS_VARIABLE} must be a positive integer (the "
-                f"most threads the closed forms may use), got {setting!r}"
-            )
-    else:
+    limit = thread_setting()
+    if limit is None:
         limit = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else \
             (os.cpu_count() or 1)
     return max(1, min(limit, elements // _PER_THREAD))
+
+
+def thread_setting() -> int | None:
+    """``$SOFTARM_NUM_THREADS`` as a positive integer, None if unset, else ValueError (checked
+    on every closed form that takes it, one load or a batch alike)."""
+    setting = os.environ.get(THREADS_VARIABLE, "").strip()
+    if not setting:
+        return None
+    try:
+        limit = int(setting)
+    except ValueError:
+        limit = 0
+    if limit < 1:
+        raise ValueError(
+            f"environment variable {THREADS_VARIABLE} must be a positive integer (the "
+            f"most threads the closed forms may use), got {setting!r}"
+        )
+    return limit
 
 
 def _in_threads(work, size: int, threads: int) -> None:

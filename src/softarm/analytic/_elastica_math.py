@@ -1,6 +1,7 @@
 """Exact planar cantilever under a dead tip force: elliptic-integral closed form.
 
-Pure mathematics, non-dimensional, no softarm imports. A straight cantilever of length L and
+Pure mathematics, non-dimensional, no softarm imports (but its compiled twin for one load,
+``_compiled``, imported on first use). A straight cantilever of length L and
 bending stiffness EI is clamped at s = 0 with its tangent along +x and carries at s = L a dead
 force P (cos φ, sin φ) in the (x, z) plane. ``planar_elastica`` returns the large-deflection
 equilibrium on the fundamental (stable, no interior inflection point) branch:
@@ -73,13 +74,12 @@ are written as products of sines so that small loads keep full relative precisio
 cancellation).
 
 Two routes evaluate this. A batch of loads (``_batch``) runs every step on arrays of shape
-(B..., N). One load (``_lone``, what ``softarm.solve`` meets most) does the tip condition in
-float arithmetic and only the station fields in numpy: a few dozen numpy calls instead of
-several hundred on tiny arrays. It takes ellipj's amplitude without the Newton polish where
-cos χ_0 ≥ 0.1 (sn is then within 4.4e-16 relative and cn within 6e-15 relative, checked against
-mpmath), uses the product form p² − w² = (sin(δ_L/2) cos(δ_L/2) sin χ_s/h)² for the curvature,
-and otherwise falls back on the batch's station solve; the two routes agree to a few units of
-1e-15 of each field's scale (tests/analytic/test_elastica_math.py).
+(B..., N). One load (``lone_rows``, what ``softarm.solve`` meets most) runs the same steps in
+compiled scalar code (``_compiled``, numba, imported on first use): the tip condition
+and every station by the same safeguarded Newton iteration with the same stopping rules, the
+stations from the same starts, with Carlson's R_F, R_D and Jacobi's sn, cn written out there.
+The two routes agree to a few units of 1e-15 of each field's scale
+(tests/analytic/test_elastica_math.py).
 
 References
 ----------
@@ -119,10 +119,6 @@ _N_CHEB = 64
 _N_CHEB_PER_ROOT_K = 4
 #: Newton steps before giving up (bisection alone needs ~60 to resolve ρ ∈ ±700 to an ulp).
 _MAX_STEPS = 100
-#: cos χ_0 from which one load's stations take ellipj's amplitude as it is (``_stations_1``).
-_CN_DIRECT = 0.1
-#: Machine epsilon of float64.
-_EPS = float(np.finfo(np.float64).eps)
 
 
 class ElasticaSolution(NamedTuple):
@@ -568,6 +564,15 @@ def _chebyshev_weights(n, stations):
     return weights
 
 
+@functools.lru_cache(maxsize=16)
+def _chebyshev_rule(n, stations):
+    """The points (n,) and the weights (n, N) of the cumulative rule, read-only (the same
+    stations come back call after call); ``stations`` is ``s.tobytes()``."""
+    points = _chebyshev_points(n)
+    points.setflags(write=False)
+    return points, _chebyshev_weights(n, stations)
+
+
 def _cumulative_chebyshev_direct(values, s):
     """∫_0^s f for f sampled at ``_chebyshev_points(n)`` on the last axis (Clenshaw-Curtis).
 
@@ -589,93 +594,38 @@ def _cumulative_chebyshev_direct(values, s):
 
 
 # --------------------------------------------------------------------------------------------
-# One load: the same algorithm with float arithmetic for the load's unknowns (the tip
-# condition, the half-angles) and numpy only along the stations. A lone case is then a few
-# dozen numpy calls instead of several hundred on 0-d arrays; _batch stays the route for
-# batches (tests/analytic/test_elastica_math.py checks that the two agree).
+# One load: the compiled route (``_compiled``, numba, imported on first use), the same
+# algorithm with scalar loops; _batch stays the route for batches
+# (tests/analytic/test_elastica_math.py checks that the two agree).
 # --------------------------------------------------------------------------------------------
-def _divide(numerator, denominator):
-    """numerator/denominator with IEEE semantics (±inf or NaN for a zero denominator)."""
-    try:
-        return numerator / denominator
-    except ZeroDivisionError:
-        if numerator != numerator or numerator == 0.0:
-            return math.nan
-        return math.copysign(math.inf, numerator) * math.copysign(1.0, denominator)
+def compiled():
+    """The compiled module ``_compiled`` of this package, imported on first use (``import
+    softarm`` does not import numba)."""
+    global _COMPILED
+    if _COMPILED is None:
+        from . import _compiled as module
+
+        _COMPILED = module
+    return _COMPILED
 
 
-def _sin_cos_from_rho_1(rho):
-    """:func:`_sin_cos_from_rho` for a float."""
-    t = math.exp(-abs(rho))
-    big = 1.0 / math.sqrt(1.0 + t * t)
-    small = t * big
-    return (big, small) if rho >= 0.0 else (small, big)
+_COMPILED = None
+#: Placeholders of the quadrature's points and weights where it is not used (the kernel's
+#: argument types stay the same, so numba compiles one version).
+_NO_POINTS = np.zeros(0)
+_NO_POINTS.setflags(write=False)
+_NO_WEIGHTS = np.zeros((0, 0))
+_NO_WEIGHTS.setflags(write=False)
 
 
-def _tip_half_angle_1(ca, sa, c_chi):
-    """:func:`_tip_half_angle` for floats."""
-    h = math.hypot(ca, sa * c_chi)
-    return sa * c_chi / h, ca / h
-
-
-def _newton_1(residual_and_slope, x, lo, hi, curvature=None):
-    """:func:`_newton` for one float unknown: the same steps, safeguard and stopping rules."""
-    tol = 4.0 * _EPS
-    count = 0
-    while count < _MAX_STEPS:
-        count += 1
-        residual, slope = residual_and_slope(x)
-        if residual < 0.0:
-            lo = x
-        else:
-            hi = x
-        step = _divide(residual, slope)
-        newton = x - step
-        size, scale = abs(step), tol * max(1.0, abs(x))
-        last = size <= scale or (curvature is not None and 0.5 * curvature * size * size <= scale)
-        x = newton if last or lo < newton < hi else 0.5 * (lo + hi)
-        if last or hi - lo <= scale:
-            break
-    return x, count
-
-
-def _solve_tip_1(ca, sa, sqrt_k, e):
-    """:func:`_solve_tip` for one load, in floats (the helpers written out)."""
-
-    def residual_and_slope(rho):
-        t = math.exp(-abs(rho))  # _sin_cos_from_rho
-        big = 1.0 / math.sqrt(1.0 + t * t)
-        s_ch, c_ch = (big, t * big) if rho >= 0.0 else (t * big, big)
-        h = math.hypot(ca, sa * c_ch)  # _tip_half_angle
-        s_dl, c_dl = sa * c_ch / h, ca / h
-        m1 = s_dl * s_dl
-        f_l = 1.0 + e * (c_dl - s_dl) * (c_dl + s_dl)  # _modulus
-        mc = m1 * (1.0 - e * m1) / f_l
-        cc = c_ch * c_ch
-        ss = s_ch * s_ch
-        delta2 = cc + mc * ss
-        arc = s_ch * float(elliprf(cc, delta2, 1.0))
-        mm1 = (s_dl * c_dl) * (s_dl * c_dl)
-        dm_f = 2.0 * mm1 * ss / f_l
-        half_j = s_ch * ss * float(elliprd(cc, 1.0, delta2)) / 6.0
-        slope = _divide(s_ch * c_ch, math.sqrt(delta2)) + dm_f * (
-            half_j * (1.0 - 2.0 * e * e * mm1 / f_l) - e * arc
-        )
-        root_f = math.sqrt(f_l)
-        return arc / root_f - sqrt_k, slope / root_f
-
-    start = math.log(math.sinh(sqrt_k * math.sqrt(1.0 - abs(e))))
-    return _newton_1(residual_and_slope, start, -_RHO_MAX, _RHO_MAX)
-
-
-def _lone(k, phi, s, a_r, g_r):
+def lone_rows(k, phi, s, a_r, g_r):
     """:func:`planar_elastica` for one validated load (floats) on the stations s (N,).
 
-    The same solution as :func:`_batch` (to a few ulps), with two product forms that need no
-    inverse trigonometric function: p² − w² = (sin(δ_L/2) cos(δ_L/2) sin χ_s / h)², h² =
-    sin²(δ_L/2) + cos²(δ_L/2) cos²χ_s (from tan(d/2) = tan(δ_L/2)/cos χ_s, so the curvature is
-    θ' = 2 √k sin(δ_L/2) cos(δ_L/2) (sin χ_s/h) √f), and, for χ_0 < 1,
-    cos χ_s − cos χ_0 = (sin χ_0 − sin χ_s)(sin χ_0 + sin χ_s)/(cos χ_s + cos χ_0).
+    Returns the fields θ, x, z, θ', N/EA, Q/GA as the rows of one fresh array (6, N) and the
+    tip angle (a float), or None where the compiled route does not apply (a quadrature whose
+    weights would be too large to keep: the caller then runs :func:`_batch`). The straight
+    and the nearly tension-aligned loads take their closed forms here, every other load the
+    compiled kernel, which agrees with :func:`_batch` to a few ulps.
     """
     n = s.shape[0]
     e = k * (a_r - g_r)
@@ -684,107 +634,34 @@ def _lone(k, phi, s, a_r, g_r):
     sign = -1.0 if wrapped < 0.0 else 1.0
     a = abs(wrapped)
     if k == 0.0 or a == 0.0:  # straight: pure tension N = P (or no load)
-        return ElasticaSolution(np.zeros(n), s * (1.0 + ka), np.zeros(n), np.zeros(n),
-                                np.full(n, ka), np.zeros(n), np.float64(0.0))
+        rows = np.zeros((6, n))
+        rows[1] = s * (1.0 + ka)
+        rows[4] = ka
+        return rows, 0.0
     if a < _A_LINEAR:  # nearly axial tension: the linearised closed form (see _batch)
         theta, x, z, kappa, sin_d = _tension_linear(s, k, a, e, ka, kg)
         tip = _tension_linear(1.0, k, a, e, ka, kg)[0]
-        return ElasticaSolution(sign * theta, x, sign * z, sign * kappa, np.full(n, ka),
-                                sign * kg * sin_d, np.float64(sign * tip))
-
-    sqrt_k = math.sqrt(k)
-    ca, sa = math.cos(0.5 * a), math.sin(0.5 * a)
-    rho_tip, _ = _solve_tip_1(ca, sa, sqrt_k, e)
-    s_chi, c_chi = _sin_cos_from_rho_1(rho_tip)
-    s_dl, c_dl = _tip_half_angle_1(ca, sa, c_chi)
-    half_tip = math.atan2(sa * ca * s_chi * s_chi / (1.0 + c_chi), ca * ca + sa * sa * c_chi)
-    tip = 2.0 * half_tip
-    m, m1 = c_dl * c_dl, s_dl * s_dl
-
-    quadrature = e != 0.0
-    if quadrature:
-        n_cheb = _N_CHEB + _N_CHEB_PER_ROOT_K * math.ceil(sqrt_k)
-        s_all = np.concatenate([s, _chebyshev_points(n_cheb)])
-    else:
-        s_all = s
-    s_chs, c_chs = _stations_1(s_all, sqrt_k, rho_tip, s_dl, c_dl, e, s_chi, c_chi)
-    if quadrature:
-        s_dn, c_dn = _station_half_angle(s_dl, c_dl, c_chs[n:])
-        integrand = (c_dn - s_dn) * (c_dn + s_dn) + ka - e * (2.0 * s_dn * c_dn) ** 2
-        xi = _cumulative_chebyshev(integrand, s)
-        s_chs, c_chs = s_chs[:n], c_chs[:n]
-    at_clamp, at_tip = s == 0.0, s == 1.0
-
-    cd = c_dl * c_chs
-    h = np.hypot(s_dl, cd)
-    s_d, c_d = s_dl / h, cd / h  # sin and cos of δ(s)/2
-    kappa = (2.0 * sqrt_k * s_dl * c_dl) * s_chs / h
-    h0 = math.hypot(s_dl, c_dl * c_chi)
-    kappa0 = 2.0 * sqrt_k * s_dl * c_dl * s_chi / h0
-    if quadrature:  # θ' carries √f(w²), f = 1 − e (sin²(δ_L/2) − cos²(d/2))
-        kappa *= np.sqrt(1.0 - e * (m1 - c_d * c_d))
-        kappa0 *= math.sqrt(1.0 - e * (m1 - ca * ca))
-    if math.atan2(s_chi, c_chi) < 1.0:
-        dcos = (s_chi - s_chs) * (s_chi + s_chs) / (c_chs + c_chi)
-    else:
-        dcos = c_chs - c_chi
-    theta = 2.0 * np.arctan2((sa * ca) * dcos, (ca * ca) * c_chs + sa * sa * c_chi)
-    theta[at_tip] = tip  # the same rounding as tip_angle
-    eta = (kappa - kappa0) / k
-    eta[at_clamp] = 0.0
-
-    cos_a, sin_a = math.cos(a), math.sin(a)
-    if not quadrature:
-        cc = c_chi * c_chi
-        j_tip = s_chi * s_chi * s_chi * float(elliprd(cc, 1.0, cc + m1 * s_chi * s_chi)) / 3.0
-        cos_dl = cos_a * math.cos(tip) + sin_a * math.sin(tip)  # cos(a − θ_L)
-        xi = s * (cos_dl + ka) - (2.0 / sqrt_k * m * m1) * (j_tip - _j_integral(s_chs, c_chs, m1))
-    x = xi * cos_a - eta * sin_a
-    z = xi * sin_a + eta * cos_a
-    axial = ka * ((c_d - s_d) * (c_d + s_d)) if ka else np.zeros(n)
-    shear = (sign * kg) * (2.0 * s_d * c_d) if kg else np.zeros(n)
-    if sign < 0.0:
-        theta, z, kappa = -theta, -z, -kappa
-    return ElasticaSolution(theta, x, z, kappa, axial, shear, np.float64(sign * tip))
+        rows = np.stack([sign * theta, x, sign * z, sign * kappa, np.full(n, ka),
+                         sign * kg * sin_d])
+        return rows, float(sign * tip)
+    points, weights = _NO_POINTS, _NO_WEIGHTS
+    if e != 0.0:
+        n_cheb = _N_CHEB + _N_CHEB_PER_ROOT_K * math.ceil(math.sqrt(k))
+        if n_cheb * n > _CACHED_WEIGHTS:
+            return None
+        points, weights = _chebyshev_rule(n_cheb, s.tobytes())
+    rows = np.empty((6, n))
+    tip = compiled().solve(k, a, sign, a_r, g_r, s, points, weights, rows)
+    return rows, tip
 
 
-def _stations_1(s, sqrt_k, rho_tip, s_dl, c_dl, e, s_chi, c_chi):
-    """(sin χ_s, cos χ_s) of :func:`_solve_stations` for one load (floats), stations s (N,).
-
-    Jacobi's amplitude am(√(k f_L)(1 − s) | m') from scipy's ``ellipj``: sn to 4.4e-16
-    relative and cn to 6e-16 absolute (checked against mpmath for m' up to 1 − 1e-16 and
-    u ≤ 12). Where every station has cos χ_s ≥ cos χ_0 ≥ ``_CN_DIRECT`` that is within 6e-15
-    relative of the root and is returned as it is. Below, one Newton step in ρ = log tan χ
-    (tan χ ← tan χ e^(−δ)) polishes it; when every step has δ² ≤ 4 ε (the bound
-    :func:`_newton` stops at, with |R''/R'| ≤ 2) that is the batch's answer. Otherwise, and for
-    loads whose stations may need the asymptotic start (√(k f_L) > 12), the batch's
-    :func:`_solve_stations` runs.
-    """
-    f_l, mc = _modulus(s_dl, c_dl, e)
-    u0 = sqrt_k * math.sqrt(f_l)
-    if u0 > 12.0:  # 2 e^(−u) ≥ 1.2e-5 below: the asymptotic start is never used there
-        s_ch, c_ch, _ = _solve_stations(s, sqrt_k, rho_tip, s_dl, c_dl, e)
-        return s_ch, c_ch
-    target = u0 * (1.0 - s)
-    sn, cn, _, _ = ellipj(target, 1.0 - mc)
-    h = np.hypot(sn, cn)
-    sn /= h
-    cn /= h
-    at_clamp, at_tip = s == 0.0, s == 1.0
-    if c_chi < _CN_DIRECT:
-        cc = cn * cn
-        delta2 = cc + mc * sn * sn
-        with np.errstate(divide="ignore", invalid="ignore"):  # 0/0 at the tip (s = 1)
-            step = (sn * elliprf(cc, delta2, 1.0) - target) / (sn * cn / np.sqrt(delta2))
-        if not ((step * step <= 4.0 * _EPS) | at_clamp | at_tip).all():
-            s_ch, c_ch, _ = _solve_stations(s, sqrt_k, rho_tip, s_dl, c_dl, e)
-            return s_ch, c_ch
-        q = np.exp(-0.5 * step)
-        sn *= q
-        cn /= q
-        h = np.hypot(sn, cn)
-        sn /= h
-        cn /= h
-    sn[at_clamp], cn[at_clamp] = s_chi, c_chi
-    sn[at_tip], cn[at_tip] = 0.0, 1.0
-    return sn, cn
+def _lone(k, phi, s, a_r, g_r):
+    """:func:`planar_elastica` for one validated load (floats) on the stations s (N,)."""
+    s = np.array(s, dtype=np.float64)  # fresh and contiguous: one compiled version
+    result = lone_rows(k, phi, s, a_r, g_r)
+    if result is None:
+        e = k * (a_r - g_r)
+        return _batch(*(np.array(v) for v in (k, phi)), s, np.array(a_r), np.array(g_r),
+                      np.array(e))
+    rows, tip = result
+    return ElasticaSolution(*rows, np.float64(tip))

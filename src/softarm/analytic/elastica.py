@@ -7,8 +7,16 @@ import math
 import numpy as np
 
 from ..loads import TipLoad
-from ._common import ROUNDOFF, build, check_arm, checked_stations, negligible, vectors
-from ._elastica_math import K_MAX, _lone, planar_elastica
+from ._common import (
+    ROUNDOFF,
+    build,
+    check_arm,
+    checked_stations,
+    negligible,
+    stiffness_diagonal,
+    vectors,
+)
+from ._elastica_math import K_MAX, compiled, lone_rows, planar_elastica
 
 __all__ = ["elastica", "elastica_plane", "solve_elastica"]
 
@@ -142,8 +150,9 @@ def solve_elastica(arm, force: np.ndarray, s: np.ndarray, extensible: bool, load
                    function: str = "elastica"):
     """:func:`elastica` for checked arguments: ``force`` (B..., 3) finite, stations ``s`` (N,)
     from ``_validate.stations``; the result carries ``loads`` as given (exact_closed_form
-    passes the caller's). A lone force (shape (3,)) takes the scalar route of
-    ``_elastica_math`` (a fraction of the time of the batch route for one case).
+    passes the caller's). A lone force (shape (3,)) takes the compiled route of
+    ``_elastica_math`` (``lone_rows`` and ``_compiled.fields``, a fraction of the time
+    of the batch route for one case).
     """
     if any(c != 0.0 for c in arm.curvature):
         raise ValueError(
@@ -173,12 +182,15 @@ def solve_elastica(arm, force: np.ndarray, s: np.ndarray, extensible: bool, load
             f"extensible elastica, got |F| up to {float(np.max(P))!r} N with EA={r.EA!r} N; "
             "pass extensible=False or use softarm.solve"
         )
+    one = None
     if lone and k * (1.0 + abs(k * (axial_ratio - shear_ratio))) <= K_MAX:
-        sol = _lone(k, phi, s / L, axial_ratio, shear_ratio)
+        one = lone_rows(k, phi, s / L, axial_ratio, shear_ratio)
+    if one is not None:  # one load, compiled: (N, 28) fields written by the kernel
+        fields = np.empty((s.shape[0], 28))
+        compiled().fields(b[1], b[2], L, stiffness_diagonal(arm), one[0], fields)
     else:  # a batch, or a load planar_elastica refuses (with its message)
         sol = planar_elastica(k, phi, s / L, axial_ratio=axial_ratio, shear_ratio=shear_ratio)
-    by, bz = (b[1], b[2]) if lone else (b[..., 1], b[..., 2])
-    fields = _fields(sol, by, bz, L, r)
+        fields = _fields(sol, *((b[1], b[2]) if lone else (b[..., 1], b[..., 2])), L, r)
     fields.setflags(write=False)  # fresh: poses, strains and stresses are views of it
     poses = fields[..., :16].reshape(*fields.shape[:-1], 4, 4)
     strains, stresses = fields[..., 16:22], fields[..., 22:]

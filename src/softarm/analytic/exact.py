@@ -14,7 +14,7 @@ from .elastica import solve_elastica
 from .force import axial_force
 from .moment import helix_applies, solve_tip_moment
 
-__all__ = ["exact_closed_form"]
+__all__ = ["closed_form", "exact_closed_form"]
 
 
 class _TipWrench:
@@ -114,9 +114,17 @@ def exact_closed_form(arm, loads, s=None):
         return None
     loads = as_loads(loads)
     s = checked_stations(s, arm.length)
-    if not loads:
+    return closed_form(arm, loads, s, batch_shape(loads)) if loads else None
+
+
+def closed_form(arm, loads: tuple, s: np.ndarray, shape: tuple):
+    """:func:`exact_closed_form` for checked arguments (``softarm.solve`` has checked them):
+    ``arm`` an Arm or SegmentedArm (None for the latter), ``loads`` a tuple of Loads that fit
+    it, of batch shape ``shape``, and ``s`` stations as ``_validate.stations`` returns them,
+    read-only or fresh (never written; the result may keep them)."""
+    if isinstance(arm, SegmentedArm) or not loads:
         return None
-    target = _TipWrench(arm, batch_shape(loads))
+    target = _TipWrench(arm, shape)
     for load in loads:
         load.apply(target)
     if target.other or len(target.used) != 1:  # other loads, or dead and follower mixed

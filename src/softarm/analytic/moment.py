@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import warnings
 
 import numpy as np
@@ -10,17 +11,19 @@ from ..errors import ApproximationWarning
 from ..loads import TipLoad
 from ._common import (
     E1,
+    ROUNDOFF,
     build,
     check_arm,
     check_follower,
     checked_stations,
     moment_is_principal,
-    negligible,
     rotational_stiffness,
     screw_poses,
     stiffness_diagonal,
+    thread_setting,
     vectors,
 )
+from ._elastica_math import compiled
 
 __all__ = ["helix_applies", "solve_tip_moment", "tip_moment"]
 
@@ -31,9 +34,9 @@ def helix_applies(arm) -> bool:
     Then the helix solution (docs/closed-forms.md, C4) is exact for every end moment, dead or
     follower.
     """
-    _, EIy, EIz = rotational_stiffness(arm)
+    r = arm.rigidities
     _, ky, kz = arm.curvature
-    return bool(negligible(EIy - EIz, max(EIy, EIz))) and ky == 0.0 and kz == 0.0
+    return abs(r.EIy - r.EIz) <= ROUNDOFF * max(r.EIy, r.EIz) and ky == 0.0 and kz == 0.0
 
 
 def _helix(arm, moment, follower, s):
@@ -45,6 +48,8 @@ def _helix(arm, moment, follower, s):
     H(s) = exp_SE3(s (e1; M/B)) · exp_SE3(s (0; c e1)). Since exp(s M/B) fixes M,
     m(s) = exp(-s c e1) M = M + (1 - cos cs) (0, -M₂, -M₃) + sin(cs) (0, M₃, -M₂).
     """
+    if moment.ndim == 1:
+        return _helix_one(arm, moment.tolist(), follower, s)
     k = stiffness_diagonal(arm)
     GJ, B = k[3], k[4]
     c = arm.curvature[0] + moment[..., 0] * (1.0 / GJ - 1.0 / B)
@@ -64,10 +69,45 @@ def _helix(arm, moment, follower, s):
     return poses, extra[..., :6], extra[..., 6:]
 
 
+def _helix_one(arm, moment, follower, s):
+    """:func:`_helix` for one moment (three floats), by the compiled screw: the same
+    arithmetic on floats."""
+    r = arm.rigidities
+    GJ, B, Bz = r.GJ, r.EIy, r.EIz  # B = EIy = EIz to roundoff; σ/K divides by each
+    m1, m2, m3 = moment
+    c = arm.curvature[0] + m1 * (1.0 / GJ - 1.0 / B)
+    if follower:
+        cos, sin = math.cos(arm.length * c), math.sin(arm.length * c)
+        m2, m3 = cos * m2 - sin * m3, sin * m2 + cos * m3
+    # rows b = (1, 1 - cos, sin): strains K⁻¹ σ, then stresses σ = (0; m)
+    fields = np.array([(0.0, 0.0, 0.0, m1 / GJ, m2 / B, m3 / Bz, 0.0, 0.0, 0.0, m1, m2, m3),
+                       (0.0, 0.0, 0.0, 0.0, -m2 / B, -m3 / Bz, 0.0, 0.0, 0.0, 0.0, -m2, -m3),
+                       (0.0, 0.0, 0.0, 0.0, m3 / B, -m2 / Bz, 0.0, 0.0, 0.0, 0.0, m3, -m2)])
+    poses, extra = _screw_one(np.array([m1 / B, m2 / B, m3 / B]), c, s, fields)
+    return poses, extra[:, :6], extra[:, 6:]
+
+
+def _screw_one(omega, twist, s, extra):
+    """:func:`screw_poses` (u = e1) for one arm, compiled: poses (N, 4, 4) and the fields
+    (N, C), read-only views of one fresh (N, 16 + C) buffer."""
+    thread_setting()  # a bad $SOFTARM_NUM_THREADS is reported for one load as for a batch
+    out = np.empty((s.shape[0], 16 + extra.shape[1]))
+    s = s if s.flags.writeable else s.copy()  # one argument type: numba compiles one version
+    compiled().screw(E1, omega, twist, s, extra, out)
+    out.setflags(write=False)
+    return out[:, :16].reshape(-1, 4, 4), out[:, 16:]
+
+
 def _constant_strain(arm, moment, s):
     """Eqs. 30-34: ε = K⁻¹ (0; moment), constant, and H(s) = exp_SE3(s (f⁰ + ε))."""
     k = stiffness_diagonal(arm)
     kappa = moment / k[3:]
+    if moment.ndim == 1:  # one load: the compiled screw, the fields as its constant columns
+        fields = np.zeros((3, 12))
+        fields[0, 3:6] = kappa
+        fields[0, 9:] = kappa * k[3:]
+        poses, extra = _screw_one(np.asarray(arm.curvature) + kappa, 0.0, s, fields)
+        return poses, extra[:, :6], extra[:, 6:]
     poses, _ = screw_poses(E1, np.asarray(arm.curvature) + kappa, s)
     strain = np.zeros((*moment.shape[:-1], 1, 6))
     strain[..., 0, 3:] = kappa
