@@ -707,3 +707,13 @@ def test_reciprocity_of_tip_motion_per_tension_and_tendon_length_per_tip_force()
         dl_dF.append((plus - minus) / (2 * h))
     np.testing.assert_allclose(dp_dtau, -np.array(dl_dF), rtol=0,
                                atol=1e-6 * np.abs(dp_dtau).max())
+
+
+def test_a_coupled_stiffness_never_takes_a_diagonal_closed_form():
+    # the elastica closed form reads only the diagonal of K: on a coupled arm, auto must take
+    # the numerical route (and agree with it)
+    K = np.diag([1e3, 5e2, 5e2, 0.01, 0.02, 0.02])
+    K[0, 4] = K[4, 0] = 1.0
+    arm = Arm.from_stiffness_matrix(0.5, K)
+    auto = softarm.solve(arm, TipLoad(force=[0.0, 0.0, 0.1]))
+    assert auto.method == "numeric.shooting"

@@ -8,6 +8,7 @@ __version__ = "0.1.0"  # first, so that submodules may import it
 
 from . import analytic, routing, sweep
 from .case import Case, CaseError, load_case
+from .control import InverseResult, InverseSolver, inverse
 from .dispatch import solve
 from .equilibrium import Equilibrium
 from .errors import ApproximationWarning, ConvergenceError
@@ -36,6 +37,8 @@ __all__ = [
     "DistributedMoment",
     "Equilibrium",
     "Gravity",
+    "InverseResult",
+    "InverseSolver",
     "Load",
     "MagneticField",
     "Material",
@@ -49,6 +52,7 @@ __all__ = [
     "Tube",
     "__version__",
     "analytic",
+    "inverse",
     "load_case",
     "routing",
     "solve",

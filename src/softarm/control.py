@@ -47,8 +47,8 @@ class InverseResult:
         Whether the task error is within tolerance (position within tol·L, orientation
         within tol rad).
     error : float or ndarray (B...)
-        The remaining task error: position error / L, or with an orientation the larger of
-        that and the rotation error in rad.
+        The remaining task error: the distance to the target / L, or with an orientation the
+        larger of that and the rotation angle to the target orientation in rad.
     iterations : int or ndarray (B...)
         Forward solves with Jacobians used (after the first).
     at_bound : ndarray of bool, shape (B..., n)
@@ -214,7 +214,7 @@ class InverseSolver:
         q = np.clip(self.q, self.lower, self.upper)
         eq, A = self._forward(q)
         e, w = self._task(eq, target, orientation)
-        size = np.max(np.abs(e))
+        size = _size(e)
         rank = np.linalg.matrix_rank(w[:, None] * A[:e.size], tol=1e-10 * np.max(
             np.abs(w[:, None] * A[:e.size]), initial=1e-300) * self.n_inputs)
         redundant = self.n_inputs > rank
@@ -241,7 +241,7 @@ class InverseSolver:
                 eq_t = None
             if eq_t is not None:
                 e_t, _ = self._task(eq_t, target, orientation)
-                size_t = np.max(np.abs(e_t))
+                size_t = _size(e_t)
             if eq_t is not None and (size_t <= max(size, self.tol)):
                 small = np.max(np.abs(step) / self.scales) <= 1e-7 * (
                     1.0 + np.max(np.abs(q) / self.scales))
@@ -296,6 +296,11 @@ class InverseSolver:
             np.array([r.at_bound for r in results]), np.array([r.condition for r in results]))
 
 
+def _size(e) -> float:
+    """The task error: |δp|/L, or with an orientation the larger of that and |δθ| (rad)."""
+    return float(max(np.linalg.norm(e[:3]), np.linalg.norm(e[3:]) if e.size > 3 else 0.0))
+
+
 def _input_count(load) -> int:
     return sum(int(np.prod(np.shape(getattr(load, name))[len(load.batch_shape):]) or 1)
                for name in load.inputs)
@@ -318,11 +323,12 @@ def inverse(arm, actuators, target, *, loads=(), bounds=None, orientation=None, 
     >>> from softarm.routing import Straight
     >>> arm = softarm.Arm.from_stiffness(0.2, EA=1e4, GAy=1e4, GAz=1e4, GJ=0.01, EIy=0.01,
     ...                                  EIz=0.01)
-    >>> tendons = [softarm.Tendon(0.0, Straight(0.0, 0.01)),
-    ...            softarm.Tendon(0.0, Straight(0.01, 0.0))]
-    >>> answer = inverse(arm, tendons, [0.19, 0.02, 0.03])
-    >>> bool(answer.reached), answer.inputs.round(3).tolist()
-    (True, [1.46, 0.97])
+    >>> hidden = [softarm.Tendon(1.2, Straight(0.0, 0.01)),
+    ...           softarm.Tendon(0.4, Straight(0.01, 0.0))]
+    >>> target = softarm.solve(arm, hidden).tip_position     # reachable by construction
+    >>> answer = inverse(arm, [t.replace(tension=0.0) for t in hidden], target)
+    >>> bool(answer.reached), answer.inputs.round(6).tolist()
+    (True, [1.2, 0.4])
     """
     solver = InverseSolver(arm, actuators, loads, bounds=bounds, scales=scales, tol=tol,
                            max_iterations=max_iterations)

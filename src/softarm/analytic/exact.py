@@ -7,7 +7,7 @@ import dataclasses
 import numpy as np
 
 from ..loads import as_loads, batch_shape
-from ..model import SegmentedArm
+from ..model import SegmentedArm, StiffnessMatrix
 from ._common import check_arm, checked_stations, moment_is_principal
 from .actuation import actuated
 from .elastica import solve_elastica
@@ -104,14 +104,6 @@ def exact_closed_form(arm, loads, s=None):
     """
     if not isinstance(arm, SegmentedArm):
         arm = check_arm(arm, "exact_closed_form")
-    result = actuated(arm, loads, s)
-    if result is not None:
-        return result
-    if isinstance(arm, SegmentedArm):
-        return None
-    K = arm.stiffness
-    if np.any(K != np.diag(np.diagonal(K))):  # coupled stiffness: no closed form here
-        return None
     loads = as_loads(loads)
     s = checked_stations(s, arm.length)
     return closed_form(arm, loads, s, batch_shape(loads)) if loads else None
@@ -119,11 +111,16 @@ def exact_closed_form(arm, loads, s=None):
 
 def closed_form(arm, loads: tuple, s: np.ndarray, shape: tuple):
     """:func:`exact_closed_form` for checked arguments (``softarm.solve`` has checked them):
-    ``arm`` an Arm or SegmentedArm (None for the latter), ``loads`` a tuple of Loads that fit
-    it, of batch shape ``shape``, and ``s`` stations as ``_validate.stations`` returns them,
-    read-only or fresh (never written; the result may keep them)."""
-    if isinstance(arm, SegmentedArm) or not loads:
+    ``arm`` an Arm or SegmentedArm, ``loads`` a tuple of Loads that fit it, of batch shape
+    ``shape``, and ``s`` stations as ``_validate.stations`` returns them, read-only or fresh
+    (never written; the result may keep them)."""
+    if not loads:
         return None
+    result = actuated(arm, loads, s)
+    if result is not None:
+        return result
+    if isinstance(arm, SegmentedArm) or isinstance(arm.section, StiffnessMatrix):
+        return None  # segments, or a coupled stiffness: no closed form below
     target = _TipWrench(arm, shape)
     for load in loads:
         load.apply(target)

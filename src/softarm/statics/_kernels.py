@@ -1,4 +1,5 @@
-"""Compiled kernels of the shooting solver (numba, the only compiled module of softarm).
+"""Compiled kernels of the shooting solver (numba; the closed forms' one-load kernels are in
+analytic/_compiled.py).
 
 Design notes (layouts, the stage machine, why this file is whole): ``README.md`` beside it.
 
@@ -36,41 +37,18 @@ with respect to x (δn(0), δm(0) = e_d), column 6 the one with respect to λ.
 from __future__ import annotations
 
 import math
-import os
-import warnings
+from functools import partial
 
 import numpy as np
-from numba import njit
+
+from .._jit import jit
 
 __all__ = ["MEMORY", "OPTIONS", "PIECE_LOADS", "TIP_LOADS", "shoot", "solve_cases"]
 
 
-def _jit(function):
-    """``njit(cache=True)``, or without the cache where numba has nowhere to write it.
+#: numba's cached compile (in memory, with a warning, where the cache cannot be written)
+_jit = partial(jit, what="the shooting solver's kernels")
 
-    Numba stores its cache beside the source file or in a user cache directory; with a
-    read-only package and no writable cache directory (a service user, a container) it raises
-    at decoration time. softarm then compiles in memory on first use and says so once.
-    """
-    try:
-        return njit(cache=True)(function)
-    except RuntimeError as error:
-        if "cannot cache" not in str(error):
-            raise
-        global _CACHE_WARNED
-        if not _CACHE_WARNED:
-            _CACHE_WARNED = True
-            warnings.warn(
-                "softarm: numba cannot cache the compiled solver here (read-only package and "
-                "no writable cache directory); it compiles on first use in every process. Set "
-                "NUMBA_CACHE_DIR to a writable directory to cache it"
-                + (f" (now {os.environ['NUMBA_CACHE_DIR']!r})"
-                   if "NUMBA_CACHE_DIR" in os.environ else ""),
-                RuntimeWarning, stacklevel=2)
-        return njit(cache=False)(function)
-
-
-_CACHE_WARNED = False
 
 # Status codes returned per load case.
 OK = 0
