@@ -31,7 +31,7 @@ import softarm
 from softarm.routing import Straight
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from actuation import GRAVITY, L, OFFSETS, loads, robot  # noqa: E402
+from actuation import GRAVITY, OFFSETS, L, loads, robot
 
 
 def _clock():
