@@ -113,3 +113,43 @@ def test_bad_input_is_named():
         inverse(arm, tendons(), [0.2, 0.0, 0.0], bounds=(1.0, 0.5))
     with pytest.raises(ValueError, match="x0 must be 3 finite numbers"):
         inverse(arm, tendons(), [0.2, 0.0, 0.0], x0=[1.0, 2.0])
+
+
+def test_the_inverse_command_reaches_the_example_target(capsys, tmp_path):
+    # examples/tendon_robot.toml's [inverse] target was made by tensions (0.5, 2.5, 0) N: the
+    # command must find tensions whose forward solve puts the tip there
+    import re
+    from pathlib import Path
+
+    from softarm.case import load_case
+    from softarm.cli import main
+
+    example = Path(__file__).resolve().parents[1] / "examples" / "tendon_robot.toml"
+    assert main(["inverse", str(example), "-o", str(tmp_path / "reached.json")]) == 0
+    out = capsys.readouterr().out
+    assert "reached   yes" in out
+    tensions = [float(v) for v in re.findall(r"tension: ([-\d.e+]+) N", out)]
+    case = load_case(example)
+    again = softarm.solve(case.arm, [case.loads[0], *tendons(tensions)], tol=1e-10)
+    assert np.linalg.norm(again.tip_position - case.inverse.target) <= 1e-5 * L
+    assert (tmp_path / "reached.json").exists()
+    # no target anywhere: one line, exit 2
+    demo = Path(__file__).resolve().parents[1] / "examples" / "demo.toml"
+    assert main(["inverse", str(demo)]) == 2
+    assert "no target" in capsys.readouterr().err
+
+
+def test_the_tracking_example_runs(tmp_path, capsys):
+    import runpy
+    import sys
+    from pathlib import Path
+
+    script = Path(__file__).resolve().parents[1] / "examples" / "track_circle.py"
+    argv = sys.argv
+    sys.argv = [str(script), str(tmp_path / "track.png")]
+    try:
+        runpy.run_path(str(script), run_name="__main__")
+    finally:
+        sys.argv = argv
+    assert "60/60 targets reached" in capsys.readouterr().out
+    assert (tmp_path / "track.png").stat().st_size > 10_000

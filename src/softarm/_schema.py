@@ -183,6 +183,12 @@ SOLVE = (Field("method", "text", choices=("auto", "numeric")),
          Field("stations", "integer"),
          Field("tol", "number", "units of the arm length"))
 
+#: ``[inverse]`` (:class:`softarm.case.InverseTask`): the target of ``softarm inverse``.
+INVERSE = (Key("target", "vector", "m", required=True),
+           Field("tol", "number", "units of the arm length"),
+           Field("lower", "numbers"), Field("upper", "numbers"),
+           Field("max_iterations", "integer", minimum=1))
+
 #: ``[sweep]`` (:class:`softarm.sweep.Sweep`), by name: ``load`` counts from 1 in the file,
 #: from 0 in the model; ``field`` is one of the swept load's vectors; either ``values`` or
 #: ``start``, ``stop`` and ``steps``.

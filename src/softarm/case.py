@@ -94,6 +94,41 @@ class SolveOptions:
         object.__setattr__(self, "tol", tol)
 
 
+@dataclass(frozen=True)
+class InverseTask:
+    """The ``[inverse]`` table: where the tip should go (``softarm inverse``).
+
+    Attributes
+    ----------
+    target : tuple of 3 floats
+        The tip position in m, spatial frame.
+    tol : float
+        Position tolerance relative to L.
+    lower, upper : tuple of floats or None
+        Bounds per actuation input (in the order of the loads' inputs; tensions are >= 0
+        anyway).
+    max_iterations : int
+    """
+
+    target: tuple
+    tol: float = 1e-6
+    lower: tuple | None = None
+    upper: tuple | None = None
+    max_iterations: int = 10
+
+    def __post_init__(self):
+        target = np.asarray(self.target, dtype=float)
+        if target.shape != (3,) or not np.all(np.isfinite(target)):
+            raise ValueError(f"InverseTask.target must be 3 finite numbers in m, got "
+                             f"{self.target!r}")
+        object.__setattr__(self, "target", tuple(float(v) for v in target))
+        if not (isinstance(self.tol, float) and self.tol > 0):
+            raise ValueError(f"InverseTask.tol must be > 0, got {self.tol!r}")
+        if self.max_iterations < 1:
+            raise ValueError(f"InverseTask.max_iterations must be >= 1, got "
+                             f"{self.max_iterations!r}")
+
+
 @dataclass(frozen=True, eq=False)
 class Case:
     """An arm, its loads and how to solve them, as read from a case file.
@@ -112,6 +147,8 @@ class Case:
     data : dict
         The validated contents of the file (what result files embed as the case).
     description : str
+    inverse : InverseTask or None
+        The ``[inverse]`` table, if any.
     """
 
     name: str
@@ -122,6 +159,7 @@ class Case:
     source: Path | None = None
     data: dict = field(default_factory=dict, repr=False)
     description: str = ""
+    inverse: InverseTask | None = None
 
     @property
     def batched_loads(self) -> tuple:
@@ -285,11 +323,14 @@ def _parse(data, source, *, name=None, batched=False) -> Case:
         table.build(load.schema, lambda load=load: load.check(arm))  # the model's own rule
     options = _solve_options(top.table("solve")) if top.has("solve") else SolveOptions()
     sweep = _sweep(top.table("sweep"), loads, options.stations) if top.has("sweep") else None
+    inverse = _build(top.table("inverse"), _schema.Schema("", InverseTask, _schema.INVERSE)) \
+        if top.has("inverse") else None
     top.done()
     clean = dict(data)
     clean.setdefault("name", case_name)
     return Case(case_name, arm, loads, options, sweep,
-                Path(source) if source is not None else None, copy.deepcopy(clean), description)
+                Path(source) if source is not None else None, copy.deepcopy(clean), description,
+                inverse)
 
 
 def load_case(path: str | os.PathLike) -> Case:

@@ -160,6 +160,20 @@ def _parser() -> argparse.ArgumentParser:
                      help="do not open a browser tab, only print the address")
     app.set_defaults(run=_run_app)
 
+    inverse = commands.add_parser(
+        "inverse", help="find the actuation inputs that bring the tip to a target",
+        description="Find the tensions, pressures or field components (the case's actuator "
+        "loads) that bring the tip to a target position, under the case's other loads, and "
+        "print them with the equilibrium they produce. The target comes from --target or "
+        "the file's [inverse] table (docs/control.md).")
+    inverse.add_argument("case", metavar="CASE.toml", help="case file")
+    inverse.add_argument("--target", type=float, nargs=3, metavar=("X", "Y", "Z"),
+                         help="tip target in m, spatial frame (default: [inverse] target)")
+    inverse.add_argument("-o", "--output", action="append", default=[], metavar="OUT",
+                         help="write the equilibrium reached (.csv, .json or .npz)")
+    inverse.add_argument("--plot", metavar="PICTURE", help="draw it (.png, .pdf, .svg)")
+    inverse.set_defaults(run=_run_inverse)
+
     demo = commands.add_parser("demo", help="solve and plot a built-in example",
                                description="Solve the built-in two-segment silicone arm under "
                                "gravity and a tip load; write demo.png and demo.csv.")
@@ -302,6 +316,71 @@ def _run_solve(args) -> int:
     print(_summary(case, result, seconds))
     _write(case, result, outputs, picture)
     return 0
+
+
+def _run_inverse(args) -> int:
+    import dataclasses
+
+    from ._schema import loads_to_dict
+    from .control import InverseSolver
+
+    outputs: list[Path] = []
+    for name in args.output:
+        outputs.append(_check_output(name, FORMATS, "output", [args.case], outputs))
+    picture = (_check_output(args.plot, _PICTURE_SUFFIXES, "picture", [args.case], outputs)
+               if args.plot else None)
+    case = load_case(args.case)
+    task = case.inverse
+    if args.target is None and task is None:
+        raise CaseError(f"{args.case}: no target: give --target X Y Z or an [inverse] table "
+                        "with target = [x, y, z]")
+    target = np.array(args.target if args.target is not None else task.target)
+    if not np.all(np.isfinite(target)):
+        raise CaseError(f"--target must be 3 finite numbers in m, got {args.target}")
+    actuators = [load for load in case.loads if load.inputs]
+    if not actuators:
+        raise CaseError(f"{args.case}: no actuator to control: add a tendon, chamber or "
+                        "magnetic load ([[load]] kind = \"tendon\", ...)")
+    others = [load for load in case.loads if not load.inputs]
+    bounds = None
+    if task is not None and (task.lower is not None or task.upper is not None):
+        bounds = (-np.inf if task.lower is None else np.array(task.lower),
+                  np.inf if task.upper is None else np.array(task.upper))
+    try:
+        solver = InverseSolver(case.arm, actuators, others, bounds=bounds,
+                               tol=task.tol if task is not None else 1e-6,
+                               max_iterations=task.max_iterations if task is not None else 10,
+                               s=int(case.solve.stations), solver_tol=float(case.solve.tol))
+    except (ValueError, TypeError) as error:
+        raise CaseError(f"{args.case}: inverse: {error}") from None
+    start = time.perf_counter()
+    answer = solver.solve(target)
+    seconds = time.perf_counter() - start
+    solved = [*others, *solver._actuators_at(answer.inputs)]
+    names = [f"{load.kind} {k + 1} {name}" for k, load in enumerate(actuators)
+             for name in load.inputs for _ in range(_input_size(load, name))]
+    units = [dict((n, u) for n, u, _ in load.arrays)[name] for load in actuators
+             for name in load.inputs for _ in range(_input_size(load, name))]
+    lines = [f"case      {case.name}" + (f"  ({case.source})" if case.source else ""),
+             f"target    {_vector(target)} m",
+             f"reached   {'yes' if answer.reached else 'NO (the closest point found)'}: tip "
+             f"{_vector(answer.equilibrium.tip_position)} m, error "
+             f"{answer.error * solver.length:.3g} m ({answer.error:.2g} L)",
+             "inputs    " + "\n          ".join(
+                 f"{name}: {value:.6g} {unit}" + (" (at its bound)" if bound else "")
+                 for name, value, unit, bound in zip(names, answer.inputs, units,
+                                                     answer.at_bound, strict=True)),
+             f"iterations {answer.iterations}, condition {answer.condition:.3g}, time "
+             f"{seconds:.3g} s"]
+    print("\n".join(lines))
+    solved_case = dataclasses.replace(case, loads=tuple(solved),
+                                      data={**case.data, "load": loads_to_dict(solved)})
+    _write(solved_case, answer.equilibrium, outputs, picture)
+    return 0
+
+
+def _input_size(load, name: str) -> int:
+    return int(np.size(getattr(load, name)))
 
 
 def _write(case: Case, result, outputs, picture) -> None:

@@ -118,11 +118,12 @@ class InverseSolver:
         Position tolerance relative to L (orientation: rad).
     max_iterations : int
         Forward solves with Jacobians per target.
-    s, solver_tol : stations and the forward solver's tolerance (relative to L).
+    s, solver_tol : stations and the forward solver's tolerance (relative to L; default
+        tol / 10).
     """
 
     def __init__(self, arm, actuators, loads=(), *, bounds=None, scales=None, tol=1e-6,
-                 max_iterations=10, s=None, solver_tol=1e-9):
+                 max_iterations=10, s=None, solver_tol=None):
         self.arm = arm
         self.actuators = as_loads(actuators)
         for load in self.actuators:
@@ -167,7 +168,7 @@ class InverseSolver:
         if not np.all(self.scales > 0):
             raise ValueError(f"scales must be > 0, got {self.scales.tolist()}")
         self.q = np.clip(self.q, lower, upper)
-        self.solver = Solver(arm, s=s, tol=solver_tol)
+        self.solver = Solver(arm, s=s, tol=0.1 * self.tol if solver_tol is None else solver_tol)
 
     @property
     def n_inputs(self) -> int:

@@ -478,7 +478,7 @@ class Solver:
         stresses = np.empty((count, S, 6))
         info = np.zeros((count, 5))
         status = np.zeros(count, dtype=np.int64)
-        inputs = _input_channels(loads, pieces, self._data, channels.piece.shape[2]) \
+        inputs = self._input_channels(loads, pieces, channels.piece.shape[2]) \
             if jacobians else (np.zeros((0, *channels.piece.shape[1:])),
                                np.zeros((0, k.TIP_LOADS)))
         n_in = inputs[0].shape[0]
@@ -526,6 +526,18 @@ class Solver:
             compliance=compliance,
             **actuation,
         )
+
+    def _input_channels(self, loads, pieces, width):
+        """:func:`_input_channels`, remembered for the last few load structures (the channels
+        per unit input depend on the cut and on each load's fixed fields, not on the input
+        values: a control loop re-solves with the same structure)."""
+        key = (pieces[0].tobytes(), tuple(_structure(load) for load in loads))
+        cache = self.__dict__.setdefault("_inputs_cache", {})
+        if key not in cache:
+            if len(cache) >= 8:
+                cache.pop(next(iter(cache)))
+            cache[key] = _input_channels(loads, pieces, self._data, width)
+        return cache[key]
 
     def shoot(self, loads, x, load_factor=1.0, *, steps=None) -> ShootResult:
         """One integration from the base reaction ``x`` = (n(0); m(0)) (N, N m, spatial) at
@@ -650,6 +662,14 @@ def _compliances(jac, motion, shape):
         if array is not None:
             array.setflags(write=False)
     return tuple(out)
+
+
+def _structure(load) -> tuple:
+    """What fixes a load's channels per unit input: its kind and its fields that are not
+    batchable (routing, span, area, anchor, ...), from its schema."""
+    batchable = {name for name, _, _ in load.arrays}
+    return (type(load), tuple((key.name, repr(getattr(load, key.name)))
+                              for key in load.schema if key.name not in batchable))
 
 
 def _input_channels(loads, pieces, data, width) -> tuple[np.ndarray, np.ndarray]:
