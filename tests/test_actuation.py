@@ -717,3 +717,13 @@ def test_a_coupled_stiffness_never_takes_a_diagonal_closed_form():
     arm = Arm.from_stiffness_matrix(0.5, K)
     auto = softarm.solve(arm, TipLoad(force=[0.0, 0.0, 0.1]))
     assert auto.method == "numeric.shooting"
+
+
+def test_a_tendon_path_that_doubles_back_is_refused():
+    # y(s) = -s·1 m/m: r' = (0, -1, 0) and w = e1 + r' has |w| = √2 (fine); with κ⁰ about z
+    # = 1/m and r = (0, 1, 0) m: κ⁰ × r = (-1, 0, 0) cancels e1, so w = 0 all along
+    arm = Arm.from_stiffness(0.5, EA=1e3, GAy=1e3, GAz=1e3, GJ=1.0, EIy=1.0, EIz=1.0,
+                             curvature=(0.0, 0.0, 1.0))
+    with pytest.raises(ValueError, match=r"Tendon\.routing: the path's tangent .* vanishes"):
+        softarm.solve(arm, Tendon(1.0, Straight(1.0, 0.0)))
+    numeric(arm, Tendon(1.0, Straight(0.5, 0.0)), s=5)  # |w| = 0.5: fine

@@ -566,6 +566,26 @@ def _check_on_arm(obj, arm, *names) -> None:
                              f"[0, {arm.length!r}] m, got {value!r}")
 
 
+def _check_tangent(obj, arm) -> None:
+    """ValueError if the path's tangent w = e1 + κ⁰ × r + r' vanishes on the unloaded arm
+    (a tendon folded back along itself has no direction to pull in)."""
+    start, end = obj.path_span(arm.length)
+    bounds = arm.boundaries
+    for k, segment in enumerate(arm.segments):
+        lo, hi = max(start, bounds[k]), min(end, bounds[k + 1])
+        if lo >= hi:
+            continue
+        s = np.linspace(lo, hi, 257)
+        f0 = segment.reference_strain
+        w = f0[:3] + np.cross(f0[3:], obj.routing.position(s)) + obj.routing.derivative(s)
+        norm = np.linalg.norm(w, axis=-1)
+        if np.min(norm) < 1e-6:
+            raise ValueError(
+                f"{type(obj).__name__}.routing: the path's tangent w = e1 + κ⁰ × r + r' "
+                f"vanishes near s = {s[np.argmin(norm)]:.4g} m (|w| = {np.min(norm):.2g}): the "
+                "path doubles back along the arm there and a tendon cannot pull along it")
+
+
 @dataclass(frozen=True, eq=False)
 class Tendon(Load):
     """A frictionless tendon pulled with tension τ, anchored at arc length ``end``, running
@@ -615,6 +635,7 @@ class Tendon(Load):
 
     def check(self, arm) -> None:
         _check_on_arm(self, arm, "end")
+        _check_tangent(self, arm)
 
     def cuts(self, arm) -> tuple[float, ...]:
         return () if self.end is None or self.end >= arm.length else (self.end,)
