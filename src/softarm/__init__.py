@@ -13,6 +13,7 @@ from .equilibrium import Equilibrium
 from .errors import ApproximationWarning, ConvergenceError
 from .loads import DistributedForce, DistributedMoment, Gravity, Load, PointLoad, TipLoad
 from .model import Arm, Circle, Material, Rectangle, Rigidities, Section, SegmentedArm, Tube
+from .sweep import open_sweep
 
 __all__ = [
     "ApproximationWarning",
@@ -37,6 +38,7 @@ __all__ = [
     "__version__",
     "analytic",
     "load_case",
+    "open_sweep",
     "solve",
     "sweep",
 ]

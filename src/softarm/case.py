@@ -37,7 +37,7 @@ from .errors import CaseError, CaseTypeError
 from .loads import LOAD_KINDS
 from .model import Arm, SegmentedArm
 from .statics.solver import check_tol
-from .sweep import Sweep, solve_case
+from .sweep import Design, Parameter, Sweep, solve_case
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -107,6 +107,10 @@ class Case:
         The loads as written (a sweep is not applied; see :attr:`batched_loads`).
     solve : SolveOptions
     sweep : Sweep or None
+        A one-parameter ``[sweep]`` (``load``, ``field``, ``component``).
+    design : softarm.sweep.Design or None
+        A ``[sweep]`` with ``design`` and ``[[sweep.parameter]]`` tables, run by
+        ``softarm sweep`` / :func:`softarm.sweep.run`.
     source : pathlib.Path or None
         The file read, None for a case built from a dict.
     data : dict
@@ -122,6 +126,7 @@ class Case:
     source: Path | None = None
     data: dict = field(default_factory=dict, repr=False)
     description: str = ""
+    design: Design | None = None
 
     @property
     def batched_loads(self) -> tuple:
@@ -179,6 +184,39 @@ def _load(table: Table):
 def _solve_options(table: Table) -> SolveOptions:
     _check_size(table, "stations", 1, table.data.get("stations"))  # before the type
     return _build(table, _schema.Schema("", SolveOptions, _schema.SOLVE))
+
+
+def _design(table: Table, data: dict) -> Design:
+    """A ``[sweep]`` with ``design`` and ``[[sweep.parameter]]`` tables: the design, its key
+    paths resolved against the file (errors name the key path)."""
+    from ._sweep_design import DESIGNS, resolve
+
+    keys = _schema.DESIGN
+    kind = table.string("design", DESIGNS, default="grid")
+    samples = table.read(keys["samples"]) if table.has("samples") else None
+    seed = table.read(keys["seed"]) if table.has("seed") else 0
+    rows = table.tables("parameter")
+    if not rows:
+        raise table.missing("parameter", "one or more [[sweep.parameter]] tables")
+    parameters = []
+    for row in rows:
+        values = {k: row.read(keys[k]) for k in ("path", "values", "start", "stop", "steps")
+                  if row.has(k)}
+        row.done()
+        if "path" not in values:
+            raise row.missing("path", "a key path such as 'load[1].force.magnitude'")
+        try:
+            resolve(data, values["path"])
+        except ValueError as error:
+            raise row.error("path", str(error)) from None
+        parameter = row.build(tuple(keys[k] for k in ("values", "start", "stop", "steps")),
+                              lambda values=values: Parameter(**values))
+        parameters.append(parameter)
+    table.done()
+    try:
+        return Design(tuple(parameters), kind, samples, seed)
+    except (ValueError, TypeError) as error:
+        raise table.error(None, str(error)) from None
 
 
 def _sweep(table: Table, loads: tuple, stations: int) -> Sweep:
@@ -272,12 +310,19 @@ def _parse(data, source, *, name=None, batched=False) -> Case:
     for table, load in zip(tables, loads, strict=True):
         table.build(load.schema, lambda load=load: load.check(arm))  # the model's own rule
     options = _solve_options(top.table("solve")) if top.has("solve") else SolveOptions()
-    sweep = _sweep(top.table("sweep"), loads, options.stations) if top.has("sweep") else None
+    sweep = design = None
+    if top.has("sweep"):
+        table = top.table("sweep")
+        if table.has("parameter") or table.has("design"):
+            design = _design(table, data)
+        else:
+            sweep = _sweep(table, loads, options.stations)
     top.done()
     clean = dict(data)
     clean.setdefault("name", case_name)
     return Case(case_name, arm, loads, options, sweep,
-                Path(source) if source is not None else None, copy.deepcopy(clean), description)
+                Path(source) if source is not None else None, copy.deepcopy(clean), description,
+                design)
 
 
 def load_case(path: str | os.PathLike) -> Case:
