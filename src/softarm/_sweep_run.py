@@ -573,9 +573,13 @@ def _prepare_store(spec: Spec, plan: Plan, case, resume: bool, chunks: int) -> l
         except Exception as error:
             raise ValueError(f"{out}: not a sweep store softarm can resume ({error})") from None
         if store.attrs.get("sweep_fingerprint") != spec.key:
-            raise ValueError(f"{out}: holds another sweep (another case, design or options); "
-                             "resume it with the same case and options, or choose another "
-                             "output")
+            mine = _attrs(spec, "")
+            differ = [k for k in ("case_json", "design", "method", "tol", "stations", "fields",
+                                  "dtype", "chunk_size", "semantics")
+                      if str(store.attrs.get(k)) != str(mine[k])]
+            raise ValueError(f"{out}: holds another sweep (its {', '.join(differ) or 'version'}"
+                             " differ); resume with the case and options it was started with, "
+                             "or choose another output")
         done = np.asarray(store["chunk_done"].values)
         return [k for k in range(chunks) if not done[k]]
     if not out.parent.is_dir():
