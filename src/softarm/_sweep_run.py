@@ -26,7 +26,8 @@ import numpy as np
 
 from ._sweep_design import Design, Parameter, Plan
 
-__all__ = ["FIELDS", "ChunkResult", "Spec", "Task", "open_sweep", "run", "solve_chunk"]
+__all__ = ["FIELDS", "ChunkResult", "Spec", "Task", "open_sweep", "process_pool", "run",
+           "solve_chunk"]
 
 #: ``--fields`` choices: the variables each adds to the store.
 FIELDS = {
@@ -376,13 +377,34 @@ def _zarr_array(zarr, group, name, shape, chunks, dtype, fill, attrs) -> None:
 
 
 def _write_chunk(spec: Spec, task: Task, data: dict) -> None:
-    xarray, _ = _need_store_packages()
-    variables = {name: (_dims(name), array) for name, array in data.items()}
-    xarray.Dataset(variables).to_zarr(spec.out, region={"case": slice(task.start, task.stop)},
-                                      mode="r+", consolidated=False)
-    xarray.Dataset({"chunk_done": ("chunk", np.ones(1, np.uint8))}).to_zarr(
-        spec.out, region={"chunk": slice(task.index, task.index + 1)}, mode="r+",
-        consolidated=False)
+    """The chunk's region of every variable, then its done flag (last: a chunk killed while
+    being written has no flag and is solved again on resume).
+
+    The layout and metadata are xarray's (:func:`_create_store`); the chunks are written
+    with zarr directly, through arrays opened once per process: an xarray region write
+    re-reads the group's metadata each time (about 50 ms a chunk, benchmarks/sweep_scaling.py),
+    a zarr write of an aligned chunk is one file per variable."""
+    arrays = _open_arrays(spec)
+    region = slice(task.start, task.stop)
+    for name, array in data.items():
+        if name != "status":
+            arrays[name][region] = array
+    arrays["status"][region] = data["status"]
+    arrays["chunk_done"][task.index:task.index + 1] = np.ones(1, np.uint8)
+
+
+_ARRAYS: dict = {}  # (store, fingerprint) -> {name: zarr array}; one per process
+
+
+def _open_arrays(spec: Spec) -> dict:
+    key = (spec.out, spec.key)
+    if key not in _ARRAYS:
+        _, zarr = _need_store_packages()
+        _ARRAYS.clear()
+        group = zarr.open_group(spec.out, mode="r+")
+        names = [*_allocate(spec, 0), "chunk_done"]
+        _ARRAYS[key] = {name: group[name] for name in names}
+    return _ARRAYS[key]
 
 
 def open_sweep(path):
@@ -522,16 +544,20 @@ def run(case, design: Design | None = None, *, out=None, map: Callable | None = 
     failed = 0
     if map is not None and todo:  # compile (or load) the solver once before forking
         _warm_up(case)
-    tasks = (Task(spec, k, k * chunk, min(size, (k + 1) * chunk),
-                  design.values(k * chunk, min(size, (k + 1) * chunk))) for k in todo)
     results = []
-    for result in (map or builtins_map)(solve_chunk, tasks):
-        done += result.stop - result.start
-        failed += result.failed
-        if out is None:
-            results.append(result)
-        if progress is not None:
-            progress(done, total, failed)
+    for window in range(0, len(todo), _WINDOW):
+        # lists (Dask maps no iterators), a window at a time: the parameter values of 10^8
+        # cases are never all held as tasks
+        tasks = [Task(spec, k, k * chunk, min(size, (k + 1) * chunk),
+                      design.values(k * chunk, min(size, (k + 1) * chunk)))
+                 for k in todo[window:window + _WINDOW]]
+        for result in (map or builtins_map)(solve_chunk, tasks):
+            done += result.stop - result.start
+            failed += result.failed
+            if out is None:
+                results.append(result)
+            if progress is not None:
+                progress(done, total, failed)
     if out is not None:
         return open_sweep(out)
     results.sort(key=lambda r: r.index)
@@ -545,12 +571,46 @@ def run(case, design: Design | None = None, *, out=None, map: Callable | None = 
 
 
 builtins_map = map
+_WINDOW = 512  # tasks handed to the map at a time
 
 
 def _warm_up(case) -> None:
-    from .statics.solver import _kernels
+    """Compile (or load from the cache) the solver in this process: one tiny solve of the
+    case's own arm and loads. Forked workers then inherit the compiled kernels."""
+    from .dispatch import solve
+    from .errors import ConvergenceError
 
-    _kernels()
+    try:
+        solve(case.arm, case.loads, method="numeric", s=2, tol=1e-3)
+    except (ConvergenceError, ValueError, TypeError):  # the sweep reports every case itself
+        pass
+
+
+def _started(_) -> int:
+    return os.getpid()
+
+
+def process_pool(workers: int, case=None):
+    """A :class:`concurrent.futures.ProcessPoolExecutor` of ``workers`` processes for
+    :func:`run` (``map=pool.map``): forked where the platform allows it and this process runs
+    no other thread (a fork copies the compiled solver; forking threads may deadlock),
+    else spawned (each worker then loads the solver from numba's on-disk cache, shared by all).
+
+    With ``case``, the solver is compiled (or loaded) here first, and the workers are started
+    at once, before any store thread exists.
+    """
+    import concurrent.futures
+    import multiprocessing
+    import threading
+
+    if case is not None:
+        _warm_up(case)
+    fork = "fork" in multiprocessing.get_all_start_methods() and \
+        threading.active_count() == 1
+    context = multiprocessing.get_context("fork" if fork else "spawn")
+    pool = concurrent.futures.ProcessPoolExecutor(workers, mp_context=context)
+    list(pool.map(_started, range(workers)))
+    return pool
 
 
 def _case_text(case) -> str:

@@ -216,7 +216,13 @@ def _design(table: Table, data: dict) -> Design:
     try:
         return Design(tuple(parameters), kind, samples, seed)
     except (ValueError, TypeError) as error:
-        raise table.error(None, str(error)) from None
+        text = str(error)
+        for row, parameter in zip(rows, parameters, strict=True):  # a fault of one row
+            prefix = f"parameter {parameter.path!r}: "
+            if text.startswith(prefix):
+                raise row.error(None, f"{parameter.path}: {text.removeprefix(prefix)}"
+                                ) from None
+        raise table.error(None, text) from None
 
 
 def _sweep(table: Table, loads: tuple, stations: int) -> Sweep:

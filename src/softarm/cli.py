@@ -521,14 +521,7 @@ def _run_sweep(args) -> int:
             executor = client.get_executor(pure=False)
             mapper = executor.map
         elif args.workers > 1 and not args.path:
-            import concurrent.futures
-            import multiprocessing
-
-            # fork shares the compiled solver; never fork a process that runs threads
-            method = "fork" if "fork" in multiprocessing.get_all_start_methods() and \
-                threading.active_count() == 1 else None
-            executor = concurrent.futures.ProcessPoolExecutor(
-                args.workers, mp_context=multiprocessing.get_context(method))
+            executor = sweep.process_pool(args.workers, case)  # forked where safe
             mapper = executor.map
         try:
             result = sweep.run(case, out=out, map=mapper, chunk=args.chunk,

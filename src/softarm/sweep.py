@@ -31,7 +31,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ._sweep_design import DESIGNS, Design, Parameter
-from ._sweep_run import FIELDS, design_of, open_sweep, run, solve_chunk
+from ._sweep_run import FIELDS, design_of, open_sweep, process_pool, run, solve_chunk
 from ._validate import check_allocation
 from .equilibrium import Equilibrium
 from .loads import LOAD_KINDS, as_loads
@@ -40,7 +40,7 @@ if TYPE_CHECKING:
     from .case import Case
 
 __all__ = ["DESIGNS", "FIELDS", "Design", "Parameter", "Sweep", "design_of", "open_sweep",
-           "run", "solve_case", "solve_chunk"]
+           "process_pool", "run", "solve_case", "solve_chunk"]
 
 
 #: The values of ``component`` in a ``[sweep]`` table.
