@@ -5,6 +5,7 @@ Needs no extra package (the designs and the case reader are numpy and scipy only
 from __future__ import annotations
 
 import math
+import sys
 
 import numpy as np
 import pytest
@@ -173,3 +174,32 @@ def test_design_to_dict_reads_back():
             "sweep": design.to_dict()}
     assert parse_case(data).design == design
     assert math.prod(design.shape) == 9
+
+
+@pytest.mark.parametrize(("missing", "options", "extra"), [
+    ("xarray", [], "softarm[sweep]"), ("zarr", [], "softarm[sweep]"),
+    ("distributed", ["--scheduler", "local"], "softarm[dask]")])
+def test_cli_names_the_extra_to_install(tmp_path, monkeypatch, capsys, missing, options, extra):
+    from softarm.cli import main
+
+    case = tmp_path / "case.toml"
+    case.write_text("[arm]\nlength = 1.0\nstiffness = { EA = 1.0, GAy = 1.0, GAz = 1.0, "
+                    "GJ = 1.0, EIy = 1.0, EIz = 1.0 }\n[[load]]\nkind = 'tip'\n"
+                    "[sweep]\ndesign = 'grid'\n[[sweep.parameter]]\npath = 'load[1].force.z'\n"
+                    "values = [0.0, 1.0]\n")
+    monkeypatch.setitem(sys.modules, missing, None)  # import fails as if not installed
+    assert main(["sweep", str(case), "-o", str(tmp_path / "out.zarr"), *options]) == 2
+    err = capsys.readouterr().err
+    assert f"pip install '{extra}'" in err and len(err.splitlines()) == 1
+    assert not (tmp_path / "out.zarr").exists()
+
+
+def test_softarm_solve_points_a_design_to_softarm_sweep(tmp_path, capsys):
+    from softarm.cli import main
+
+    case = tmp_path / "case.toml"
+    case.write_text("[arm]\nlength = 1.0\nstiffness = { EA = 1.0, GAy = 1.0, GAz = 1.0, "
+                    "GJ = 1.0, EIy = 1.0, EIz = 1.0 }\n[[load]]\nkind = 'tip'\n"
+                    "[sweep]\n[[sweep.parameter]]\npath = 'arm.length'\nvalues = [1.0, 2.0]\n")
+    assert main(["solve", str(case)]) == 2
+    assert "softarm sweep" in capsys.readouterr().err
