@@ -76,7 +76,7 @@ class Parameter:
     steps: int | None = None
 
     def __post_init__(self):
-        where = f"parameter {self.path!r}"
+        where = str(self.path)
         if not isinstance(self.path, str) or _PATH.fullmatch(self.path) is None:
             raise ValueError(f"Parameter.path must be a key path such as "
                              f"'load[1].force.magnitude', 'arm.length' or "
@@ -111,8 +111,7 @@ class Parameter:
         if self.values is not None:
             return np.asarray(self.values, dtype=np.float64)
         if self.steps is None:
-            raise ValueError(f"parameter {self.path!r}: a grid needs values, or start, stop "
-                             "and steps")
+            raise ValueError(f"{self.path}: a grid needs values, or start, stop and steps")
         return np.linspace(self.start, self.stop, self.steps)
 
 
@@ -157,7 +156,7 @@ class Design:
         paths = [p.path for p in params]
         twice = sorted({p for p in paths if paths.count(p) > 1})
         if twice:
-            raise ValueError(f"parameter {twice[0]!r} is given twice")
+            raise ValueError(f"{twice[0]}: given twice")
         if self.kind not in DESIGNS:
             raise ValueError(f"Design.kind must be one of {DESIGNS}, got {self.kind!r}")
         sampled = self.kind in ("latin-hypercube", "sobol")
@@ -168,7 +167,7 @@ class Design:
                                  f"{self.samples!r}")
             for p in params:
                 if p.values is not None or p.steps is not None:
-                    raise ValueError(f"parameter {p.path!r}: a {self.kind} design samples "
+                    raise ValueError(f"{p.path}: a {self.kind} design samples "
                                      "[start, stop]; give start and stop only")
         elif self.samples is not None:
             raise ValueError(f"samples is for 'latin-hypercube' and 'sobol' designs, not "
@@ -553,4 +552,5 @@ class Plan:
                         error = str(e)
                 if error:
                     bad = float(trial[group.rows[0], j])
-                    raise ValueError(f"sweep: {target.path} = {bad!r}: {error}")
+                    raise ValueError(f"sweep: {target.path} = {bad!r}: "
+                                     f"{error.removeprefix(target.path + ': ')}")

@@ -218,10 +218,8 @@ def _design(table: Table, data: dict) -> Design:
     except (ValueError, TypeError) as error:
         text = str(error)
         for row, parameter in zip(rows, parameters, strict=True):  # a fault of one row
-            prefix = f"parameter {parameter.path!r}: "
-            if text.startswith(prefix):
-                raise row.error(None, f"{parameter.path}: {text.removeprefix(prefix)}"
-                                ) from None
+            if text.startswith(f"{parameter.path}: "):
+                raise row.error(None, text) from None
         raise table.error(None, text) from None
 
 
