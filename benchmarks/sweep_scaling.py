@@ -153,6 +153,32 @@ def main(argv=None) -> int:
         for label, ratio in ratios:
             print(f"RATIO {label}: {ratio:.2f}")
 
+        # the fixed costs that set the chunk size: one chunk's store write, one Dask task
+        from softarm import _sweep_run
+
+        spec = _sweep_run.Spec(case.to_dict(), None, design, "numeric", 101, 1e-8, fields,
+                               "float64", args.chunk, str(scratch / "serial.zarr"))
+        data = _sweep_run._allocate(spec, args.chunk)
+        data["status"][:] = 0
+        chunks = min(20, args.cases // args.chunk)
+        start = clock()
+        for k in range(chunks):
+            task = _sweep_run.Task(spec, k, k * args.chunk, (k + 1) * args.chunk, None)
+            _sweep_run._write_chunk(spec, task, data)
+        wall, _ = since(start)
+        print(f"COST store write of one chunk of {args.chunk} cases (tip, positions): "
+              f"{1e3 * wall / chunks:.1f} ms")
+        if not args.no_dask:
+            with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                              dashboard_address=None) as cluster, Client(cluster) as client:
+                mapper = client.get_executor(pure=False).map
+                list(mapper(abs, range(100)))
+                start = clock()
+                list(mapper(abs, range(2000)))
+                wall, _ = since(start)
+            print(f"COST Dask task round trip (2 workers, 2000 no-op tasks): "
+                  f"{1e3 * wall / 2000:.2f} ms a task")
+
         # store size per case for each --fields choice (actual compressed bytes on disk)
         small = parse_case(case_dict(args.size_cases))
         print(f"\nstore size per case ({args.size_cases} cases, 101 stations, Blosc-lz4 as "

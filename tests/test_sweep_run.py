@@ -351,3 +351,38 @@ def test_cli_sweep(tmp_path):
     assert main(["sweep", str(case_file), "-o", str(out), "--resume", "--dtype",
                  "float32"]) == 2
     assert main(["sweep", str(case_file), "-o", str(out), "--stations", "3", "--resume"]) == 0
+
+
+def test_segment_parameters_group_cases_onto_their_arm():
+    """A grid over the second segment's Young's modulus and the tip force: each case equals
+    softarm.solve of the SegmentedArm built here by hand (two arms, three forces)."""
+    soft = {"E": 1.0e6, "nu": 0.5, "density": 1100.0}
+    data = {
+        "segment": [{"length": 0.2, "section": {"kind": "circle", "radius": 0.012},
+                     "material": dict(soft)},
+                    {"length": 0.1, "section": {"kind": "tube", "outer_radius": 0.01,
+                                                "inner_radius": 0.004},
+                     "material": dict(soft)}],
+        "load": [{"kind": "gravity"}, {"kind": "tip", "force": [0.0, 0.0, -1.0]}],
+        "solve": {"method": "numeric", "stations": 7},
+        "sweep": {"design": "grid", "parameter": [
+            {"path": "segment[2].material.E", "values": [5e5, 2e6]},
+            {"path": "load[2].force.magnitude", "values": [0.0, 0.05, 0.1]}]}}
+    ds = softarm.sweep.run(parse_case(data), fields=("poses",))
+    assert np.all(ds["status"].values == 0)
+    for k in range(6):
+        E = float(ds["segment[2].material.E"][k])
+        arm = softarm.SegmentedArm([
+            softarm.Arm(0.2, softarm.Circle(0.012), softarm.Material(1e6, poisson_ratio=0.5,
+                                                                     density=1100.0)),
+            softarm.Arm(0.1, softarm.Tube(0.01, 0.004),
+                        softarm.Material(E, poisson_ratio=0.5, density=1100.0))])
+        force = [0.0, 0.0, -float(ds["load[2].force.magnitude"][k])]
+        eq = softarm.solve(arm, [softarm.Gravity(), softarm.TipLoad(force=force)],
+                           method="numeric", s=7)
+        np.testing.assert_allclose(ds["positions"][k].values, eq.positions, rtol=0,
+                                   atol=1e-12)
+        np.testing.assert_allclose(ds["orientations"][k].values,
+                                   softarm.lie.so3.to_quaternion(eq.rotations), rtol=0,
+                                   atol=1e-12)
+    np.testing.assert_allclose(ds["length"].values, 0.3)
