@@ -513,11 +513,22 @@ def run(case, design: Design | None = None, *, out=None, map: Callable | None = 
             raise ValueError(f"fields must be among {', '.join(FIELDS)}, got {f!r}")
     if dtype not in ("float64", "float32"):
         raise ValueError(f"dtype must be 'float64' or 'float32', got {dtype!r}")
+    from ._validate import check_allocation, count
+    from .dispatch import METHODS
+    from .statics.solver import check_tol
+
     size = design.size
-    if chunk is None:
-        chunk = max(1, min(1000, math.ceil(size / 16)))
-    if isinstance(chunk, bool) or not isinstance(chunk, int) or chunk < 1:
-        raise ValueError(f"chunk must be an integer >= 1, got {chunk!r}")
+    chunk = max(1, min(1000, math.ceil(size / 16))) if chunk is None else \
+        count(chunk, "chunk", 1)
+    stations = count(options.stations if stations is None else stations, "stations", 2)
+    tol = check_tol(options.tol if tol is None else tol)
+    method = options.method if method is None else method
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+    if out is None:  # everything in memory: refuse what cannot fit, before solving
+        check_allocation(size, stations, "the sweep (give out= to write a store)")
+    else:
+        check_allocation(chunk, stations, "one chunk (give a smaller chunk)")
     plan = Plan(case, design)  # resolves every key path
     if path:
         if len(design.parameters) != 1 or not plan.targets[0].batched:
@@ -529,9 +540,7 @@ def run(case, design: Design | None = None, *, out=None, map: Callable | None = 
         chunk = size
     plan.check()  # every parameter value buildable, before any solve
     spec = Spec(case.to_dict(), str(case.source) if case.source else None, design,
-                method or options.method,
-                int(stations if stations is not None else options.stations),
-                float(tol if tol is not None else options.tol), fields, dtype, chunk,
+                method, stations, tol, fields, dtype, chunk,
                 None if out is None else os.fspath(out), bool(path),
                 bool(map is not None if single_thread is None else single_thread))
     chunks = math.ceil(size / chunk)
@@ -539,8 +548,7 @@ def run(case, design: Design | None = None, *, out=None, map: Callable | None = 
     if out is not None:
         todo = _prepare_store(spec, plan, case, resume, chunks)
     total = size
-    done = sum(min(size, (k + 1) * chunk) - k * chunk for k in range(chunks)) - \
-        sum(min(size, (k + 1) * chunk) - k * chunk for k in todo)
+    done = size - sum(min(size, (k + 1) * chunk) - k * chunk for k in todo)  # by a past run
     failed = 0
     if map is not None and todo:  # compile (or load) the solver once before forking
         _warm_up(case)
