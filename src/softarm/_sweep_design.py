@@ -183,6 +183,13 @@ class Design:
             for p in params:
                 p.grid_values()  # a range without steps is an error here
 
+    def __getstate__(self):  # tasks carry the design: never its cached samples
+        return {k: v for k, v in self.__dict__.items() if k != "_cache"}
+
+    def __setstate__(self, state):
+        for k, v in {**state, "_cache": {}}.items():
+            object.__setattr__(self, k, v)
+
     @property
     def paths(self) -> tuple[str, ...]:
         return tuple(p.path for p in self.parameters)

@@ -13,6 +13,7 @@ aligned with the store's chunks along ``case``, so no two writers touch the same
 from __future__ import annotations
 
 import dataclasses
+import functools
 import hashlib
 import json
 import math
@@ -97,9 +98,10 @@ class Spec:
     chained: bool = False
     single_thread: bool = False
 
-    @property
+    @functools.cached_property
     def key(self) -> str:
-        """Fingerprint of what the store holds (the case, design and options)."""
+        """Fingerprint of what the store holds (the case, design and options; computed once,
+        and carried to the workers with the spec)."""
         text = json.dumps({"case": self.case_data, "design": self.design.to_dict(),
                            "method": self.method, "stations": self.stations, "tol": self.tol,
                            "fields": list(self.fields), "dtype": self.dtype,
