@@ -203,3 +203,37 @@ def test_softarm_solve_points_a_design_to_softarm_sweep(tmp_path, capsys):
                     "[sweep]\n[[sweep.parameter]]\npath = 'arm.length'\nvalues = [1.0, 2.0]\n")
     assert main(["solve", str(case)]) == 2
     assert "softarm sweep" in capsys.readouterr().err
+
+
+def test_progress_counts_cases_with_rate_and_eta():
+    """The sweep's progress line: cases (not chunks), the rate since the first report and
+    the time left at that rate (reference: the counts and times given here)."""
+    import io
+
+    from softarm import cli
+
+    stream = io.StringIO()
+    progress = cli._CaseProgress(stream, width=10, delay=0.0)
+    progress.start -= 5.0
+    progress(1000, 10000, 0)  # the first report starts the rate clock
+    progress.first = (progress.first[0] - 2.0, 1000)  # 2 s ago
+    progress.last = 0.0
+    progress(5000, 10000, 3)  # 4000 cases in 2 s: 2000 cases/s, 5000 left: 2.5 s
+    line = stream.getvalue().split("\r")[-1]
+    assert line.startswith("sweep [#####.....] 5000/10000 cases, ")
+    rate = float(line.split(", ")[1].split()[0])
+    assert 1900 < rate <= 2000  # a little time passes between the two calls
+    assert "ETA 0:02" in line or "ETA 0:03" in line
+    assert line.endswith("3 failed")
+
+
+def test_a_pickled_design_leaves_its_samples_behind():
+    """Tasks carry the design to every worker: its cached samples (n × d floats) stay home,
+    and the unpickled design draws the same points again."""
+    import pickle
+
+    design = Design((Parameter("arm.length", start=1.0, stop=2.0),), "sobol", samples=4096)
+    values = design.values()
+    small = len(pickle.dumps(Design(design.parameters, "sobol", samples=4096)))
+    assert len(pickle.dumps(design)) == small < 1000
+    np.testing.assert_array_equal(pickle.loads(pickle.dumps(design)).values(), values)
