@@ -501,11 +501,16 @@ class Plan:
                 continue
             arm, loads = base
             try:
-                loads = self._batched_loads(loads, values[rows])
-            except (ValueError, TypeError) as error:
-                out.append(Group(rows, error=str(error)))
-                continue
-            out.append(Group(rows, arm, loads, base_loads=base[1]))
+                out.append(Group(rows, arm, self._batched_loads(loads, values[rows]),
+                                 base_loads=loads))
+            except (ValueError, TypeError):  # find the cases at fault, one by one
+                for row in rows:
+                    try:
+                        batched = self._batched_loads(loads, values[row:row + 1])
+                    except (ValueError, TypeError) as error:
+                        out.append(Group(np.array([row]), error=str(error)))
+                    else:
+                        out.append(Group(np.array([row]), arm, batched, base_loads=loads))
         return out
 
     def rebatch(self, group: Group, values: np.ndarray) -> tuple:

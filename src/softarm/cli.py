@@ -284,12 +284,12 @@ def _fail(code: int, message: str) -> int:
     return code
 
 
-def interrupted() -> int:
+def interrupted(what: str = "interrupted") -> int:
     """Ctrl-C: say so in one line and return 130; a second Ctrl-C is ignored from here on."""
     with contextlib.suppress(ValueError, OSError):  # ValueError: not the main thread
         signal.signal(signal.SIGINT, signal.SIG_IGN)
     with contextlib.suppress(OSError, ValueError):
-        print("softarm: interrupted", file=sys.stderr, flush=True)
+        print(f"softarm: {what}", file=sys.stderr, flush=True)
     return 130
 
 
@@ -472,6 +472,7 @@ class _CaseProgress:
         if self.shown:
             self.stream.write("\n")
             self.stream.flush()
+            self.shown = False
 
 
 def _duration(seconds: float) -> str:
@@ -506,8 +507,9 @@ def _run_sweep(args) -> int:
         except ImportError:
             raise CaseError("--scheduler needs Dask's distributed: pip install "
                             "'softarm[dask]'") from None
-        if args.path:
-            raise CaseError("--path is serial; give no --scheduler")
+    if args.path and (args.scheduler is not None or args.workers > 1):
+        raise CaseError("--path follows the cases one after the other, in this process; give "
+                        "no --workers or --scheduler")
     progress = _CaseProgress()
     start = time.perf_counter()
     try:
@@ -534,9 +536,8 @@ def _run_sweep(args) -> int:
                             f"{case.source or case.name}: {text}") from None
     except KeyboardInterrupt:
         progress.close()
-        print(f"softarm: interrupted; finish it with softarm sweep {args.case} -o {out} "
-              "--resume", file=sys.stderr, flush=True)
-        raise
+        return interrupted(f"interrupted; finish it with softarm sweep {args.case} -o {out} "
+                           "--resume")
     finally:
         progress.close()
         if executor is not None and client is None:
