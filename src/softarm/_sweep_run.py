@@ -543,7 +543,7 @@ def run(case, design: Design | None = None, *, out=None, map: Callable | None = 
     plan.check()  # every parameter value buildable, before any solve
     spec = Spec(case.to_dict(), str(case.source) if case.source else None, design,
                 method, stations, tol, fields, dtype, chunk,
-                None if out is None else os.fspath(out), bool(path),
+                None if out is None else os.path.abspath(out), bool(path),  # any worker's cwd
                 bool(map is not None if single_thread is None else single_thread))
     chunks = math.ceil(size / chunk)
     todo = list(range(chunks))
