@@ -727,3 +727,51 @@ def test_a_tendon_path_that_doubles_back_is_refused():
     with pytest.raises(ValueError, match=r"Tendon\.routing: the path's tangent .* vanishes"):
         softarm.solve(arm, Tendon(1.0, Straight(1.0, 0.0)))
     numeric(arm, Tendon(1.0, Straight(0.5, 0.0)), s=5)  # |w| = 0.5: fine
+
+
+def test_a_design_sweep_over_tension_and_pressure_equals_direct_solves():
+    pytest.importorskip("xarray", reason="softarm.sweep.run needs pip install 'softarm[sweep]'")
+    import tomllib
+
+    from softarm import CaseError
+    from softarm.case import parse_case
+
+    text = CASE.split("[[load]]")[0] + """
+[[load]]
+kind = "tendon"
+tension = 1.0
+routing = { kind = "straight", y = 0.0, z = 0.008 }
+
+[[load]]
+kind = "chamber"
+pressure = 0.0
+area = 1e-5
+routing = { kind = "straight", y = 0.008, z = 0.0 }
+
+[sweep]
+design = "grid"
+[[sweep.parameter]]
+path = "load[1].tension"
+values = [0.0, 0.5]
+[[sweep.parameter]]
+path = "load[2].pressure"
+start = 0.0
+stop = 2e4
+steps = 3
+"""
+    case = parse_case(tomllib.loads(text))
+    ds = softarm.sweep.run(case, fields=("tip", "positions"), stations=11, tol=1e-9)
+    assert ds.sizes["case"] == 6 and np.all(ds["status"].values == 0)
+    for k in range(6):
+        tension = float(ds["load[1].tension"][k])
+        pressure = float(ds["load[2].pressure"][k])
+        eq = numeric(case.arm, [case.loads[0].replace(tension=tension),
+                                case.loads[1].replace(pressure=pressure)], s=11, tol=1e-9)
+        # the sweep takes method "auto" (the closed form where it applies): both within tol
+        np.testing.assert_allclose(ds["positions"][k].values, eq.positions, rtol=0,
+                                   atol=1e-9 * case.arm.length)
+    # the one-parameter [sweep] form sweeps vectors only; it says what to write instead
+    old = text.split("[sweep]")[0] + "[sweep]\nload = 1\nvalues = [0.0, 1.0]\n"
+    with pytest.raises(CaseError, match=r"sweep\.load: load 1 \(tendon\) has no vector.*"
+                                        r"load\[1\]\.tension"):
+        parse_case(tomllib.loads(old))

@@ -13,7 +13,7 @@ import pytest
 from softarm.case import load_case, solve_case
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
-CASES = sorted(p.stem for p in EXAMPLES.glob("*.toml"))
+CASES = sorted(p.stem for p in EXAMPLES.glob("*.toml") if p.stem != "design_sweep")
 
 
 def solve(name: str):
@@ -25,6 +25,7 @@ def test_the_examples_are_there():
     assert {"demo", "fig2_pure_bending", "fig2_sweep", "fig3_shear_load",
             "mattiasson_cantilever", "precurved", "tendon_robot", "pneumatic_actuator",
             "magnetic_catheter"} <= set(CASES)
+    assert (EXAMPLES / "design_sweep.toml").is_file()  # run by test_design_sweep_example
 
 
 @pytest.mark.parametrize("name", ["tendon_robot", "pneumatic_actuator"])
@@ -56,6 +57,28 @@ def test_magnetic_catheter_tip_is_turned_by_the_dipole_couple():
     np.testing.assert_allclose(result.poses, again.poses, rtol=0, atol=1e-7 * case.arm.length)
     # the field turns the magnet towards it: the tip axis gains a +y component
     assert result.tip[1, 0] > 0.5
+
+
+def test_design_sweep_example():
+    """The design example (run by softarm sweep) solves every case, and each equals
+    softarm.solve of that case built by hand."""
+    pytest.importorskip("xarray", reason="softarm.sweep.run needs pip install "
+                        "'softarm[sweep]'")
+    import softarm
+
+    case = load_case(EXAMPLES / "design_sweep.toml")
+    ds = softarm.sweep.run(case, fields=("tip", "positions"))
+    assert ds.sizes["case"] == 60 and np.all(ds["status"].values == 0)
+    for k in (0, 27, 59):
+        radius = float(ds["segment[1].section.radius"][k])
+        silicone = softarm.Material(2.0e6, poisson_ratio=0.49, density=1070.0)
+        arm = softarm.SegmentedArm([softarm.Arm(0.25, softarm.Circle(radius), silicone),
+                                    softarm.Arm(0.15, softarm.Tube(0.011, 0.005), silicone)])
+        force = [0.0, float(ds["load[2].force.y"][k]), float(ds["load[2].force.z"][k])]
+        eq = softarm.solve(arm, [softarm.Gravity(), softarm.TipLoad(force=force)],
+                           method="numeric", s=21)
+        np.testing.assert_allclose(ds["positions"][k].values, eq.positions, rtol=0,
+                                   atol=1e-12)
 
 
 @pytest.mark.parametrize("name", CASES)

@@ -24,6 +24,7 @@ from .loads import (
     TipLoad,
 )
 from .model import Arm, Circle, Material, Rectangle, Rigidities, Section, SegmentedArm, Tube
+from .sweep import open_sweep
 
 __all__ = [
     "ApproximationWarning",
@@ -54,6 +55,7 @@ __all__ = [
     "analytic",
     "inverse",
     "load_case",
+    "open_sweep",
     "routing",
     "solve",
     "sweep",

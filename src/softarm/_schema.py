@@ -49,6 +49,7 @@ from .sweep import COMPONENTS, Sweep
 
 __all__ = [
     "ARM",
+    "DESIGN",
     "MATERIAL",
     "ROUTING",
     "SECTIONS",
@@ -196,6 +197,13 @@ SWEEP = {key.name: key for key in (
     Field("load", "integer", minimum=1), Field("field", "text"),
     Field("component", "text", choices=COMPONENTS), Field("name", "text"),
     Field("values", "numbers"), Field("start", "number", finite=True),
+    Field("stop", "number", finite=True), Field("steps", "integer", minimum=2))}
+
+#: ``[sweep]`` with a ``design`` (:class:`softarm.sweep.Design`) and its
+#: ``[[sweep.parameter]]`` tables (:class:`softarm.sweep.Parameter`), by name.
+DESIGN = {key.name: key for key in (
+    Field("samples", "integer", minimum=1), Field("seed", "integer", minimum=0),
+    Field("path", "text"), Field("values", "numbers"), Field("start", "number", finite=True),
     Field("stop", "number", finite=True), Field("steps", "integer", minimum=2))}
 
 

@@ -37,7 +37,7 @@ from .errors import CaseError, CaseTypeError
 from .loads import LOAD_KINDS
 from .model import Arm, SegmentedArm, StiffnessMatrix
 from .statics.solver import check_tol
-from .sweep import Sweep, solve_case
+from .sweep import Design, Parameter, Sweep, solve_case
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -142,6 +142,10 @@ class Case:
         The loads as written (a sweep is not applied; see :attr:`batched_loads`).
     solve : SolveOptions
     sweep : Sweep or None
+        A one-parameter ``[sweep]`` (``load``, ``field``, ``component``).
+    design : softarm.sweep.Design or None
+        A ``[sweep]`` with ``design`` and ``[[sweep.parameter]]`` tables, run by
+        ``softarm sweep`` / :func:`softarm.sweep.run`.
     source : pathlib.Path or None
         The file read, None for a case built from a dict.
     data : dict
@@ -159,6 +163,7 @@ class Case:
     source: Path | None = None
     data: dict = field(default_factory=dict, repr=False)
     description: str = ""
+    design: Design | None = None
     inverse: InverseTask | None = None
 
     @property
@@ -231,6 +236,43 @@ def _solve_options(table: Table) -> SolveOptions:
     return _build(table, _schema.Schema("", SolveOptions, _schema.SOLVE))
 
 
+def _design(table: Table, data: dict) -> Design:
+    """A ``[sweep]`` with ``design`` and ``[[sweep.parameter]]`` tables: the design, its key
+    paths resolved against the file (errors name the key path)."""
+    from ._sweep_design import DESIGNS, resolve
+
+    keys = _schema.DESIGN
+    kind = table.string("design", DESIGNS, default="grid")
+    samples = table.read(keys["samples"]) if table.has("samples") else None
+    seed = table.read(keys["seed"]) if table.has("seed") else 0
+    rows = table.tables("parameter")
+    if not rows:
+        raise table.missing("parameter", "one or more [[sweep.parameter]] tables")
+    parameters = []
+    for row in rows:
+        values = {k: row.read(keys[k]) for k in ("path", "values", "start", "stop", "steps")
+                  if row.has(k)}
+        row.done()
+        if "path" not in values:
+            raise row.missing("path", "a key path such as 'load[1].force.magnitude'")
+        try:
+            resolve(data, values["path"])
+        except ValueError as error:
+            raise row.error("path", str(error)) from None
+        parameter = row.build(tuple(keys[k] for k in ("values", "start", "stop", "steps")),
+                              lambda values=values: Parameter(**values))
+        parameters.append(parameter)
+    table.done()
+    try:
+        return Design(tuple(parameters), kind, samples, seed)
+    except (ValueError, TypeError) as error:
+        text = str(error)
+        for row, parameter in zip(rows, parameters, strict=True):  # a fault of one row
+            if text.startswith(f"{parameter.path}: "):
+                raise row.error(None, text) from None
+        raise table.error(None, text) from None
+
+
 def _sweep(table: Table, loads: tuple, stations: int) -> Sweep:
     keys = _schema.SWEEP
     index = table.read(keys["load"]) if table.has("load") else 1
@@ -239,6 +281,11 @@ def _sweep(table: Table, loads: tuple, stations: int) -> Sweep:
                           f"{index} (counted from 1)")
     kind = loads[index - 1].kind
     fields = dict(loads[index - 1].vectors)
+    if not fields:
+        raise table.error("load", f"load {index} ({kind}) has no vector to sweep this way; "
+                          f"use a design: [[sweep.parameter]] path = \"load[{index}]."
+                          f"{loads[index - 1].arrays[0][0] if loads[index - 1].arrays else 'key'}"
+                          "\" (docs/case-files.md)")
     field_name = table.string("field", tuple(fields), default=next(iter(fields)))
     component = table.read(keys["component"]) if table.has("component") else "magnitude"
     label = table.read(keys["name"]) if table.has("name") else ""
@@ -322,7 +369,13 @@ def _parse(data, source, *, name=None, batched=False) -> Case:
     for table, load in zip(tables, loads, strict=True):
         table.build(load.schema, lambda load=load: load.check(arm))  # the model's own rule
     options = _solve_options(top.table("solve")) if top.has("solve") else SolveOptions()
-    sweep = _sweep(top.table("sweep"), loads, options.stations) if top.has("sweep") else None
+    sweep = design = None
+    if top.has("sweep"):
+        table = top.table("sweep")
+        if table.has("parameter") or table.has("design"):
+            design = _design(table, data)
+        else:
+            sweep = _sweep(table, loads, options.stations)
     inverse = _build(top.table("inverse"), _schema.Schema("", InverseTask, _schema.INVERSE)) \
         if top.has("inverse") else None
     top.done()
@@ -330,7 +383,7 @@ def _parse(data, source, *, name=None, batched=False) -> Case:
     clean.setdefault("name", case_name)
     return Case(case_name, arm, loads, options, sweep,
                 Path(source) if source is not None else None, copy.deepcopy(clean), description,
-                inverse)
+                design, inverse)
 
 
 def load_case(path: str | os.PathLike) -> Case:

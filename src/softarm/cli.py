@@ -7,6 +7,9 @@
     softarm plot RESULT.(csv|json|npz) [-o out.png]
     softarm view RESULT.(csv|json|npz) [-o out.html]
     softarm app CASE.toml [--port PORT] [--no-browser]
+    softarm sweep CASE.toml -o OUT.zarr [--workers N] [--scheduler local|tcp://host:8786]
+                            [--resume] [--fields F,...] [--stations N] [--dtype float32]
+                            [--chunk N] [--path] [--method auto|numeric] [--tol TOL]
     softarm demo [--out DIR]
     softarm reproduce [--out DIR]
 
@@ -107,6 +110,26 @@ def _tolerance(text: str) -> float:
     return value
 
 
+def _positive(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be an integer, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be >= 1, got {value}")
+    return value
+
+
+def _fields(text: str) -> tuple[str, ...]:
+    from .sweep import FIELDS
+
+    names = tuple(name.strip() for name in text.split(",") if name.strip())
+    unknown = [n for n in names if n not in FIELDS]
+    if unknown or not names:
+        raise argparse.ArgumentTypeError(f"must be among {', '.join(FIELDS)}, got {text!r}")
+    return names
+
+
 def _parser() -> argparse.ArgumentParser:
     parser = _Parser(
         prog="softarm",
@@ -174,6 +197,42 @@ def _parser() -> argparse.ArgumentParser:
     inverse.add_argument("--plot", metavar="PICTURE", help="draw it (.png, .pdf, .svg)")
     inverse.set_defaults(run=_run_inverse)
 
+    sweep = commands.add_parser(
+        "sweep", help="solve a [sweep] design into a resumable Zarr store",
+        description="Solve every case of the case file's [sweep] (a design over any "
+        "parameters, or a one-parameter sweep) in chunks, in-process, on N local processes or "
+        "a Dask cluster, into a Zarr store that softarm.open_sweep reads with xarray. Needs "
+        "pip install 'softarm[sweep]' ('softarm[dask]' for --scheduler).")
+    sweep.add_argument("case", metavar="CASE.toml", help="case file with a [sweep] table")
+    sweep.add_argument("-o", "--output", required=True, metavar="OUT.zarr",
+                       help="Zarr store to write (a folder)")
+    sweep.add_argument("--workers", type=_positive, default=1, metavar="N",
+                       help="local worker processes (default 1: in this process); with "
+                       "--scheduler local, the LocalCluster's workers")
+    sweep.add_argument("--scheduler", metavar="ADDRESS",
+                       help="'local' (a Dask LocalCluster of --workers processes) or a Dask "
+                       "scheduler address such as tcp://host:8786")
+    sweep.add_argument("--resume", action="store_true",
+                       help="finish the chunks an interrupted run of the same sweep left")
+    sweep.add_argument("--fields", type=_fields, default=("tip", "positions"),
+                       metavar="F,...", help="outputs to keep, comma-separated, among "
+                       "tip, positions, orientations, poses, strains, stresses (default "
+                       "tip,positions)")
+    sweep.add_argument("--stations", type=_stations, metavar="N",
+                       help="number of output stations (default from the file, else 101)")
+    sweep.add_argument("--dtype", choices=("float64", "float32"), default="float64",
+                       help="of the stored outputs (default float64)")
+    sweep.add_argument("--chunk", type=_positive, metavar="N",
+                       help="cases per chunk (task and store chunk; default up to 1000)")
+    sweep.add_argument("--path", action="store_true",
+                       help="follow a one-parameter load sweep quasi-statically, serially, "
+                       "instead of solving each case from the unloaded arm")
+    sweep.add_argument("--method", choices=("auto", "numeric"),
+                       help="override [solve] method (default from the file, else auto)")
+    sweep.add_argument("--tol", type=_tolerance,
+                       help="tip position tolerance relative to the arm length (default 1e-8)")
+    sweep.set_defaults(run=_run_sweep)
+
     demo = commands.add_parser("demo", help="solve and plot a built-in example",
                                description="Solve the built-in two-segment silicone arm under "
                                "gravity and a tip load; write demo.png and demo.csv.")
@@ -239,12 +298,12 @@ def _fail(code: int, message: str) -> int:
     return code
 
 
-def interrupted() -> int:
+def interrupted(what: str = "interrupted") -> int:
     """Ctrl-C: say so in one line and return 130; a second Ctrl-C is ignored from here on."""
     with contextlib.suppress(ValueError, OSError):  # ValueError: not the main thread
         signal.signal(signal.SIGINT, signal.SIG_IGN)
     with contextlib.suppress(OSError, ValueError):
-        print("softarm: interrupted", file=sys.stderr, flush=True)
+        print(f"softarm: {what}", file=sys.stderr, flush=True)
     return 130
 
 
@@ -451,6 +510,131 @@ def _run_app(args) -> int:
         return app.serve(case, port=args.port, browser=not args.no_browser)
     except ImportError as error:  # plotly missing
         raise CaseError(str(error)) from None
+
+
+class _CaseProgress:
+    """Progress of a sweep on stderr: cases (not chunks), rate and ETA."""
+
+    def __init__(self, stream=None, width: int = 30, delay: float = 1.0):
+        self.stream = sys.stderr if stream is None else stream
+        self.width = width
+        self.delay = delay
+        self.start = time.perf_counter()
+        self.first: tuple[float, int] | None = None
+        self.shown = False
+        self.last = 0.0
+
+    def __call__(self, done: int, total: int, failed: int) -> None:
+        now = time.perf_counter()
+        if self.first is None:  # the rate counts from the first chunk (after resuming)
+            self.first = (now, done)
+        if (now - self.start < self.delay or now - self.last < 0.1) and done < total:
+            return
+        if done == total and not self.shown:
+            return
+        self.last = now
+        elapsed = now - self.first[0]
+        rate = (done - self.first[1]) / elapsed if elapsed > 0 else 0.0
+        eta = (total - done) / rate if rate > 0 else float("nan")
+        filled = round(self.width * done / max(total, 1))
+        bar = "#" * filled + "." * (self.width - filled)
+        text = f"\rsweep [{bar}] {done}/{total} cases"
+        if rate > 0:
+            text += f", {rate:.4g} cases/s, ETA {_duration(eta)}"
+        if failed:
+            text += f", {failed} failed"
+        self.stream.write(text)
+        self.stream.flush()
+        self.shown = True
+
+    def close(self) -> None:
+        if self.shown:
+            self.stream.write("\n")
+            self.stream.flush()
+            self.shown = False
+
+
+def _duration(seconds: float) -> str:
+    if not np.isfinite(seconds):
+        return "?"
+    seconds = round(seconds)
+    hours, rest = divmod(seconds, 3600)
+    return f"{hours}:{rest // 60:02d}:{rest % 60:02d}" if hours else \
+        f"{rest // 60}:{rest % 60:02d}"
+
+
+def _run_sweep(args) -> int:
+    from . import sweep
+
+    try:
+        import xarray  # noqa: F401
+        import zarr  # noqa: F401
+    except ImportError as error:
+        raise CaseError(f"softarm sweep needs xarray and zarr ({error.name} is missing): pip "
+                        "install 'softarm[sweep]'") from None
+    out = Path(args.output)
+    if _same_file(out, Path(args.case)):
+        raise CaseError(f"{out}: is the input file {args.case}; choose another output")
+    case = load_case(args.case)
+    if case.sweep is None and case.design is None:
+        raise CaseError(f"{args.case}: sweep: missing (softarm sweep needs a [sweep] table)")
+    executor = cluster = client = None
+    mapper = None
+    if args.scheduler is not None:
+        try:
+            from distributed import Client, LocalCluster
+        except ImportError:
+            raise CaseError("--scheduler needs Dask's distributed: pip install "
+                            "'softarm[dask]'") from None
+    if args.path and (args.scheduler is not None or args.workers > 1):
+        raise CaseError("--path follows the cases one after the other, in this process; give "
+                        "no --workers or --scheduler")
+    progress = _CaseProgress()
+    start = time.perf_counter()
+    try:
+        if args.scheduler is not None:
+            if args.scheduler == "local":
+                cluster = LocalCluster(n_workers=args.workers, threads_per_worker=1,
+                                       processes=True, dashboard_address=None)
+                client = Client(cluster)
+            else:
+                client = Client(args.scheduler)
+            executor = client.get_executor(pure=False)
+            mapper = executor.map
+        elif args.workers > 1 and not args.path:
+            executor = sweep.process_pool(args.workers, case)  # forked where safe
+            mapper = executor.map
+        try:
+            result = sweep.run(case, out=out, map=mapper, chunk=args.chunk,
+                               fields=args.fields, stations=args.stations, dtype=args.dtype,
+                               method=args.method, tol=args.tol, resume=args.resume,
+                               path=args.path, progress=progress)
+        except (ValueError, TypeError) as error:
+            text = str(error)
+            raise CaseError(text if text.startswith(str(out)) else
+                            f"{case.source or case.name}: {text}") from None
+    except KeyboardInterrupt:
+        progress.close()
+        return interrupted(f"interrupted; finish it with softarm sweep {args.case} -o {out} "
+                           "--resume")
+    finally:
+        progress.close()
+        if executor is not None and client is None:
+            executor.shutdown(cancel_futures=True)
+        if client is not None:
+            client.close()
+        if cluster is not None:
+            cluster.close()
+    status = np.asarray(result["status"].values)
+    solved = int(np.sum(status == 0))
+    failed = int(np.sum(status > 0))
+    print(f"case      {case.name}" + (f"  ({case.source})" if case.source else ""))
+    print(f"sweep     {status.size} cases over {', '.join(sweep.design_of(case).paths)}")
+    print(f"solved    {solved} ok, {failed} failed"
+          + (" (see the status and message variables)" if failed else ""))
+    print(f"time      {time.perf_counter() - start:.3g} s")
+    print(f"wrote     {out}  (softarm.open_sweep({str(out)!r}) reads it with xarray)")
+    return 0
 
 
 def _run_demo(args) -> int:

@@ -1,9 +1,13 @@
-"""Sweeps: one load parameter over a range, solved as batches with progress (public).
+"""Sweeps (public): one load parameter in memory, or designs over any parameters at scale.
 
-A :class:`Sweep` describes the ``[sweep]`` table of a case file; :func:`solve_case` solves a
-:class:`softarm.case.Case`, every step of its sweep if it has one, in batched calls of
-``softarm.solve`` that warm-start one from the next, in chunks that report progress on long
-sweeps.
+- A :class:`Sweep` describes a one-parameter ``[sweep]`` table of a case file;
+  :func:`solve_case` solves a :class:`softarm.case.Case`, every step of its sweep if it has
+  one, in batched calls of ``softarm.solve``, in chunks that report progress on long sweeps.
+- A :class:`Design` varies any number of :class:`Parameter` s, each named by a key path of
+  the case file (``load[2].force.magnitude``, ``segment[1].section.radius``, ...), on a grid,
+  a list, a Latin hypercube or a Sobol sequence; :func:`run` solves it in chunks with any
+  map-like executor (in-process, a process pool, a Dask client), into a resumable Zarr store
+  that :func:`open_sweep` reads as an xarray Dataset (``pip install 'softarm[sweep]'``).
 
 Examples
 --------
@@ -26,6 +30,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ._sweep_design import DESIGNS, Design, Parameter
+from ._sweep_run import FIELDS, design_of, open_sweep, process_pool, run, solve_chunk
 from ._validate import check_allocation
 from .equilibrium import Equilibrium
 from .loads import LOAD_KINDS, as_loads
@@ -33,7 +39,8 @@ from .loads import LOAD_KINDS, as_loads
 if TYPE_CHECKING:
     from .case import Case
 
-__all__ = ["Sweep", "solve_case"]
+__all__ = ["DESIGNS", "FIELDS", "Design", "Parameter", "Sweep", "design_of", "open_sweep",
+           "process_pool", "run", "solve_case", "solve_chunk"]
 
 
 #: The values of ``component`` in a ``[sweep]`` table.
@@ -154,6 +161,10 @@ def solve_case(case: Case, *, method: str | None = None, stations: int | None = 
     Equilibrium
         Batch shape (steps,) for a sweep, () otherwise.
     """
+    if getattr(case, "design", None) is not None:
+        raise ValueError(f"{case.source or case.name}: [sweep] is a design over "
+                         f"{', '.join(case.design.paths)}; run it with softarm sweep CASE.toml "
+                         "-o OUT.zarr (softarm.sweep.run)")
     solve = _solver() if solve is None else solve
     options = case.solve
     kwargs = {"method": method or options.method,
