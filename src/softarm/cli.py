@@ -364,12 +364,18 @@ def _solve(case: Case, args) -> tuple:
     return result, time.perf_counter() - start
 
 
-def _run_solve(args) -> int:
+def _outputs(args) -> tuple[list[Path], Path | None]:
+    """The result files (-o) and picture (--plot) asked for, checked before any solve."""
     outputs: list[Path] = []
     for name in args.output:
         outputs.append(_check_output(name, FORMATS, "output", [args.case], outputs))
     picture = (_check_output(args.plot, _PICTURE_SUFFIXES, "picture", [args.case], outputs)
                if args.plot else None)
+    return outputs, picture
+
+
+def _run_solve(args) -> int:
+    outputs, picture = _outputs(args)
     case = load_case(args.case)
     result, seconds = _solve(case, args)
     print(_summary(case, result, seconds))
@@ -383,11 +389,7 @@ def _run_inverse(args) -> int:
     from ._schema import loads_to_dict
     from .control import InverseSolver
 
-    outputs: list[Path] = []
-    for name in args.output:
-        outputs.append(_check_output(name, FORMATS, "output", [args.case], outputs))
-    picture = (_check_output(args.plot, _PICTURE_SUFFIXES, "picture", [args.case], outputs)
-               if args.plot else None)
+    outputs, picture = _outputs(args)
     case = load_case(args.case)
     task = case.inverse
     if args.target is None and task is None:
