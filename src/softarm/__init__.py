@@ -9,8 +9,8 @@ __version__ = "0.1.0"  # first, so that submodules may import it
 from . import analytic, routing, sweep
 from .case import Case, CaseError, load_case
 from .dispatch import solve
-from .equilibrium import Equilibrium
-from .errors import ApproximationWarning, ConvergenceError
+from .equilibrium import Equilibrium, Stability
+from .errors import ApproximationWarning, ConvergenceError, StabilityWarning
 from .loads import (
     Chamber,
     DistributedForce,
@@ -44,6 +44,8 @@ __all__ = [
     "Rigidities",
     "Section",
     "SegmentedArm",
+    "Stability",
+    "StabilityWarning",
     "Tendon",
     "TipLoad",
     "Tube",

@@ -7,11 +7,13 @@ this module is the only place that knows both.
 from __future__ import annotations
 
 import dataclasses
+import warnings
 
 import numpy as np
 
 from . import analytic
 from .equilibrium import Equilibrium
+from .errors import StabilityWarning
 from .statics import Solver
 
 __all__ = ["METHODS", "solve", "solve_prepared"]
@@ -113,8 +115,29 @@ def solve(arm, loads, *, method="auto", s=None, tol=1e-8, base=None, jacobians=F
         if method == "analytic":
             raise ValueError("jacobians=True needs the numerical route; use method='auto' or "
                              "'numeric'")
-        return solver.solve_from_unloaded(loads, jacobians=True)
+        return warn_unstable(solver.solve_from_unloaded(loads, jacobians=True))
     return solve_prepared(solver, loads, method)
+
+
+def warn_unstable(eq: Equilibrium, stacklevel: int = 3) -> Equilibrium:
+    """``eq``, after a :class:`~softarm.StabilityWarning` if any of its cases is unstable."""
+    verdict = eq.stability
+    if verdict is None:
+        return eq
+    unstable = np.asarray(verdict.unstable)
+    if not np.any(unstable):
+        return eq
+    index = np.asarray(verdict.index)
+    first = np.unravel_index(int(np.flatnonzero(unstable.ravel())[0]), index.shape) \
+        if index.shape else ()
+    where = f" (load case {first}, and {int(unstable.sum()) - 1} more)" if index.shape else ""
+    warnings.warn(
+        f"softarm: the equilibrium returned is unstable{where}: Morse index "
+        f"{int(index[first])}, {int(index[first])} independent direction(s) in which a real "
+        "arm would move away from it. Use solve(..., branch='stable') for a stable "
+        "equilibrium under the same loads, or softarm.critical_load to find where stability "
+        "is lost.", StabilityWarning, stacklevel=stacklevel)
+    return eq
 
 
 #: The solver options that are numbers: real (float) or integer ones.
@@ -136,10 +159,15 @@ def solve_prepared(solver: Solver, loads, method="auto") -> Equilibrium:
         loads, _ = solver.check_loads(loads)
         result = _closed_form(solver.arm, loads, solver.s, solver.base)
         if result is not None:
-            return result
+            if solver.stability:
+                from .statics.stability import closed_form_verdict
+
+                result = dataclasses.replace(
+                    result, stability=closed_form_verdict(solver, loads, result))
+            return warn_unstable(result)
         if method == "analytic":
             raise ValueError(
                 "method='analytic' but no exact closed form applies to this arm and these "
                 "loads; use method='auto' or 'numeric'"
             )
-    return solver.solve_from_unloaded(loads)
+    return warn_unstable(solver.solve_from_unloaded(loads))

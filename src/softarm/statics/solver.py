@@ -320,6 +320,9 @@ class Solver:
         Largest number of RK4 steps tried before giving up on ``tol`` (ConvergenceError).
     max_shootings : int
         Budget of trajectory integrations per load case before a ConvergenceError.
+    stability : bool
+        Compute the stability verdict of every case (``Equilibrium.stability``; a backward
+        sweep of the linearised equations, docs/stability.md). Default True.
 
     Examples
     --------
@@ -332,7 +335,8 @@ class Solver:
     """
 
     def __init__(self, arm, *, s=None, tol=1e-8, base=None, max_iterations=12,
-                 max_load_step=1.0, steps=None, max_steps=_N_MAX, max_shootings=10000):
+                 max_load_step=1.0, steps=None, max_steps=_N_MAX, max_shootings=10000,
+                 stability=True):
         self.arm = _check_arm(arm)
         self._data = _arm_data(arm)
         self.length = self._data.length
@@ -358,6 +362,9 @@ class Solver:
         self.steps = steps
         self.max_steps = count(max_steps, "max_steps", 4)
         self.max_shootings = count(max_shootings, "max_shootings", 1)
+        if not isinstance(stability, (bool, np.bool_)):
+            raise TypeError(f"stability must be True or False, got {stability!r}")
+        self.stability = bool(stability)
         self._coarse_ratio = 4  # the path runs on N / 4 steps (benchmarks/run.py measures it)
         self.reset()
 
@@ -499,6 +506,11 @@ class Solver:
         if jacobians:
             tip_compliance, compliance = _compliances(jac, motion, shape)
         actuation = _actuation(channels, base_wrench, lengths, shape)
+        if self.stability:
+            from .stability import verdict
+
+            actuation["stability"] = verdict(channels, self._base_kernel, base_wrench,
+                                             info[:, 4], shape)
         # fresh arrays, frozen before reshaping: Equilibrium takes them without a copy
         for array in (poses, strains, stresses, info):
             array.setflags(write=False)
