@@ -128,8 +128,8 @@ def warn_unstable(eq: Equilibrium, stacklevel: int = 3) -> Equilibrium:
     if not np.any(unstable):
         return eq
     index = np.asarray(verdict.index)
-    first = np.unravel_index(int(np.flatnonzero(unstable.ravel())[0]), index.shape) \
-        if index.shape else ()
+    first = tuple(int(i) for i in np.unravel_index(
+        int(np.flatnonzero(unstable.ravel())[0]), index.shape)) if index.shape else ()
     where = f" (load case {first}, and {int(unstable.sum()) - 1} more)" if index.shape else ""
     warnings.warn(
         f"softarm: the equilibrium returned is unstable{where}: Morse index "

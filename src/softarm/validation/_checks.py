@@ -30,7 +30,8 @@ STATUSES = ("pass", "fail", "finding", "skipped")
 GATED = ("pass", "fail")
 
 #: The reference tables shipped in ``softarm/validation/data`` (each with its provenance).
-TABLES = ("mattiasson_cantilever.json", "princeton_beam.json", "rod_benchmarks.json")
+TABLES = ("mattiasson_cantilever.json", "princeton_beam.json", "rod_benchmarks.json",
+          "buckling.json")
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,162 @@
+"""Stability verdicts (issue 15): the Morse index of equilibria against classical buckling
+results (softarm/validation/data/buckling.json) and a finite-difference determinant."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+from conftest import reference_table
+
+import softarm
+from softarm import Arm, Gravity, StabilityWarning, TipLoad
+from softarm.routing import Straight
+from softarm.statics import Solver
+
+BUCKLING = reference_table("buckling.json")["facts"]
+# buckling.json, euler_cantilever: (2n-1)² π²/4, n = 1, 2, 3 (Euler 1744)
+EULER = np.array(BUCKLING["euler_cantilever"]["P_cr_L2_over_EI"])
+# buckling.json, greenhill_heavy_column: qL³/EI of modes 1 and 2 (Greenhill 1881)
+GREENHILL = (BUCKLING["greenhill_heavy_column"]["C"],
+             BUCKLING["greenhill_heavy_column"]["second_mode"]["C2"])
+
+
+def model_critical(Q, EA, GA):
+    """The extensible, shearable rod's critical force for the inextensible value Q:
+    P (1 + P (1/GA - 1/EA)) = Q (buckling.json, cosserat_cantilever_extensible_shearable)."""
+    c = 1.0 / GA - 1.0 / EA
+    return Q if c == 0.0 else (-1.0 + np.sqrt(1.0 + 4.0 * c * Q)) / (2.0 * c)
+
+
+def quiet_solve(*args, **kwargs):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", StabilityWarning)
+        return softarm.solve(*args, **kwargs)
+
+
+@pytest.mark.parametrize("EIz", [1.0, 1.7])
+def test_compressed_cantilever_index_counts_the_critical_loads_below(EIz):
+    # A soft arm (shear and extension lower the critical loads by ~1 %): the index of the
+    # straight column is the number of critical loads below P, each plane on its own (a
+    # round section counts every one twice: a double root of det Θ).
+    L, EA, GA, EIy = 1.0, 400.0, 150.0, 1.0
+    arm = Arm.from_stiffness(L, EA=EA, GAy=GA, GAz=GA, GJ=0.8, EIy=EIy, EIz=EIz)
+    # critical loads of each bending plane (EIy: bending about y, the z deflection)
+    crit = np.sort(np.concatenate([model_critical(EULER * EIy, EA, GA),
+                                   model_critical(EULER * EIz, EA, GA)]))
+    distinct = np.unique(crit)
+    points = np.concatenate([[0.5 * distinct[0]], 0.5 * (distinct[:-1] + distinct[1:])])
+    for P in points:
+        k = int(np.sum(crit < P))
+        eq = quiet_solve(arm, TipLoad(force=[-P, 0.0, 0.0]), method="numeric")
+        assert eq.stability.index == k, (P, eq.stability)
+        assert eq.stability.conservative
+        assert eq.stability.stable == (k == 0)
+        np.testing.assert_allclose(eq.tip_position, [L * (1 - P / EA), 0, 0], atol=1e-12)
+
+
+def test_closed_form_route_also_carries_the_verdict():
+    arm = Arm.from_stiffness(1.0, EA=1e9, GAy=1e9, GAz=1e9, GJ=1.0, EIy=1.0, EIz=1.0)
+    with pytest.warns(StabilityWarning, match="Morse index 2"):
+        eq = softarm.solve(arm, TipLoad(force=[-1.5 * EULER[0], 0.0, 0.0]))
+    assert eq.method == "analytic.axial_force"
+    assert (eq.stability.index, eq.stability.stable) == (2, False)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        eq = softarm.solve(arm, TipLoad(force=[-0.9 * EULER[0], 0.0, 0.0]))
+    assert eq.stability.stable
+
+
+def test_batch_verdict_and_warning_name_the_case():
+    arm = Arm.from_stiffness(1.0, EA=1e9, GAy=1e9, GAz=1e9, GJ=1.0, EIy=1.0, EIz=1.0)
+    P = np.array([0.5, 1.5, 0.9, 3.0])[:, None] * EULER[0]
+    with pytest.warns(StabilityWarning, match=r"load case \(1,\), and 1 more"):
+        eq = softarm.solve(arm, TipLoad(force=np.concatenate([-P, 0 * P, 0 * P], 1)),
+                           method="numeric")
+    np.testing.assert_array_equal(eq.stability.index, [0, 2, 0, 2])
+    np.testing.assert_array_equal(eq.stability.stable, [True, False, True, False])
+    assert softarm.solve(arm, TipLoad(force=[-0.5, 0, 0]), stability=False).stability is None
+
+
+@pytest.mark.parametrize("ratio", [0.9, 1.1, 3.0, 0.99 * GREENHILL[1] / GREENHILL[0],
+                                   1.01 * GREENHILL[1] / GREENHILL[0]])
+def test_upright_heavy_column(ratio):
+    # Greenhill (1881): the upright round column is stable below qL³/EI = 7.8373 and has
+    # index 2 (both planes) above it, 4 above the second mode 55.977 (buckling.json). The
+    # sign of det ∂r/∂x is + for index 2 and 4: it alone could not tell.
+    mu = 1.0
+    g = ratio * GREENHILL[0]  # q = μ g with L = EI = 1
+    arm = Arm.from_stiffness(1.0, EA=1e8, GAy=1e8, GAz=1e8, GJ=1.0, EIy=1.0, EIz=1.0,
+                             mass_per_length=mu)
+    eq = quiet_solve(arm, Gravity(acceleration=[-g, 0.0, 0.0]), method="numeric")
+    expected = 2 * int(np.sum(g > np.array(GREENHILL) * (1 + 1e-9)))
+    assert eq.stability.index == expected
+    assert eq.stability.stable == (expected == 0)
+
+
+def test_index_parity_is_the_sign_of_a_finite_difference_determinant():
+    # (-1)^index = sign det ∂r/∂x: the shooting map differentiated by central differences
+    arm = Arm.from_stiffness(1.0, EA=300.0, GAy=100.0, GAz=100.0, GJ=0.8, EIy=1.0, EIz=1.6)
+    solver = Solver(arm)
+    for P in (1.0, 3.0, 4.5, 12.0):
+        load = TipLoad(force=[-P, 0.1 * P, 0.05 * P])
+        eq = quiet_solve(arm, load, method="numeric")
+        x = np.asarray(eq.base_wrench)
+        J = np.empty((6, 6))
+        for d in range(6):
+            e = np.zeros(6)
+            e[d] = 1e-6
+            J[:, d] = (solver.shoot(load, x + e, steps=400).residual
+                       - solver.shoot(load, x - e, steps=400).residual) / 2e-6
+        assert (-1) ** eq.stability.index == np.sign(np.linalg.det(J)), P
+
+
+def test_buckled_branch_is_stable_and_straight_one_is_not():
+    # The elastica past P_cr: a tiny lateral force selects the buckled branch, which is
+    # stable; the straight equilibrium under the same axial force is not.
+    arm = Arm.from_stiffness(1.0, EA=1e8, GAy=1e8, GAz=1e8, GJ=1.0, EIy=1.0, EIz=1.0)
+    P = 2.0 * EULER[0]
+    bent = softarm.solve(arm, TipLoad(force=[-P, 0.05, 0.0]), method="numeric")
+    assert bent.stability.stable and abs(bent.tip_position[1]) > 0.5
+    straight = quiet_solve(arm, TipLoad(force=[-P, 0.0, 0.0]), method="numeric")
+    assert straight.stability.index == 2
+
+
+def test_mattiasson_cantilever_k10_is_stable():
+    # Mattiasson (1981), k = PL²/EI = 10, transverse dead tip force: a stable equilibrium
+    arm = Arm.from_stiffness(1.0, EA=1e9, GAy=1e9, GAz=1e9, GJ=1.0, EIy=1.0, EIz=1.0)
+    eq = softarm.solve(arm, TipLoad(force=[0.0, 0.0, 10.0]), method="numeric")
+    assert eq.stability.stable
+
+
+def test_follower_load_is_nonconservative_never_buckled():
+    # Beck's column (buckling.json): a tangential tip force has no static critical load, it
+    # flutters at 20.05 EI/L². Beyond it the static test finds no conjugate point, and the
+    # verdict says it cannot decide (conservative False), never "buckled".
+    arm = Arm.from_stiffness(1.0, EA=1e8, GAy=1e8, GAz=1e8, GJ=1.0, EIy=1.0, EIz=1.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        eq = softarm.solve(arm, TipLoad(force=[-30.0, 0.0, 0.0], follower=True),
+                           method="numeric")
+    assert (eq.stability.index, eq.stability.conservative, eq.stability.stable) == \
+        (0, False, False)
+
+
+def test_dead_tip_couple_is_reported_nonconservative():
+    arm = Arm.from_stiffness(1.0, EA=1e8, GAy=1e8, GAz=1e8, GJ=1.0, EIy=1.0, EIz=1.0)
+    eq = softarm.solve(arm, TipLoad(moment=[0.0, 1.0, 0.0]), method="numeric")
+    assert not eq.stability.conservative and not eq.stability.stable
+
+
+def test_a_centred_tendon_never_buckles_the_arm():
+    # A frictionless tendon threaded along the centreline compresses the arm but cannot
+    # buckle it, whatever its tension (the classical result for a beam prestressed by a
+    # tendon bonded or ducted along it: the tendon follows the axis); the same force as a
+    # dead tip load buckles it.
+    arm = Arm.from_stiffness(1.0, EA=1e4, GAy=1e4, GAz=1e4, GJ=1.0, EIy=1.0, EIz=1.0)
+    tension = 10.0 * EULER[0]
+    eq = softarm.solve(arm, softarm.Tendon(tension, Straight(0.0, 0.0)), method="numeric")
+    assert eq.stability.conservative and eq.stability.index == 0
+    dead = quiet_solve(arm, TipLoad(force=[-tension, 0.0, 0.0]), method="numeric")
+    assert dead.stability.index == 4
