@@ -23,15 +23,18 @@ from .loads import (
     TipLoad,
 )
 from .model import Arm, Circle, Material, Rectangle, Rigidities, Section, SegmentedArm, Tube
+from .stability import Branch, CriticalPoint, continuation, critical_load
 
 __all__ = [
     "ApproximationWarning",
     "Arm",
+    "Branch",
     "Case",
     "CaseError",
     "Chamber",
     "Circle",
     "ConvergenceError",
+    "CriticalPoint",
     "DistributedForce",
     "DistributedMoment",
     "Equilibrium",
@@ -51,6 +54,8 @@ __all__ = [
     "Tube",
     "__version__",
     "analytic",
+    "continuation",
+    "critical_load",
     "load_case",
     "routing",
     "solve",

@@ -41,7 +41,7 @@ def _closed_form(arm, loads, s, H0) -> Equilibrium | None:
 
 
 def solve(arm, loads, *, method="auto", s=None, tol=1e-8, base=None, jacobians=False,
-          **options) -> Equilibrium:
+          branch=None, imperfection=None, **options) -> Equilibrium:
     """Static equilibrium of a clamped arm under any combination of loads.
 
     The answer is defined: the equilibrium connected to the unloaded arm along the
@@ -77,9 +77,18 @@ def solve(arm, loads, *, method="auto", s=None, tol=1e-8, base=None, jacobians=F
         station compliances ``compliance`` (B..., N, 6, 6): (δp; δθ), spatial, per unit extra
         dead tip wrench (δF; δM), spatial (δR = δθ~ R), from the variational equations and
         the implicit function theorem. Forces the numerical route.
+    branch : None or "stable"
+        None: the equilibrium connected to the unloaded arm, with a
+        :class:`~softarm.StabilityWarning` if it is unstable. "stable": a stable
+        equilibrium instead (single load case, numerical route): the loading path's first
+        critical point is located, the branch switched along the null vector of ∂r/∂x
+        there and followed to the full load (docs/stability.md).
+    imperfection : array_like (3,), optional
+        With ``branch="stable"``: a spatial direction for the tip's displacement that picks
+        one of two mirror branches (default: the mode's own sign).
     **options
         Passed to :class:`softarm.statics.Solver` (``max_iterations``, ``max_load_step``,
-        ``steps``, ``max_steps``, ``max_shootings``); checked on every route.
+        ``steps``, ``max_steps``, ``max_shootings``, ``stability``); checked on every route.
 
     Returns
     -------
@@ -111,6 +120,18 @@ def solve(arm, loads, *, method="auto", s=None, tol=1e-8, base=None, jacobians=F
     solver = Solver(arm, s=s, tol=tol, base=base, **options)
     if not isinstance(jacobians, (bool, np.bool_)):
         raise TypeError(f"jacobians must be True or False, got {jacobians!r}")
+    if branch not in (None, "stable"):
+        raise ValueError(f"branch must be None or 'stable', got {branch!r}")
+    if imperfection is not None and branch != "stable":
+        raise ValueError("imperfection chooses a buckled branch: it needs branch='stable'")
+    if branch == "stable":
+        if jacobians or method == "analytic" or not solver.stability:
+            raise ValueError("branch='stable' needs the numerical route with its stability "
+                             "verdict (method 'auto' or 'numeric', no jacobians, "
+                             "stability=True)")
+        from .stability import solve_stable
+
+        return warn_unstable(solve_stable(solver, loads, imperfection))
     if jacobians:
         if method == "analytic":
             raise ValueError("jacobians=True needs the numerical route; use method='auto' or "

@@ -1803,3 +1803,28 @@ def sweep_point(x, lam, steps, base, arm, case, theta0, states, fields):
     J = np.empty((6, 7))
     return _sweep(x, lam, steps, base, arm, case, scratch, theta0.shape[0], r, J, states,
                   fields, theta0)
+
+
+@_jit
+def record_points(base, arm, loads, xs, steps, s_out, out):
+    """The outputs (stations) of equilibria given by their base reactions: case b has the
+    loads (loads[0][b], loads[1][b]) and the solution xs[b] on ``steps`` RK4 steps per piece
+    (continuation points); ``out`` as in :func:`solve_cases` (poses, strains, stresses,
+    info, status, J, E, x, lengths), without tangents. info[b, 0] is the residual."""
+    piece_loads, tip_loads = loads
+    npieces = arm[1].size
+    width = piece_loads.shape[2]
+    scratch = _scratch(npieces, width - PIECE_LOADS)
+    start = np.zeros((npieces, width))
+    tip_start = np.zeros(TIP_LOADS)
+    r = np.empty(6)
+    J = np.empty((6, 7))
+    none = J.shape[1] - 7  # no tangents (a variable: one compiled version)
+    for b in range(piece_loads.shape[0]):
+        case = (start, piece_loads[b], tip_start, tip_loads[b])
+        _record(xs[b], none, steps, base, arm, case, scratch, s_out, out, b, r, J)
+        residual = 0.0
+        for i in range(6):
+            if not abs(r[i]) <= residual:
+                residual = abs(r[i])
+        out[3][b, 0] = residual

@@ -532,6 +532,26 @@ class Solver:
             **actuation,
         )
 
+    def solve_near(self, loads, x, steps: int) -> Equilibrium:
+        """The equilibrium of the single case ``loads`` continued from the base reaction
+        ``x`` (N, N m, spatial), a solution on ``steps`` RK4 steps over the arm (from
+        continuation), refined to tol like any solve: the branch x is on, not the one
+        connected to the unloaded arm. Leaves this Solver at that equilibrium."""
+        k = _kernels()
+        self.reset()
+        _, shape, _, pieces, channels = self._prepare(loads)
+        if shape != ():
+            raise ValueError(f"Solver.solve_near takes a single load case, got batch shape "
+                             f"{shape}")
+        self._last = (pieces[0], channels.piece[0].copy(), channels.tip_loads[0].copy(),
+                      channels.signature())
+        memory = np.zeros(k.MEMORY)
+        memory[0:6] = memory[6:12] = np.asarray(x, dtype=np.float64)
+        memory[12] = max(1, int(steps) // 2)
+        memory[13] = 1.0
+        self._memory = memory
+        return self.solve(loads)
+
     def shoot(self, loads, x, load_factor=1.0, *, steps=None) -> ShootResult:
         """One integration from the base reaction ``x`` = (n(0); m(0)) (N, N m, spatial) at
         load factor λ (the loads scaled by λ): the shooting primitive that continuation,
