@@ -160,3 +160,114 @@ def test_a_centred_tendon_never_buckles_the_arm():
     assert eq.stability.conservative and eq.stability.index == 0
     dead = quiet_solve(arm, TipLoad(force=[-tension, 0.0, 0.0]), method="numeric")
     assert dead.stability.index == 4
+
+
+# ------------------------------------------------------------------ critical loads, branches
+
+def test_euler_critical_load_of_a_soft_arm_and_its_mode():
+    # buckling.json: P (1 + P (1/GA - 1/EA)) = π²EI/(4L²) for the extensible, shearable rod
+    L, EA, GA = 1.0, 300.0, 100.0
+    arm = Arm.from_stiffness(L, EA=EA, GAy=GA, GAz=GA, GJ=0.8, EIy=1.0, EIz=1.0)
+    point = softarm.critical_load(arm, TipLoad(force=[-1.0, 0.0, 0.0]))
+    assert point.factor == pytest.approx(model_critical(EULER[0], EA, GA), rel=1e-8)
+    assert (point.kind, point.nullity) == ("bifurcation", 2)
+    # the null vector: the base force does not change (a dead load), the base moment does
+    assert np.allclose(point.mode.base_reaction[:, :3], 0.0, atol=1e-9)
+    assert np.all(np.linalg.norm(point.mode.base_reaction[:, 3:], axis=1) > 0.1)
+
+
+def test_euler_mode_shape_is_one_minus_cosine():
+    # buckling.json: w(x) = 1 - cos(π x / 2L) (inextensible: a very stiff EA, GA)
+    arm = Arm.from_stiffness(1.0, EA=1e9, GAy=1e9, GAz=1e9, GJ=1.0, EIy=1.0, EIz=2.0)
+    point = softarm.critical_load(arm, TipLoad(force=[-1.0, 0.0, 0.0]))
+    assert point.factor == pytest.approx(EULER[0], rel=1e-8)
+    assert point.nullity == 1
+    w = point.mode.displacement[0]
+    lateral = w[:, 2]  # bending about y (the soft axis EIy): deflection along z
+    np.testing.assert_allclose(lateral, 1 - np.cos(np.pi * point.mode.s / 2), atol=1e-6)
+    np.testing.assert_allclose(w[:, :2], 0.0, atol=1e-6)
+
+
+def test_greenhill_critical_weight():
+    # buckling.json: qL³/EI = 7.837347438943 (inextensible limit; EA = GA = 1e9 EI/L² shift
+    # it by ~1e-9)
+    arm = Arm.from_stiffness(1.0, EA=1e9, GAy=1e9, GAz=1e9, GJ=1.0, EIy=1.0, EIz=1.0,
+                             mass_per_length=1.0)
+    point = softarm.critical_load(arm, Gravity(acceleration=[-1.0, 0.0, 0.0]))
+    assert point.factor == pytest.approx(GREENHILL[0], rel=1e-6)
+    assert point.nullity == 2
+
+
+def test_heavy_column_with_a_tip_load_only_the_tip_load_varies():
+    # buckling.json, heavy_column_with_tip_load: qL³/EI = 3 held, P_cr L²/EI = 1.55601544419
+    # (the Airy-function solution)
+    fact = BUCKLING["heavy_column_with_tip_load"]["example"]
+    arm = Arm.from_stiffness(1.0, EA=1e9, GAy=1e9, GAz=1e9, GJ=1.0, EIy=1.0, EIz=1.0,
+                             mass_per_length=1.0)
+    weight = Gravity(acceleration=[-fact["q_L3_over_EI"], 0.0, 0.0])
+    tip = TipLoad(force=[-1.0, 0.0, 0.0])
+    point = softarm.critical_load(arm, [weight, tip], vary=tip)
+    assert point.factor == pytest.approx(fact["P_cr_L2_over_EI"], rel=1e-6)
+
+
+def test_prandtl_lateral_torsional_buckling():
+    # buckling.json: P_cr = 4.0126 √(EI_weak GJ)/L² for EI_strong → ∞; EI_strong = 1e6 EI_weak
+    # raises it by about (EI_weak + GJ)/(2 EI_strong) ~ 1e-6 (the note there)
+    C = BUCKLING["prandtl_lateral_torsional_cantilever"]["C"]
+    EIw, GJ = 1.0, 0.5
+    arm = Arm.from_stiffness(1.0, EA=1e10, GAy=1e10, GAz=1e10, GJ=GJ, EIy=EIw, EIz=1e6)
+    point = softarm.critical_load(arm, TipLoad(force=[0.0, 1.0, 0.0]))
+    assert point.factor == pytest.approx(C * np.sqrt(EIw * GJ), rel=1e-4)
+    assert (point.kind, point.nullity) == ("bifurcation", 1)
+
+
+def test_no_static_critical_load_for_a_follower_force():
+    arm = Arm.from_stiffness(1.0, EA=1e8, GAy=1e8, GAz=1e8, GJ=1.0, EIy=1.0, EIz=1.0)
+    with pytest.raises(ValueError, match="flutter"):
+        softarm.critical_load(arm, TipLoad(force=[-1.0, 0.0, 0.0], follower=True))
+
+
+def test_no_critical_load_under_tension():
+    arm = Arm.from_stiffness(1.0, EA=1e4, GAy=1e4, GAz=1e4, GJ=1.0, EIy=1.0, EIz=1.0)
+    assert softarm.critical_load(arm, TipLoad(force=[1.0, 0.0, 0.0]), max_factor=50) is None
+
+
+def test_continuation_finds_euler_modes_1_to_3_and_the_buckled_branch():
+    arm = Arm.from_stiffness(1.0, EA=1e9, GAy=1e9, GAz=1e9, GJ=1.0, EIy=1.0, EIz=1.0)
+    branch = softarm.continuation(arm, TipLoad(force=[-EULER[0], 0.0, 0.0]), lam=(0, 26))
+    factors = [c.factor for c in branch.critical]
+    np.testing.assert_allclose(factors, EULER / EULER[0], rtol=1e-7)
+    assert [c.nullity for c in branch.critical] == [2, 2, 2]
+    np.testing.assert_array_equal(np.unique(branch.index), [0, 2, 4, 6])
+    assert branch.lam[-1] == 26.0
+    # the first mode's branch, followed to λ = 3.105361984277 (buckling.json, α = 150°)
+    row = BUCKLING["elastica_postbuckling_cantilever"]["table"][14]
+    bent = branch.switch(0, lam=row["P_over_Pcr"], imperfection=[0.0, 1.0, 0.0])
+    assert bent.lam[-1] == row["P_over_Pcr"]
+    assert np.all(bent.index[1:] == 0)
+    np.testing.assert_allclose(bent.equilibria.tip_position[-1],
+                               [row["x_over_L"], row["delta_over_L"], 0.0], atol=1e-7)
+
+
+@pytest.mark.parametrize("row", [0, 5, 8, 14, 17])
+def test_stable_branch_matches_the_elastica_table(row):
+    # buckling.json, elastica_postbuckling_cantilever (Timoshenko & Gere §2.7; elliptic
+    # integrals to 13 digits): tip deflection δ/L and x/L at P/P_cr, to 1e-8 L
+    row = BUCKLING["elastica_postbuckling_cantilever"]["table"][row]
+    arm = Arm.from_stiffness(1.0, EA=1e11, GAy=1e11, GAz=1e11, GJ=1.0, EIy=1.0, EIz=1.0)
+    load = TipLoad(force=[-row["P_over_Pcr"] * EULER[0], 0.0, 0.0])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        eq = softarm.solve(arm, load, branch="stable", imperfection=[0.0, 0.0, -1.0])
+    assert eq.stability.stable
+    np.testing.assert_allclose(eq.tip_position, [row["x_over_L"], 0.0, -row["delta_over_L"]],
+                               atol=1e-8)
+
+
+def test_stable_branch_is_the_connected_one_when_that_is_stable():
+    arm = Arm.from_stiffness(1.0, EA=1e9, GAy=1e9, GAz=1e9, GJ=1.0, EIy=1.0, EIz=1.0)
+    load = TipLoad(force=[0.0, 0.0, 10.0])
+    a = softarm.solve(arm, load, branch="stable")
+    b = softarm.solve(arm, load)
+    assert a.stability.stable
+    np.testing.assert_allclose(a.poses, b.poses, atol=1e-8)

@@ -1539,6 +1539,10 @@ def shoot(x, lam, steps, base, arm, case, r, J, tip_state, tip_tangents):
 # A step whose transition Θ_k⁻¹ Θ_k+1 is within this Frobenius distance of the identity
 # has every eigenvalue in the disc |μ - 1| < 0.5: no crossing, no eigenvalue solve.
 _NEAR_IDENTITY = 0.5
+# In the last step (to the clamp), an eigenvalue of the transition within this of zero is a
+# conjugate point at the clamp itself (a critical or neutral equilibrium: the orbit of a round
+# section's buckled shape turning about the axis), not inside (0, L): not counted.
+_AT_CLAMP = 1e-8
 
 
 @_jit
@@ -1617,14 +1621,15 @@ def _det_small(A, n, work):
 
 
 @_jit
-def _crossings(old, new, n, work, M):
+def _crossings(old, new, n, work, M, floor):
     """How many zeros of det Θ lie between two consecutive points of the sweep, with their
     multiplicity: the eigenvalues of Θ_old⁻¹ Θ_new with a negative real part. Away from a
     conjugate point that matrix is I + O(h); a direction in which Θ passes through zero
     between the two points has a negative eigenvalue (the ratio of its values there), a
     direction that only comes near zero a positive one. So a double root (a round section,
     det Θ touching zero without changing sign) counts twice, and a near miss not at all.
-    Returns -1 if Θ_old is singular (a conjugate point exactly on the grid)."""
+    Eigenvalues with a real part in [-floor, 0) are not counted. Returns -1 if Θ_old is
+    singular (a conjugate point exactly on the grid)."""
     if not _small_solve(old, new, n, work, M):
         return -1
     dist = 0.0
@@ -1641,17 +1646,21 @@ def _crossings(old, new, n, work, M):
     values = np.linalg.eigvals(C)
     count = 0
     for i in range(n):
-        if values[i].real < 0.0:
+        if values[i].real < -floor:
             count += 1
     return count
 
 
 @_jit
-def _orthonormalise(T, nt, weights):
+def _orthonormalise(T, nt, weights, A):
     """Modified Gram–Schmidt on the first nt tangent columns, in the weighted norm
     (δp/L, δθ, δn L²/EI, δm L/EI): a change of basis of the same family of solutions (the
     conjugate points are those of the family, not of the basis), against growth and loss
-    of independence along the sweep."""
+    of independence along the sweep. A (nt × nt) receives the change of basis: the new
+    columns are the old ones times A."""
+    for d in range(nt):
+        for e in range(nt):
+            A[e, d] = 1.0 if e == d else 0.0
     for d in range(nt):
         for e in range(d):
             dot = 0.0
@@ -1659,6 +1668,8 @@ def _orthonormalise(T, nt, weights):
                 dot += T[d, i] * T[e, i] * weights[i] * weights[i]
             for i in range(NT):
                 T[d, i] -= dot * T[e, i]
+            for i in range(nt):
+                A[i, d] -= dot * A[i, e]
         norm = 0.0
         for i in range(NT):
             norm += (T[d, i] * weights[i]) ** 2
@@ -1666,6 +1677,8 @@ def _orthonormalise(T, nt, weights):
         if norm > 0.0 and math.isfinite(norm):
             for i in range(NT):
                 T[d, i] /= norm
+            for i in range(nt):
+                A[i, d] /= norm
 
 
 @_jit
@@ -1677,7 +1690,9 @@ def _sweep(x, lam, steps, base, arm, case, scratch, nt, r, J, states, fields, th
     of conjugate points in (0, L) with multiplicity (the Morse index), or -1 if one lies
     exactly on a grid point. ``theta0`` receives Θ(0) of the orthonormalised family; with
     ``states`` of length steps + 1, the state and the tangents at every grid point from the
-    tip (index steps) to the base (0) are stored (the Jacobi fields of the mode)."""
+    tip (index steps) to the base (0) are stored, and in ``fields[k, nt:2nt, :nt]`` the
+    change of basis A_k of step k (the columns stored at k are those propagated from k + 1
+    times A_k: a solution with coefficients c at k has A_k c at k + 1)."""
     y, T, work, twork, now = scratch[0], scratch[1], scratch[2], scratch[3], scratch[4]
     tip_now, law = scratch[5], scratch[8]
     rate, tip_rate = case[1], case[3]
@@ -1732,12 +1747,12 @@ def _sweep(x, lam, steps, base, arm, case, scratch, nt, r, J, states, fields, th
             top = piece_start[j] + (i + 1) * h
             _rk4(y, T, nt, -h, top, arm, j, now, rate, work, twork, law)
             _block(T, nt, length, new)
-            c = _crossings(old, new, nt, lu, M)
+            c = _crossings(old, new, nt, lu, M, _AT_CLAMP if j == 0 and i == 0 else 0.0)
             if c < 0:
                 exact = True
             else:
                 count += c
-            _orthonormalise(T, nt, weights)
+            _orthonormalise(T, nt, weights, M)
             _block(T, nt, length, old)
             k -= 1
             if store:
@@ -1745,6 +1760,8 @@ def _sweep(x, lam, steps, base, arm, case, scratch, nt, r, J, states, fields, th
                 for d in range(nt):
                     for i2 in range(NT):
                         fields[k, d, i2] = T[d, i2]
+                    for i2 in range(nt):
+                        fields[k, nt + i2, d] = M[i2, d]
         _jump(y, T, nt, undo, rate, j, arm, law)  # the point wrench there, undone
     for i in range(nt):
         for d in range(nt):
@@ -1796,8 +1813,9 @@ def stability_cases(base, arm, loads, xs, Ns, index, theta0):
 def sweep_point(x, lam, steps, base, arm, case, theta0, states, fields):
     """One backward sweep at (x, λ) of a homotopy ``case`` (continuation, critical loads):
     the Morse index (or -1), Θ(0) into ``theta0`` (nt × nt, nt = its size), and with
-    ``states`` (K + 1, 18 + A), ``fields`` (K + 1, nt, 12), K the total number of steps, the
-    state and the orthonormalised Jacobi fields at every grid point."""
+    ``states`` (K + 1, 18 + A), ``fields`` (K + 1, 2 nt, 12), K the total number of steps,
+    the state and the orthonormalised Jacobi fields at every grid point (with the changes of
+    basis, see :func:`_sweep`)."""
     scratch = _scratch(arm[1].size, case[0].shape[1] - PIECE_LOADS)
     r = np.empty(6)
     J = np.empty((6, 7))

@@ -29,6 +29,7 @@ _NEWTON_TOL = 1e-11  # nondimensional residual of a converged point
 _NEWTON_ITER = 12
 _DS_MAX = 0.25
 _DS_MIN = 1e-9
+_RANK = 1e-8  # singular values below this times the largest: a null direction
 
 
 @dataclass(frozen=True, eq=False)
@@ -153,7 +154,7 @@ class Path:
         theta0 = np.empty((self.nt, self.nt))
         if store:
             states = np.empty((self.n + 1, self._y.size))
-            fields = np.empty((self.n + 1, self.nt, 12))
+            fields = np.zeros((self.n + 1, 2 * self.nt, 12))
         else:
             states, fields = np.empty((0, 1)), np.empty((0, 1, 1))
         index = self.k.sweep_point(self.x(z), float(z[6]), self.steps, self.base, self.arm,
@@ -178,37 +179,48 @@ class Path:
                     return None
                 z[:6] += dz
             else:
+                # the least-squares (minimum-norm) step: a symmetry of the problem (a round
+                # section's buckled branch turns freely about the axis) leaves a direction
+                # along which r does not change, and the corrector must not drift along it
                 A = np.vstack([J, normal])
                 b = np.append(-r, -float(normal @ (z - anchor)))
-                try:
-                    z += np.linalg.solve(A, b)
-                except np.linalg.LinAlgError:
-                    return None
+                z += np.linalg.lstsq(A, b, rcond=_RANK)[0]
         return None
 
     def tangent(self, z, previous=None):
         """The unit tangent of the branch at z (null vector of J̃), oriented along
         ``previous`` (or towards increasing λ)."""
         _, J = self.residual(z)
-        t = np.linalg.svd(J)[2][-1]
+        _, sv, V = np.linalg.svd(J)
         if previous is not None:
-            if t @ previous < 0:
+            # a second null direction (a symmetry orbit): the tangent closest to the last one
+            null = V[-2:] if sv[-1] <= _RANK * sv[0] else V[-1:]
+            t = null.T @ (null @ previous)
+            t /= np.linalg.norm(t)
+        else:
+            t = V[-1]
+            if t[6] < 0:
                 t = -t
-        elif t[6] < 0:
-            t = -t
         return t
 
     def mode(self, z, nullity) -> Mode:
         """The ``nullity`` Jacobi fields of z whose (δp, δθ) vanish at the clamp."""
         _, theta0, states, fields = self.index(z, store=True)
+        nt = self.nt
         c = np.linalg.svd(theta0)[2][-nullity:][::-1].T  # (nt, nullity)
-        dp = np.einsum("kdi,dm->mki", fields[:, :, 0:3], c)
+        # the coefficients of the mode in each grid point's basis: c_k+1 = A_k c_k
+        coef = np.empty((fields.shape[0], nt, nullity))
+        coef[0] = c
+        for k in range(fields.shape[0] - 1):
+            coef[k + 1] = fields[k, nt:, :nt] @ coef[k]
+        fields = fields[:, :nt]
+        dp = np.einsum("kdi,kdm->mki", fields[:, :, 0:3], coef)
         if self.nt == 3:
             # the rotation seeds carry δp(L) = 0; a rigid translation (itself a solution when
             # no load depends on position) brings δp(0) to 0
             dp -= dp[:, :1, :]
         R = states[:, 3:12].reshape(-1, 3, 3)
-        dth = np.einsum("kij,kdj,dm->mki", R, fields[:, :, 3:6], c)
+        dth = np.einsum("kij,kdj,kdm->mki", R, fields[:, :, 3:6], coef)
         base = np.einsum("di,dm->mi", fields[0, :, 6:12], c)
         size = np.max(np.linalg.norm(dp, axis=-1), axis=-1)
         size = np.where(size > 0, size, 1.0)
