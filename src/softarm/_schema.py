@@ -181,7 +181,8 @@ ROUTING: dict[str, Schema] = {
 #: ``[solve]``: the keys of :class:`softarm.case.SolveOptions` (which checks the values).
 SOLVE = (Field("method", "text", choices=("auto", "numeric")),
          Field("stations", "integer"),
-         Field("tol", "number", "units of the arm length"))
+         Field("tol", "number", "units of the arm length"),
+         Field("branch", "text", choices=("connected", "stable")))
 
 #: ``[sweep]`` (:class:`softarm.sweep.Sweep`), by name: ``load`` counts from 1 in the file,
 #: from 0 in the model; ``field`` is one of the swept load's vectors; either ``values`` or

@@ -55,6 +55,24 @@ class Stability:
     conservative: bool | np.ndarray
     stable: bool | np.ndarray
 
+    @classmethod
+    def of(cls, index, conservative, shape=None) -> Stability:
+        """The verdict of batch shape ``shape`` (default: index's own) from the indices and
+        the conservative flags (plain Python scalars for shape ())."""
+        index = np.asarray(index, dtype=np.int64)
+        shape = index.shape if shape is None else tuple(shape)
+        index = index.reshape(shape)
+        conservative = np.asarray(conservative, dtype=bool)
+        conservative = (conservative.reshape(shape) if conservative.size == index.size
+                        else np.broadcast_to(conservative, shape)).copy()
+        stable = (index == 0) & conservative
+        if shape == ():
+            return cls(int(index), bool(conservative), bool(stable))
+        index = index.copy()
+        for array in (index, conservative, stable):
+            array.setflags(write=False)
+        return cls(index, conservative, stable)
+
     @property
     def unstable(self):
         """Proven unstable: index > 0 (for a nonconservative load only an odd index is a

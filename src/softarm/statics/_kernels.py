@@ -1682,11 +1682,13 @@ def _orthonormalise(T, nt, weights, A):
 
 
 @_jit
-def _sweep(x, lam, steps, base, arm, case, scratch, nt, r, J, states, fields, theta0):
+def _sweep(x, lam, steps, base, arm, case, scratch, nt, r, J, states, fields, theta0, tip):
     """The backward sweep of one equilibrium (base reaction x at load factor λ, ``steps``
     RK4 steps per piece, the solution's own grid): the state integrated forward to the tip
     (state only), then the state and nt seeded tangent columns back to the base with the
-    same steps reversed (the point wrenches undone at each piece start). Returns the number
+    same steps reversed (the point wrenches undone at each piece start); with a tip pose
+    ``tip`` (4, 4) (the solution's own, e.g. its last station) the forward pass is skipped
+    (n(L), m(L) are then the tip loads, by the tip condition). Returns the number
     of conjugate points in (0, L) with multiplicity (the Morse index), or -1 if one lies
     exactly on a grid point. ``theta0`` receives Θ(0) of the orthonormalised family; with
     ``states`` of length steps + 1, the state and the tangents at every grid point from the
@@ -1698,7 +1700,19 @@ def _sweep(x, lam, steps, base, arm, case, scratch, nt, r, J, states, fields, th
     rate, tip_rate = case[1], case[3]
     length = arm[6]
     scale = arm[7]
-    _integrate(x, lam, 0, steps, base, arm, case, scratch, r, J)
+    if tip.shape[0] == 4:
+        _set_loads(lam, case, now, tip_now)
+        for i in range(y.size):
+            y[i] = 0.0
+        for i in range(3):
+            y[_P + i] = tip[i, 3]
+            for k2 in range(3):
+                y[_R + 3 * i + k2] = tip[i, k2]
+        _tip_residual(y, T, 0, tip_now, tip_rate, r, J, arm, now, rate, law)
+        for i in range(6):
+            y[_N + i] = -r[i]  # the total wrench at the tip equals the tip loads
+    else:
+        _integrate(x, lam, 0, steps, base, arm, case, scratch, r, J)
     # seeds: unit rotations of the tip section (and translations with nt = 6), with the δn,
     # δm of the linearised tip loads (follower and dipole terms), so that δr(L) = 0
     for d in range(nt):
@@ -1781,11 +1795,33 @@ def _tangent_columns(arm, piece):
 
 
 @_jit
-def stability_cases(base, arm, loads, xs, Ns, index, theta0):
+def _conservative(piece, tip):
+    """False if a follower load (any channel) or a dead couple acts (see
+    softarm.statics.stability.conservative, which says why)."""
+    for j in range(piece.shape[0]):
+        for i in range(3):
+            if (piece[j, _FF + i] != 0.0 or piece[j, _LF + i] != 0.0
+                    or piece[j, _LD + i] != 0.0 or piece[j, _JF + i] != 0.0
+                    or piece[j, _JF + 3 + i] != 0.0 or piece[j, _JD + 3 + i] != 0.0):
+                return False
+    for i in range(6):
+        if tip[_TF + i] != 0.0:
+            return False
+    for i in range(3):
+        if tip[_TD + 3 + i] != 0.0:
+            return False
+    return True
+
+
+@_jit
+def stability_cases(base, arm, loads, xs, Ns, tips, factor, index, theta0, conservative):
     """The Morse index of every solved case of a batch (loads at λ = 1 from zero, the
-    solution x on 2N steps, as :func:`solve_cases` returns them): ``index[b]`` (-1 if a
-    conjugate point falls exactly on a grid point) and Θ(0) of the sweep (``theta0[b]``,
-    nt × nt in its top-left corner)."""
+    solution x, as :func:`solve_cases` returns them), swept on ``factor`` × Ns[b] steps
+    (the solution's coarse grid N: the count needs the Jacobi fields resolved, not the
+    solution's 1e-8 L): ``index[b]`` (-1 if a conjugate point falls exactly on a grid
+    point) and Θ(0) of the sweep (``theta0[b]``, nt × nt in its top-left corner). With
+    ``tips`` (B, 4, 4), the solution's tip poses, the forward pass is skipped.
+    ``conservative[b]``: whether case b's loads are conservative."""
     piece_loads, tip_loads = loads
     npieces = arm[1].size
     width = piece_loads.shape[2]
@@ -1800,10 +1836,11 @@ def stability_cases(base, arm, loads, xs, Ns, index, theta0):
     for b in range(piece_loads.shape[0]):
         case = (start, piece_loads[b], tip_start, tip_loads[b])
         nt = _tangent_columns(arm, piece_loads[b])
-        _fill_steps(arm[6], arm[1], int(Ns[b]), 2, steps)
+        conservative[b] = _conservative(piece_loads[b], tip_loads[b])
+        _fill_steps(arm[6], arm[1], int(Ns[b]), factor, steps)
         t0 = np.zeros((nt, nt))
         index[b] = _sweep(xs[b], 1.0, steps, base, arm, case, scratch, nt, r, J, none3,
-                          none4, t0)
+                          none4, t0, tips[b] if tips.shape[0] > b else none3)
         for i in range(nt):
             for d in range(nt):
                 theta0[b, i, d] = t0[i, d]
@@ -1820,7 +1857,7 @@ def sweep_point(x, lam, steps, base, arm, case, theta0, states, fields):
     r = np.empty(6)
     J = np.empty((6, 7))
     return _sweep(x, lam, steps, base, arm, case, scratch, theta0.shape[0], r, J, states,
-                  fields, theta0)
+                  fields, theta0, np.empty((0, 1)))
 
 
 @_jit

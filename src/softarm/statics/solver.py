@@ -509,8 +509,10 @@ class Solver:
         if self.stability:
             from .stability import verdict
 
+            # from the tip (the last station when it is s = L) on the coarse grid N
+            tips = poses[:, -1] if self.s[-1] == self.length else None
             actuation["stability"] = verdict(channels, self._base_kernel, base_wrench,
-                                             info[:, 4], shape)
+                                             info[:, 4], shape, tips)
         # fresh arrays, frozen before reshaping: Equilibrium takes them without a copy
         for array in (poses, strains, stresses, info):
             array.setflags(write=False)

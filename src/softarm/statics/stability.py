@@ -40,28 +40,25 @@ def conservative(piece: np.ndarray, tip: np.ndarray) -> np.ndarray:
     return (follower == 0.0) & (couple == 0.0)
 
 
-def verdict(channels, base, xs, Ns, shape) -> Stability:
+def verdict(channels, base, xs, Ns, shape, tips=None, factor=1) -> Stability:
     """The stability of every case solved by ``solve_cases`` (loads from zero to the
-    channels' values, solution xs on 2 Ns steps)."""
+    channels' values, solution xs), swept on factor × Ns steps; ``tips`` (B, 4, 4): the
+    solution's tip poses (the forward pass to the tip is then skipped)."""
     k = _k()
     count = xs.shape[0]
     index = np.zeros(count, dtype=np.int64)
     theta0 = np.zeros((count, 6, 6))
+    tips = np.zeros((0, 4, 4)) if tips is None else np.ascontiguousarray(tips)
+    flags = np.empty(count, dtype=np.bool_)
     k.stability_cases(base, channels.arm_tuple(), (channels.piece, channels.tip_loads), xs,
-                      np.ascontiguousarray(Ns, dtype=np.float64), index, theta0)
-    return make(index, conservative(channels.piece, channels.tip_loads), shape)
+                      np.ascontiguousarray(Ns, dtype=np.float64), tips, int(factor), index,
+                      theta0, flags)
+    return make(index, flags, shape)
 
 
 def make(index, conservative_, shape) -> Stability:
-    """A :class:`Stability` of batch shape ``shape`` (plain Python scalars for shape ())."""
-    index = np.asarray(index, dtype=np.int64).reshape(shape)
-    conservative_ = np.asarray(conservative_, dtype=bool).reshape(shape)
-    stable = (index == 0) & conservative_
-    if shape == ():
-        return Stability(int(index), bool(conservative_), bool(stable))
-    for array in (index, conservative_, stable):
-        array.setflags(write=False)
-    return Stability(index, conservative_, stable)
+    """A :class:`Stability` of batch shape ``shape``."""
+    return Stability.of(index, conservative_, shape)
 
 
 #: RK4 steps of the sweep of a closed-form equilibrium (whose base reaction is exact): the
@@ -81,5 +78,5 @@ def closed_form_verdict(solver, loads, eq) -> Stability | None:
         return None
     xs = np.concatenate([eq.forces_spatial[..., 0, :], eq.moments_spatial[..., 0, :]], -1)
     xs = np.ascontiguousarray(np.broadcast_to(xs, (*shape, 6)).reshape(count, 6))
-    Ns = np.full(count, CLOSED_FORM_STEPS // 2, dtype=np.float64)
+    Ns = np.full(count, CLOSED_FORM_STEPS, dtype=np.float64)
     return verdict(channels, solver._base_kernel, xs, Ns, shape)
