@@ -271,3 +271,25 @@ def test_stable_branch_is_the_connected_one_when_that_is_stable():
     b = softarm.solve(arm, load)
     assert a.stability.stable
     np.testing.assert_allclose(a.poses, b.poses, atol=1e-8)
+
+
+def test_upright_soft_arm_example(tmp_path, monkeypatch):
+    # examples/upright_arm.py (docs/stability.md): runs, draws, and its numbers hold: the
+    # critical length agrees with Greenhill's (7.8373 EI/q)^(1/3) to the shift of extension
+    # and shear (silicone: q L / EA ~ 1e-3)
+    import runpy
+    import sys
+    from pathlib import Path
+
+    pytest.importorskip("matplotlib")
+    monkeypatch.setattr(sys, "argv", ["upright_arm.py", str(tmp_path)])
+    script = Path(__file__).resolve().parents[1] / "examples" / "upright_arm.py"
+    names = runpy.run_path(str(script), run_name="__main__")
+    assert (tmp_path / "stability_upright.png").stat().st_size > 10_000
+    greenhill = (GREENHILL[0] * names["EI"] / names["q"]) ** (1 / 3)
+    critical = 0.15 * names["point"].factor ** (1 / 3)
+    assert critical == pytest.approx(greenhill, rel=2e-3)
+    assert names["short"].stability.stable
+    assert names["straight"].stability.index == 2
+    assert names["fallen"].stability.stable
+    assert names["fallen"].tip_position[2] < 0.0  # it has fallen over

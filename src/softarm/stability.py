@@ -24,7 +24,8 @@ from .statics import Solver
 from .statics.continuation import STEPS, Branch, CriticalPoint, Mode, Path, branch, follow
 from .statics.continuation import _switch as switch_at
 
-__all__ = ["Branch", "CriticalPoint", "Mode", "continuation", "critical_load", "solve_stable"]
+__all__ = ["Branch", "CriticalPoint", "Mode", "continuation", "critical_load", "plot_branch",
+           "solve_stable"]
 
 
 def _split(loads, vary):
@@ -128,7 +129,7 @@ def _start(path: Path):
 
 
 def continuation(arm, loads, lam=(0.0, 1.0), *, steps=STEPS, base=None, s=None,
-                 max_points=2000) -> Branch:
+                 max_points=2000, max_step=0.25) -> Branch:
     """Follow the equilibria of λ·loads from λ = lam[0] to lam[1] by pseudo-arclength
     continuation in (x, λ) (x the base reaction), through folds and bifurcations, with the
     Morse index at every point.
@@ -137,7 +138,9 @@ def continuation(arm, loads, lam=(0.0, 1.0), *, steps=STEPS, base=None, s=None,
     (:func:`softarm.solve`). Returns a :class:`Branch`: ``lam``, ``x``, ``index``,
     ``critical`` (folds and bifurcations, located to about 1e-12 in arclength) and
     ``equilibria`` (one batched Equilibrium); ``branch.switch(point)`` follows a bifurcating
-    branch.
+    branch. ``max_step`` bounds the steps (nondimensional arclength in (x, λ): base reaction
+    in units of the bending scale times the load size, and λ); ``steps``: RK4 steps over
+    the arm.
     """
     lam0, lam1 = (real(v, "lam") for v in lam)
     solver = Solver(arm, base=base, s=s, stability=False)
@@ -150,7 +153,7 @@ def continuation(arm, loads, lam=(0.0, 1.0), *, steps=STEPS, base=None, s=None,
     if z0 is None:
         raise ConvergenceError(f"no equilibrium to start from at λ = {lam0}", math.nan)
     points, indices, critical = follow(path, z0, lam1, max_points=max_points,
-                                       locate=path.conservative)
+                                       locate=path.conservative, max_step=max_step)
     return branch(path, points, indices, critical)
 
 
@@ -188,3 +191,59 @@ def solve_stable(solver: Solver, loads, imperfection=None, *, max_switches=4):
             f"no stable equilibrium was reached under the full load (the branch followed has "
             f"Morse index {int(indices[-1])} at λ = {points[-1, 6]:.6g})", math.nan)
     return solver.solve_near(loads, path.x(points[-1]), path.n)
+
+
+def plot_branch(*branches, coordinate=2, ax=None, labels=None, path=None):
+    """Draw branches as load factor λ against a tip coordinate: stable points joined by a
+    solid line, unstable (or undecided) ones by a dashed line, critical points marked.
+
+    Parameters
+    ----------
+    *branches : Branch
+    coordinate : int
+        The tip position component on the horizontal axis (0, 1, 2: x, y, z; default 2).
+    ax : matplotlib Axes, optional
+    labels : sequence of str, optional
+    path : str or Path, optional
+        Write the figure there.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
+    import matplotlib.pyplot as plt
+
+    if coordinate not in (0, 1, 2):
+        raise ValueError(f"coordinate must be 0, 1 or 2 (x, y, z), got {coordinate!r}")
+    component = int(coordinate)
+    if ax is None:
+        _, ax = plt.subplots(figsize=(6.0, 4.2), layout="constrained")
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for b, item in enumerate(branches):
+        colour = colours[b % len(colours)]
+        tip = np.asarray(item.equilibria.tip_position)[:, component]
+        stable = np.asarray(item.stable)
+        index = np.asarray(item.index)
+        label = labels[b] if labels is not None else f"branch {b + 1}"
+        for k in range(len(tip) - 1):
+            # a critical point (index -1) takes the style of the other end
+            a = stable[k] if index[k] >= 0 else stable[k + 1]
+            b = stable[k + 1] if index[k + 1] >= 0 else stable[k]
+            style = "-" if a and b else "--"
+            ax.plot(tip[k:k + 2], item.lam[k:k + 2], style, color=colour,
+                    label=label if k == 0 else None)
+        for point in item.critical:
+            z = item.path.z(point.x, point.factor)
+            eq = item.path.record(z[None])
+            ax.plot(eq.tip_position[0, component], point.factor, "o", color=colour,
+                    markerfacecolor="white")
+            ax.annotate(f"{point.kind}, λ = {point.factor:.4g}",
+                        (eq.tip_position[0, component], point.factor),
+                        textcoords="offset points", xytext=(6, -10), fontsize=8)
+    ax.set_xlabel(f"tip {'xyz'[component]} (m)")
+    ax.set_ylabel("load factor λ")
+    ax.grid(alpha=0.3)
+    ax.legend(title="solid: stable, dashed: unstable", fontsize=8, title_fontsize=8)
+    if path is not None:
+        ax.figure.savefig(path, dpi=120)
+    return ax

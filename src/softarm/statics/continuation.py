@@ -277,7 +277,8 @@ class Branch:
     x : ndarray, shape (K, 6)
         The base reactions (N, N m, spatial).
     index : ndarray of int, shape (K,)
-        The Morse index at each point.
+        The Morse index at each point (-1 at a critical point: a switched branch starts at
+        its bifurcation).
     critical : tuple of CriticalPoint
         The critical points met (folds, bifurcations), in order.
     equilibria : Equilibrium
@@ -302,7 +303,9 @@ class Branch:
         position in :attr:`critical`), followed from there along the null vector of ∂r/∂x
         (not an arbitrary perturbation) to ``lam`` (default: this branch's last λ).
         ``imperfection``: a spatial direction (3,) for the tip's displacement that picks one
-        of two mirror branches (and, with nullity 2, the plane of buckling)."""
+        of two mirror branches (and, with nullity 2, the plane of buckling). ``options``:
+        ``ds`` (first step), ``max_step`` (largest step, nondimensional arclength in
+        (x, λ)), ``max_points``."""
         if isinstance(point, (int, np.integer)):
             point = self.critical[int(point)]
         if point.kind != "bifurcation":
@@ -332,9 +335,10 @@ def _orient(mode: Mode, imperfection) -> np.ndarray:
 
 
 def follow(path: Path, z0, lam_end, *, direction=None, ds=0.05, max_points=2000,
-           locate=True, stop_at_critical=False) -> tuple:
+           locate=True, stop_at_critical=False, max_step=_DS_MAX) -> tuple:
     """Pseudo-arclength continuation from the point z0 (converged) until λ reaches
-    ``lam_end``. Returns (points (K, 7), indices (K,), critical points)."""
+    ``lam_end``, with steps of at most ``max_step`` (nondimensional arclength in (x, λ)).
+    Returns (points (K, 7), indices (K,), critical points)."""
     t = path.tangent(z0, direction)
     if direction is None and np.sign(t[6]) != np.sign(lam_end - z0[6]) and t[6] != 0:
         t = -t
@@ -378,7 +382,7 @@ def follow(path: Path, z0, lam_end, *, direction=None, ds=0.05, max_points=2000,
         z, t = new, t_new
         if landed:
             break
-        ds = min(_DS_MAX, ds * 1.4)
+        ds = min(max_step, ds * 1.4)
     return np.array(points), np.array(indices), tuple(critical)
 
 
@@ -422,8 +426,8 @@ def branch(path: Path, points, indices, critical) -> Branch:
     return Branch(lam, x, indices, critical, eq, path, path.conservative)
 
 
-def _switch(path: Path, point: CriticalPoint, imperfection, lam_end, ds=0.02,
-            max_points=2000) -> Branch:
+def _switch(path: Path, point: CriticalPoint, imperfection, lam_end, ds=0.005,
+            max_points=2000, max_step=_DS_MAX) -> Branch:
     """Leave the bifurcation ``point`` along its null vector and follow the new branch."""
     mode = point.mode
     c = _orient(mode, imperfection)
@@ -445,8 +449,8 @@ def _switch(path: Path, point: CriticalPoint, imperfection, lam_end, ds=0.02,
             f"could not leave the bifurcation at λ = {point.factor:.6g} along its mode",
             math.nan, f"{path.shootings} shootings", load_factor=point.factor)
     t = path.tangent(first, direction)
-    points, indices, critical = follow(path, first, lam_end, direction=t,
-                                       max_points=max_points)
+    points, indices, critical = follow(path, first, lam_end, direction=t, ds=ds,
+                                       max_points=max_points, max_step=max_step)
     points = np.vstack([zc[None], points])
-    indices = np.concatenate([[point.index_after], indices])
+    indices = np.concatenate([[-1], indices])  # the bifurcation point itself: critical
     return branch(path, points, indices, critical)
