@@ -12,13 +12,13 @@ from __future__ import annotations
 import math
 import warnings
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import partial
 
 import numpy as np
 
 from ..errors import StabilityWarning
-from ..loads import TipLoad
+from ..loads import Gravity, TipLoad
 from ..model import Arm
 from . import references as ref
 from ._checks import CaseResult, DataTables, finding, gate, skipped
@@ -677,6 +677,77 @@ def helix(tables: DataTables) -> CaseResult:
     return result
 
 
+# ------------------------------------------------------------------------------------------
+# Stability (issue 15): critical loads, the stable branch and the verdicts
+# ------------------------------------------------------------------------------------------
+_BUCKLING = "buckling.json"
+
+
+def stability(tables: DataTables) -> CaseResult:
+    from ..stability import critical_load  # the stability module imports the solver
+
+    case = "stability"
+    data, result = _table_or_skip(tables, _BUCKLING, case, "critical loads, elastica",
+                                  "λc, tip", f"{_BUCKLING}: facts")
+    if data is None:
+        return result
+    facts = data["facts"]
+    method = "critical_load"
+    stiff = Arm.from_stiffness(1.0, EA=1e9, GAy=1e9, GAz=1e9, GJ=1.0, EIy=1.0, EIz=1.0,
+                               mass_per_length=1.0)
+    euler = facts["euler_cantilever"]["P_cr_L2_over_EI"][0]
+    greenhill = facts["greenhill_heavy_column"]["C"]
+    airy = facts["heavy_column_with_tip_load"]["example"]
+    prandtl = facts["prandtl_lateral_torsional_cantilever"]["C"]
+    strip = Arm.from_stiffness(1.0, EA=1e10, GAy=1e10, GAz=1e10, GJ=0.5, EIy=1.0, EIz=1e6)
+    weight = Gravity(acceleration=(-airy["q_L3_over_EI"], 0.0, 0.0))
+    tip_load = TipLoad(force=(-1.0, 0.0, 0.0))
+    for item, reference, run, tol, note in (
+        ("Euler cantilever, P L²/EI", euler,
+         lambda: critical_load(stiff, TipLoad(force=(-1.0, 0.0, 0.0))), 1e-8,
+         "EA = GA = 1e9 EI/L²"),
+        ("Greenhill heavy column, q L³/EI", greenhill,
+         lambda: critical_load(stiff, Gravity(acceleration=(-1.0, 0.0, 0.0))), 1e-6,
+         "EA = GA = 1e9 EI/L²"),
+        ("heavy column q L³/EI = 3 + tip load, P L²/EI", airy["P_cr_L2_over_EI"],
+         lambda: critical_load(stiff, [weight, tip_load], vary=tip_load), 1e-6,
+         "Airy-function solution"),
+        ("Prandtl strip, P L²/√(EI GJ)", prandtl,
+         lambda: _scaled(critical_load(strip, TipLoad(force=(0.0, 1.0, 0.0))),
+                         1 / math.sqrt(0.5)), 1e-4,
+         "EI_strong = 1e6 EI_weak shifts it by ~1e-6"),
+    ):
+        point, error = attempt(run)
+        ours = math.nan if point is None else point.factor
+        result.checks.append(gate(case, item, method, "λc", reference, ours, tol,
+                                  f"{_BUCKLING}: provenance of the fact", error_kind="rel",
+                                  note=error or note))
+    # the stable branch past the Euler load against the elastica table (Timoshenko & Gere)
+    arm = Arm.from_stiffness(1.0, EA=1e11, GAy=1e11, GAz=1e11, GJ=1.0, EIy=1.0, EIz=1.0)
+    table = facts["elastica_postbuckling_cantilever"]["table"]
+    for row in (table[2], table[8], table[14], table[17]):
+        item = f"elastica, P/P_cr = {row['P_over_Pcr']:.6g}"
+        load = TipLoad(force=(-row["P_over_Pcr"] * euler, 0.0, 0.0))
+        eq, note = attempt(numeric_stable, arm, load)
+        for name, axis, reference in (("tip x/L", 0, row["x_over_L"]),
+                                      ("tip δ/L", 1, row["delta_over_L"])):
+            result.checks.append(gate(case, item, "solve(branch='stable')", name, reference,
+                                      value(eq, tip, axis), 1e-8,
+                                      f"{_BUCKLING}: elastica_postbuckling_cantilever",
+                                      note=note))
+    return result
+
+
+def _scaled(point, factor):
+    return None if point is None else replace(point, factor=point.factor * factor)
+
+
+def numeric_stable(arm, load):
+    import softarm
+
+    return softarm.solve(arm, load, branch="stable", imperfection=(0.0, 1.0, 0.0))
+
+
 CASES: tuple[ValidationCase, ...] = (
     ValidationCase(
         "fig2_pure_bending", "Paper Fig. 2: pure bending",
@@ -734,4 +805,10 @@ CASES: tuple[ValidationCase, ...] = (
         "paper's constant-strain formula (eqs. 30-34, with an ApproximationWarning), exact "
         "only for a moment about a principal axis (C2 and C4): its tip against "
         "the exact solver is reported as a finding.", helix),
+    ValidationCase(
+        "stability", "Stability: critical loads and the stable branch (issue 15)",
+        "critical_load against Euler's cantilever, Greenhill's heavy column (alone and with a "
+        "tip load, Airy functions) and Prandtl's lateral-torsional buckling of a narrow "
+        "strip; solve(branch='stable') past the Euler load against the post-buckling "
+        "elastica table (Timoshenko & Gere §2.7, elliptic integrals).", stability),
 )
