@@ -53,10 +53,10 @@ def main():
     for name, arm, loads, repeats in solve_cases():
         for stability in (True, False):  # compile both
             softarm.solve(arm, loads, method="numeric", stability=stability)
-        w1, c1 = timed(lambda: softarm.solve(arm, loads, method="numeric",
-                                             stability=False), repeats)
-        w2, c2 = timed(lambda: softarm.solve(arm, loads, method="numeric",
-                                             stability=True), repeats)
+        w1, c1 = timed(lambda arm=arm, loads=loads: softarm.solve(
+            arm, loads, method="numeric", stability=False), repeats)
+        w2, c2 = timed(lambda arm=arm, loads=loads: softarm.solve(
+            arm, loads, method="numeric", stability=True), repeats)
         print(f"{name:40s} {1e3 * w1:10.3f} {1e3 * w2:12.3f} {(w2 - w1) / w1:7.1%} "
               f"{(c2 - c1) / c1:9.1%}")
     print()
@@ -83,7 +83,7 @@ def main():
     w, c = timed(lambda: softarm.solve(arm, load, branch="stable"), 3)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        w0, c0 = timed(lambda: softarm.solve(arm, load, method="numeric"), 10)
+        w0, _ = timed(lambda: softarm.solve(arm, load, method="numeric"), 10)
     print(f"branch='stable': {w:.3f} s wall, {c:.3f} s CPU (a plain solve: {1e3 * w0:.2f} ms)")
 
 
