@@ -293,3 +293,80 @@ def test_upright_soft_arm_example(tmp_path, monkeypatch):
     assert names["straight"].stability.index == 2
     assert names["fallen"].stability.stable
     assert names["fallen"].tip_position[2] < 0.0  # it has fallen over
+
+
+def test_magnetic_gradient_sweep_parity_and_conservative():
+    # a hard-magnet arm in a field with a gradient: the sweep seeds translations too (6
+    # columns); its index parity is the sign of a finite-difference det ∂r/∂x, and magnets,
+    # tendons and chambers are conservative
+    G = np.array([[0.0, 0.3, 0.0], [0.3, 0.0, 0.0], [0.0, 0.0, 0.0]])
+    arm = Arm.from_stiffness(1.0, EA=300.0, GAy=100.0, GAz=100.0, GJ=0.8, EIy=1.0, EIz=1.3,
+                             magnetization=(2.0, 0.0, 0.0))
+    solver = Solver(arm)
+    for B in ((-3.0, 0.2, 0.0), (-6.0, 0.1, 0.3)):
+        load = softarm.MagneticField(field=B, gradient=G)
+        eq = quiet_solve(arm, load, method="numeric")
+        assert eq.stability.conservative
+        x = np.asarray(eq.base_wrench)
+        J = np.empty((6, 6))
+        for d in range(6):
+            e = np.zeros(6)
+            e[d] = 1e-6
+            J[:, d] = (solver.shoot(load, x + e, steps=400).residual
+                       - solver.shoot(load, x - e, steps=400).residual) / 2e-6
+        assert (-1) ** eq.stability.index == np.sign(np.linalg.det(J)), B
+    # a magnetisation along the axis in a uniform field against it: like a compressive load,
+    # m B L²/EI = 2 × 3 = 6 > π²/4 (the magnetic torque density m × B), so index > 0
+    eq = quiet_solve(arm, softarm.MagneticField(field=(-3.0, 0.0, 0.0)), method="numeric")
+    assert eq.stability.index > 0
+    soft = Arm.from_stiffness(1.0, EA=1e4, GAy=1e4, GAz=1e4, GJ=1.0, EIy=1.0, EIz=1.0)
+    chamber = softarm.Chamber(pressure=1e4, area=1e-4, routing=Straight(0.0, 0.01))
+    eq = softarm.solve(soft, chamber, method="numeric")
+    assert eq.stability.conservative and eq.stability.stable
+
+
+def test_branch_stable_refuses_a_batch():
+    arm = Arm.from_stiffness(1.0, EA=1e9, GAy=1e9, GAz=1e9, GJ=1.0, EIy=1.0, EIz=1.0)
+    with pytest.raises(ValueError, match="single load case"):
+        softarm.solve(arm, TipLoad(force=[[-3.0, 0, 0], [-4.0, 0, 0]]), branch="stable")
+    with pytest.raises(ValueError, match="branch must be"):
+        softarm.solve(arm, TipLoad(force=[-3.0, 0, 0]), branch="unstable")
+
+
+CASE = """
+name = "column"
+[arm]
+length = 1.0
+stiffness = {{ EA = 1.0e9, GAy = 1.0e9, GAz = 1.0e9, GJ = 1.0, EIy = 1.0, EIz = 1.0 }}
+[[load]]
+kind = "tip"
+force = [{force}, 0.0, 0.0]
+[solve]
+method = "numeric"
+{branch}
+"""
+
+
+def test_cli_critical_and_the_stable_branch_in_a_case_file(tmp_path, capsys):
+    from softarm.cli import main
+
+    path = tmp_path / "column.toml"
+    path.write_text(CASE.format(force=-1.0, branch=""))
+    assert main(["critical", str(path)]) == 0
+    out = capsys.readouterr().out
+    # Euler: λc = π²/4 (buckling.json), nullity 2 on a round section
+    assert "λc = 2.4674011003" in out and "bifurcation, nullity 2" in out
+    path.write_text(CASE.format(force=-1.5 * EULER[0], branch=""))
+    assert main(["solve", str(path)]) == 0
+    captured = capsys.readouterr()
+    assert "UNSTABLE (Morse index 2" in captured.out
+    assert captured.err.startswith("softarm: warning:") and captured.err.count("\n") == 1
+    path.write_text(CASE.format(force=-1.5 * EULER[0], branch='branch = "stable"'))
+    assert main(["solve", str(path)]) == 0
+    captured = capsys.readouterr()
+    assert "stability stable (Morse index 0)" in captured.out and captured.err == ""
+    path.write_text(CASE.format(force=-1.0, branch="").replace('kind = "tip"',
+                                                                'kind = "tip"\nfollower = true'))
+    assert main(["critical", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "flutter" in err

@@ -342,7 +342,7 @@ def _run_critical(args) -> int:
     else:
         mode = point.mode
         lines += [
-            f"critical  load factor λc = {point.factor:.10g} ({point.kind}, nullity "
+            f"critical  load factor λc = {point.factor:.12g} ({point.kind}, nullity "
             f"{point.nullity}; Morse index {point.index_before} -> {point.index_after})",
         ]
         for i in range(point.nullity):

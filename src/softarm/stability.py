@@ -162,15 +162,15 @@ def solve_stable(solver: Solver, loads, imperfection=None, *, max_switches=4):
     unloaded arm if it is stable, else the branch reached by switching, at the first
     critical point of the loading path, along the null vector of ∂r/∂x, followed to the
     full load (repeated at later critical points of that branch)."""
+    _, shape = solver.check_loads(loads)
+    if shape != ():
+        raise ValueError("branch='stable' takes a single load case (batch shape ()), got "
+                         f"batch shape {shape}")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", StabilityWarning)
         eq = solver.solve_from_unloaded(loads)
     verdict = eq.stability
-    if verdict is None or eq.batch_shape != () or verdict.index == 0 \
-            or not verdict.conservative:
-        if eq.batch_shape != ():
-            raise ValueError("branch='stable' takes a single load case (batch shape ()), got "
-                             f"batch shape {eq.batch_shape}")
+    if verdict is None or verdict.index == 0 or not verdict.conservative:
         return eq
     path = Path(Solver(solver.arm, base=solver.base, s=solver.s, stability=False), (),
                 loads, STEPS)
