@@ -370,3 +370,19 @@ def test_cli_critical_and_the_stable_branch_in_a_case_file(tmp_path, capsys):
     assert main(["critical", str(path)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "flutter" in err
+
+
+def test_closed_form_axial_index_agrees_with_the_count_and_the_sweep():
+    # the closed form's index (a formula) and the numerical route's (the sweep) against the
+    # count of the model's critical loads below P, over a range reaching index 5
+    arm = Arm.from_stiffness(1.0, EA=400.0, GAy=150.0, GAz=120.0, GJ=0.8, EIy=1.0, EIz=1.7)
+    P = np.linspace(0.1, 70.0, 60)
+    crit = np.concatenate([model_critical(EULER * 1.0, 400.0, 120.0),
+                           model_critical(EULER * 1.7, 400.0, 150.0)])
+    expected = (P[:, None] > crit[None, :]).sum(1)
+    force = np.column_stack([-P, 0 * P, 0 * P])
+    closed = quiet_solve(arm, TipLoad(force=force), s=11)
+    numeric = quiet_solve(arm, TipLoad(force=force), s=11, method="numeric")
+    assert closed.method == "analytic.axial_force"
+    np.testing.assert_array_equal(closed.stability.index, expected)
+    np.testing.assert_array_equal(numeric.stability.index, expected)

@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..equilibrium import Stability
+from ..loads import TipLoad, as_loads
 
 __all__ = ["conservative", "verdict"]
 
@@ -61,22 +62,67 @@ def make(index, conservative_, shape) -> Stability:
     return Stability.of(index, conservative_, shape)
 
 
-#: RK4 steps of the sweep of a closed-form equilibrium (whose base reaction is exact): the
-#: count of conjugate points needs the grid to resolve the Jacobi fields only, not 1e-8 L.
-CLOSED_FORM_STEPS = 128
+def _closed_form_steps(channels, data) -> np.ndarray:
+    """RK4 steps for the sweep of each closed-form case: the Jacobi fields vary on the
+    scales 1/√(F/EI) and EI/(F L), EI/M; 8 + 2 (kL + F L²/EI + M L/EI) steps keep h k and
+    the turning per step below about 1/2, in [12, 256]."""
+    k = _k()
+    tip = np.abs(channels.tip_loads)
+    force = np.linalg.norm(tip[:, k.TD:k.TD + 3] + tip[:, k.TF:k.TF + 3], axis=-1)
+    moment = np.linalg.norm(tip[:, k.TD + 3:k.TD + 6] + tip[:, k.TF + 3:k.TF + 6], axis=-1)
+    EI = float(np.min(data.K[:, [4, 5], [4, 5]]))
+    L = data.length
+    n = 8 + 2 * (np.sqrt(force * L * L / EI) + force * L * L / EI + moment * L / EI)
+    return np.clip(np.ceil(n), 12, 256)
+
+
+def _axial_index(eq, data, loads):
+    """The Morse index of the straight arm under a dead axial tip force (a compression P),
+    in closed form, or None where it does not apply: each bending plane loses stability at
+    every P_n with P_n (1 + P_n (1/GA - 1/EA)) = (2n - 1)² π² EI/(4L²) (the linearised
+    extensible, shearable rod; buckling.json, cosserat_cantilever_extensible_shearable)."""
+    K = data.K
+    if K.shape[0] != 1 or np.any(K[0] != np.diag(np.diagonal(K[0]))) or np.any(data.f0[:, 1:]):
+        return None
+    if not all(isinstance(load, TipLoad) and not load.follower for load in loads):
+        return None
+    P = -np.asarray(eq.stresses[..., 0, 0])  # the compression (material axial force)
+    EA, GAy, GAz, _, EIy, EIz = np.diagonal(K[0])
+    L = data.length
+    index = np.zeros(P.shape, dtype=np.int64)
+    for EI, GA in ((EIy, GAz), (EIz, GAy)):
+        c = 1.0 / GA - 1.0 / EA
+        # the n >= 1 with P_n < P: P (1 + c P) > (2n - 1)² Q1, Q1 = π² EI/(4 L²)
+        Q1 = np.pi ** 2 * EI / (4 * L * L)
+        root = np.sqrt(np.maximum(np.where(P > 0, P * (1 + c * P), 0.0), 0.0) / Q1)
+        n = np.ceil((root + 1.0) / 2.0) - 1.0  # the n with 2n - 1 < root
+        index += np.where(P > 0, n, 0).astype(np.int64)
+    return index
 
 
 def closed_form_verdict(solver, loads, eq) -> Stability | None:
-    """The stability of a closed-form equilibrium ``eq`` of ``loads`` on ``solver``'s arm:
-    the backward sweep from its base reaction (the internal wrench at s = 0, spatial).
-    None where that reaction is not available (no station at s = 0, or actuators, whose
-    share of the base wrench the closed form does not return)."""
+    """The stability of a closed-form equilibrium ``eq`` of ``loads`` on ``solver``'s arm.
+
+    The straight arm under a dead axial force has its index in closed form; every other
+    closed form gets the backward sweep from its base reaction (the internal wrench at
+    s = 0, spatial) and its tip pose (when the last station is s = L), on a grid that
+    resolves the Jacobi fields (:func:`_closed_form_steps`). None where the base reaction is
+    not available (no station at s = 0, or actuators, whose share of the base wrench the
+    closed form does not return)."""
     if eq.s[0] != 0.0:
         return None
+    data = solver._data
+    if eq.method == "analytic.axial_force":
+        index = _axial_index(eq, data, as_loads(loads))
+        if index is not None:
+            return make(index, np.ones(index.shape, dtype=bool), index.shape)
     _, shape, count, _, channels = solver._prepare(loads)
     if channels.actuators:
         return None
     xs = np.concatenate([eq.forces_spatial[..., 0, :], eq.moments_spatial[..., 0, :]], -1)
     xs = np.ascontiguousarray(np.broadcast_to(xs, (*shape, 6)).reshape(count, 6))
-    Ns = np.full(count, CLOSED_FORM_STEPS, dtype=np.float64)
-    return verdict(channels, solver._base_kernel, xs, Ns, shape)
+    tips = None
+    if eq.s[-1] == solver.length:
+        tips = np.broadcast_to(eq.poses[..., -1, :, :], (*shape, 4, 4)).reshape(count, 4, 4)
+    return verdict(channels, solver._base_kernel, xs, _closed_form_steps(channels, data),
+                   shape, tips)
