@@ -30,6 +30,17 @@ def timed(function, repeats):
     return statistics.median(wall), statistics.median(cpu)
 
 
+def paired(without, with_, repeats):
+    """Median wall and CPU times of two functions timed in alternation (the machine's load
+    drifts; alternating shares it between the two)."""
+    a, b = [], []
+    for _ in range(repeats):
+        a.append(timed(without, 1))
+        b.append(timed(with_, 1))
+    return (statistics.median(x[0] for x in a), statistics.median(x[1] for x in a),
+            statistics.median(x[0] for x in b), statistics.median(x[1] for x in b))
+
+
 def solve_cases():
     round_arm = Arm.from_stiffness(1.0, EA=1e6, GAy=1e6, GAz=1e6, GJ=1.0, EIy=1.0, EIz=1.0,
                                    mass_per_length=1.0)
@@ -38,11 +49,11 @@ def solve_cases():
     rng = np.random.default_rng(1)
     forces = rng.normal(size=(1000, 3))
     return [
-        ("3D tip force (k = 5)", round_arm, TipLoad(force=[0.0, 3.0, 4.0]), 50),
-        ("upright heavy column, q = 0.9 q_c", round_arm, Gravity([-0.9 * 7.8373, 0, 0]), 50),
+        ("3D tip force (k = 5)", round_arm, TipLoad(force=[0.0, 3.0, 4.0]), 200),
+        ("upright heavy column, q = 0.9 q_c", round_arm, Gravity([-0.9 * 7.8373, 0, 0]), 200),
         ("soft arm: gravity + 3D tip force", soft,
-         [Gravity(), TipLoad(force=[0.0, 0.02, -0.05])], 50),
-        ("batch of 1000 random tip forces", round_arm, TipLoad(force=forces), 3),
+         [Gravity(), TipLoad(force=[0.0, 0.02, -0.05])], 200),
+        ("batch of 1000 random tip forces", round_arm, TipLoad(force=forces), 7),
     ]
 
 
@@ -53,11 +64,29 @@ def main():
     for name, arm, loads, repeats in solve_cases():
         for stability in (True, False):  # compile both
             softarm.solve(arm, loads, method="numeric", stability=stability)
-        w1, c1 = timed(lambda arm=arm, loads=loads: softarm.solve(
-            arm, loads, method="numeric", stability=False), repeats)
-        w2, c2 = timed(lambda arm=arm, loads=loads: softarm.solve(
-            arm, loads, method="numeric", stability=True), repeats)
+        w1, c1, w2, c2 = paired(
+            lambda arm=arm, loads=loads: softarm.solve(arm, loads, method="numeric",
+                                                       stability=False),
+            lambda arm=arm, loads=loads: softarm.solve(arm, loads, method="numeric",
+                                                       stability=True), repeats)
         print(f"{name:40s} {1e3 * w1:10.3f} {1e3 * w2:12.3f} {(w2 - w1) / w1:7.1%} "
+              f"{(c2 - c1) / c1:9.1%}")
+    print()
+    print("closed forms, 10^4 cases, 11 stations (softarm.solve, method='auto')")
+    arm = Arm.from_stiffness(1.0, EA=1e6, GAy=1e6, GAz=1e6, GJ=1.0, EIy=1.0, EIz=1.0)
+    rng = np.random.default_rng(0)
+    axial = np.zeros((10000, 3))
+    axial[:, 0] = rng.uniform(-5.0, 5.0, 10000)
+    for name, loads in (("axial force (closed-form index)", TipLoad(force=axial)),
+                        ("tip moment, helix (swept)", TipLoad(moment=rng.normal(size=(10000, 3))))):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            for stability in (True, False):
+                softarm.solve(arm, loads, s=11, stability=stability)
+            w1, c1, w2, c2 = paired(
+                lambda loads=loads: softarm.solve(arm, loads, s=11, stability=False),
+                lambda loads=loads: softarm.solve(arm, loads, s=11, stability=True), 5)
+        print(f"{name:40s} {1e3 * w1:10.1f} {1e3 * w2:12.1f} {(w2 - w1) / w1:7.1%} "
               f"{(c2 - c1) / c1:9.1%}")
     print()
     print("critical_load (default steps 256, refined until two grids agree to 1e-9)")
