@@ -185,10 +185,10 @@ def solve_prepared(solver: Solver, loads, method="auto") -> Equilibrium:
 
                 result = dataclasses.replace(
                     result, stability=closed_form_verdict(solver, loads, result))
-            return warn_unstable(result)
+            return warn_unstable(result, 4)
         if method == "analytic":
             raise ValueError(
                 "method='analytic' but no exact closed form applies to this arm and these "
                 "loads; use method='auto' or 'numeric'"
             )
-    return warn_unstable(solver.solve_from_unloaded(loads))
+    return warn_unstable(solver.solve_from_unloaded(loads), 4)
