@@ -10,8 +10,8 @@ from . import analytic, routing, sweep
 from .case import Case, CaseError, load_case
 from .control import InverseResult, InverseSolver, inverse
 from .dispatch import solve
-from .equilibrium import Equilibrium
-from .errors import ApproximationWarning, ConvergenceError
+from .equilibrium import Equilibrium, Stability
+from .errors import ApproximationWarning, ConvergenceError, StabilityWarning
 from .loads import (
     Chamber,
     DistributedForce,
@@ -24,16 +24,19 @@ from .loads import (
     TipLoad,
 )
 from .model import Arm, Circle, Material, Rectangle, Rigidities, Section, SegmentedArm, Tube
+from .stability import Branch, CriticalPoint, continuation, critical_load
 from .sweep import open_sweep
 
 __all__ = [
     "ApproximationWarning",
     "Arm",
+    "Branch",
     "Case",
     "CaseError",
     "Chamber",
     "Circle",
     "ConvergenceError",
+    "CriticalPoint",
     "DistributedForce",
     "DistributedMoment",
     "Equilibrium",
@@ -48,11 +51,15 @@ __all__ = [
     "Rigidities",
     "Section",
     "SegmentedArm",
+    "Stability",
+    "StabilityWarning",
     "Tendon",
     "TipLoad",
     "Tube",
     "__version__",
     "analytic",
+    "continuation",
+    "critical_load",
     "inverse",
     "load_case",
     "open_sweep",

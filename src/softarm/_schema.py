@@ -182,7 +182,8 @@ ROUTING: dict[str, Schema] = {
 #: ``[solve]``: the keys of :class:`softarm.case.SolveOptions` (which checks the values).
 SOLVE = (Field("method", "text", choices=("auto", "numeric")),
          Field("stations", "integer"),
-         Field("tol", "number", "units of the arm length"))
+         Field("tol", "number", "units of the arm length"),
+         Field("branch", "text", choices=("connected", "stable")))
 
 #: ``[inverse]`` (:class:`softarm.case.InverseTask`): the target of ``softarm inverse``.
 INVERSE = (Key("target", "vector", "m", required=True),

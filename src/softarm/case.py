@@ -79,11 +79,15 @@ class SolveOptions:
     tol : float
         Tolerance of the numerical solver: tip-position error relative to the arm length, in
         [1e-13, 0.1] (see ``softarm.solve``).
+    branch : str
+        ``"connected"`` (the equilibrium connected to the unloaded arm, with a stability
+        warning if it is unstable) or ``"stable"`` (``softarm.solve(..., branch="stable")``).
     """
 
     method: str = "auto"
     stations: int = 101
     tol: float = 1e-8
+    branch: str = "connected"
 
     def __post_init__(self):
         object.__setattr__(self, "stations", count(self.stations, "SolveOptions.stations", 2))
@@ -92,6 +96,9 @@ class SolveOptions:
         except (TypeError, ValueError) as error:
             raise type(error)(f"SolveOptions.{error}") from None
         object.__setattr__(self, "tol", tol)
+        if self.branch not in ("connected", "stable"):
+            raise ValueError(f"SolveOptions.branch must be 'connected' or 'stable', got "
+                             f"{self.branch!r}")
 
 
 @dataclass(frozen=True)

@@ -34,6 +34,7 @@ import signal
 import sys
 import threading
 import time
+import warnings
 from collections.abc import Sequence
 from importlib import resources
 from pathlib import Path
@@ -42,7 +43,7 @@ import numpy as np
 
 from . import __version__
 from .case import Case, CaseError, load_case
-from .errors import ConvergenceError
+from .errors import ConvergenceError, StabilityWarning
 from .io import FORMATS, load_saved, save_result
 from .sweep import solve_case
 
@@ -153,6 +154,19 @@ def _parser() -> argparse.ArgumentParser:
     solve.add_argument("--tol", type=_tolerance,
                        help="tip position tolerance relative to the arm length (default 1e-8)")
     solve.set_defaults(run=_run_solve)
+
+    critical = commands.add_parser(
+        "critical", help="the critical load factor of a case and its buckling mode",
+        description="Scale the case's loads (or those given with --vary) by a load factor λ "
+        "from 0 and print the smallest λ at which the arm loses stability (softarm."
+        "critical_load), its kind (fold or bifurcation), nullity and mode.")
+    critical.add_argument("case", metavar="CASE.toml", help="case file (no [sweep])")
+    critical.add_argument("--vary", type=int, action="append", metavar="K",
+                          help="scale only load K (counted from 1 as in the file; may be "
+                          "repeated); the others are held at their value")
+    critical.add_argument("--max-factor", type=_tolerance, default=10.0, metavar="F",
+                          help="largest load factor searched (default 10)")
+    critical.set_defaults(run=_run_critical)
 
     plot = commands.add_parser("plot", help="re-plot a saved result",
                                description="Re-plot a result written by 'softarm solve -o'.")
@@ -354,14 +368,68 @@ def _solve(case: Case, args) -> tuple:
     if case.sweep is None:
         notice.start()
     try:
-        result = solve_case(case, method=args.method, stations=args.stations, tol=args.tol,
-                            progress=progress)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", StabilityWarning)
+            result = solve_case(case, method=args.method, stations=args.stations,
+                                tol=args.tol, progress=progress)
     except (ValueError, TypeError) as error:  # the solver rejected the case's data
         raise CaseError(f"{case.source or case.name}: {error}") from None
     finally:
         notice.cancel()
         progress.close()
+    for warning in caught:  # one line each on stderr; anything else as Python shows it
+        if issubclass(warning.category, StabilityWarning):
+            print(_line(f"softarm: warning: {str(warning.message).removeprefix('softarm: ')}"),
+                  file=sys.stderr)
+        else:
+            warnings.showwarning(warning.message, warning.category, warning.filename,
+                                 warning.lineno)
     return result, time.perf_counter() - start
+
+
+def _run_critical(args) -> int:
+    case = load_case(args.case)
+    if case.sweep is not None:
+        raise CaseError(f"{case.source or case.name}: softarm critical takes a case without "
+                        "[sweep] (the load factor is the sweep)")
+    vary = None
+    if args.vary:
+        for k in args.vary:
+            if not 1 <= k <= len(case.loads):
+                raise CaseError(f"--vary {k}: the case has {len(case.loads)} loads "
+                                "(counted from 1)")
+        vary = [case.loads[k - 1] for k in args.vary]
+    from .stability import critical_load
+
+    start = time.perf_counter()
+    point = critical_load(case.arm, case.loads, vary, max_factor=args.max_factor)
+    seconds = time.perf_counter() - start
+    from .plot import describe_loads
+
+    lines = [f"case      {case.name}" + (f"  ({case.source})" if case.source else ""),
+             f"loads     {describe_loads(case.loads, None)}",
+             "varied    " + ("all loads" if vary is None else
+                            ", ".join(f"load {k}" for k in args.vary))]
+    if point is None:
+        lines.append(f"critical  none: stable up to load factor {args.max_factor:g}")
+    else:
+        mode = point.mode
+        lines += [
+            f"critical  load factor λc = {point.factor:.12g} ({point.kind}, nullity "
+            f"{point.nullity}; Morse index {point.index_before} -> {point.index_after})",
+        ]
+        for i in range(point.nullity):
+            tip = mode.displacement[i, -1]
+            k = int(np.argmax(np.linalg.norm(mode.displacement[i], axis=-1)))
+            lines += [
+                f"mode {i + 1}    base reaction change (null vector of ∂r/∂x) "
+                f"{_vector(mode.base_reaction[i])} (N, N m)",
+                f"          tip displacement direction {_vector(tip)}, largest at s = "
+                f"{mode.s[k]:.4g} m",
+            ]
+    lines.append(f"time      {seconds:.3g} s")
+    print("\n".join(lines))
+    return 0
 
 
 def _outputs(args) -> tuple[list[Path], Path | None]:
@@ -713,8 +781,24 @@ def _summary(case: Case, result, seconds: float) -> str:
             lines.append(f"base      total wrench (clamp and actuators) force "
                          f"{_vector(result.base_wrench[:3])} N, moment "
                          f"{_vector(result.base_wrench[3:])} N m")
+        if result.stability is not None:
+            lines.append(f"stability {_verdict(result.stability)}")
     lines.append(f"time      {seconds:.3g} s")
     return "\n".join(lines)
+
+
+def _verdict(verdict) -> str:
+    """One case's stability verdict in words."""
+    index = int(verdict.index)
+    if index < 0:
+        return "critical (a conjugate point at the clamp: neither stable nor unstable)"
+    if not verdict.conservative:
+        return (f"not decided: follower loads or dead couples are not conservative (Morse "
+                f"index {index}{', odd: unstable by divergence' if index % 2 else ''})")
+    if index == 0:
+        return "stable (Morse index 0)"
+    return (f"UNSTABLE (Morse index {index}: a real arm would move away; solve with "
+            "branch = \"stable\")")
 
 
 def _sweep_table(case: Case, result) -> str:
@@ -730,4 +814,10 @@ def _sweep_table(case: Case, result) -> str:
             f"{'max |κ2,κ3| 1/m':>16} {'residual':>9}")
     rows = [f"{v:>26.6g}  {t[0]:>11.5g} {t[1]:>11.5g} {t[2]:>11.5g} {k:>16.4g} {r:>9.1e}"
             for v, t, k, r in zip(values, tips, curvature.reshape(-1), residual, strict=True)]
+    if result.stability is not None:  # the Morse index, * where the verdict is undecided
+        head += f" {'index':>6}"
+        index = np.broadcast_to(result.stability.index, result.batch_shape).reshape(-1)
+        sure = np.broadcast_to(result.stability.conservative, result.batch_shape).reshape(-1)
+        rows = [f"{row} {i:>5d}{' ' if c else '*'}"
+                for row, i, c in zip(rows, index, sure, strict=True)]
     return "sweep\n" + "\n".join(["  " + head, *("  " + r for r in rows)])

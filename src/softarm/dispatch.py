@@ -7,11 +7,13 @@ this module is the only place that knows both.
 from __future__ import annotations
 
 import dataclasses
+import warnings
 
 import numpy as np
 
 from .analytic.exact import closed_form
 from .equilibrium import Equilibrium
+from .errors import StabilityWarning
 from .statics import Solver
 
 __all__ = ["METHODS", "solve", "solve_prepared"]
@@ -43,7 +45,7 @@ def _closed_form(arm, loads, shape, s, H0) -> Equilibrium | None:
 
 
 def solve(arm, loads, *, method="auto", s=None, tol=1e-8, base=None, jacobians=False,
-          **options) -> Equilibrium:
+          branch=None, imperfection=None, **options) -> Equilibrium:
     """Static equilibrium of a clamped arm under any combination of loads.
 
     The answer is defined: the equilibrium connected to the unloaded arm along the
@@ -79,9 +81,18 @@ def solve(arm, loads, *, method="auto", s=None, tol=1e-8, base=None, jacobians=F
         station compliances ``compliance`` (B..., N, 6, 6): (δp; δθ), spatial, per unit extra
         dead tip wrench (δF; δM), spatial (δR = δθ~ R), from the variational equations and
         the implicit function theorem. Forces the numerical route.
+    branch : None or "stable"
+        None: the equilibrium connected to the unloaded arm, with a
+        :class:`~softarm.StabilityWarning` if it is unstable. "stable": a stable
+        equilibrium instead (single load case, numerical route): the loading path's first
+        critical point is located, the branch switched along the null vector of ∂r/∂x
+        there and followed to the full load (docs/stability.md).
+    imperfection : array_like (3,), optional
+        With ``branch="stable"``: a spatial direction for the tip's displacement that picks
+        one of two mirror branches (default: the mode's own sign).
     **options
         Passed to :class:`softarm.statics.Solver` (``max_iterations``, ``max_load_step``,
-        ``steps``, ``max_steps``, ``max_shootings``); checked on every route.
+        ``steps``, ``max_steps``, ``max_shootings``, ``stability``); checked on every route.
 
     Returns
     -------
@@ -113,12 +124,45 @@ def solve(arm, loads, *, method="auto", s=None, tol=1e-8, base=None, jacobians=F
     solver = Solver(arm, s=s, tol=tol, base=base, **options)
     if not isinstance(jacobians, (bool, np.bool_)):
         raise TypeError(f"jacobians must be True or False, got {jacobians!r}")
+    if branch not in (None, "stable"):
+        raise ValueError(f"branch must be None or 'stable', got {branch!r}")
+    if imperfection is not None and branch != "stable":
+        raise ValueError("imperfection chooses a buckled branch: it needs branch='stable'")
+    if branch == "stable":
+        if jacobians or method == "analytic" or not solver.stability:
+            raise ValueError("branch='stable' needs the numerical route with its stability "
+                             "verdict (method 'auto' or 'numeric', no jacobians, "
+                             "stability=True)")
+        from .stability import solve_stable
+
+        return warn_unstable(solve_stable(solver, loads, imperfection))
     if jacobians:
         if method == "analytic":
             raise ValueError("jacobians=True needs the numerical route; use method='auto' or "
                              "'numeric'")
-        return solver.solve_from_unloaded(loads, jacobians=True)
+        return warn_unstable(solver.solve_from_unloaded(loads, jacobians=True))
     return solve_prepared(solver, loads, method)
+
+
+def warn_unstable(eq: Equilibrium, stacklevel: int = 3) -> Equilibrium:
+    """``eq``, after a :class:`~softarm.StabilityWarning` if any of its cases is unstable."""
+    verdict = eq.stability
+    if verdict is None:
+        return eq
+    unstable = np.asarray(verdict.unstable)
+    if not np.any(unstable):
+        return eq
+    index = np.asarray(verdict.index)
+    first = tuple(int(i) for i in np.unravel_index(
+        int(np.flatnonzero(unstable.ravel())[0]), index.shape)) if index.shape else ()
+    where = f" (load case {first}, and {int(unstable.sum()) - 1} more)" if index.shape else ""
+    warnings.warn(
+        f"softarm: the equilibrium returned is unstable{where}: Morse index "
+        f"{int(index[first])}, {int(index[first])} independent direction(s) in which a real "
+        "arm would move away from it. Use solve(..., branch='stable') for a stable "
+        "equilibrium under the same loads, or softarm.critical_load to find where stability "
+        "is lost.", StabilityWarning, stacklevel=stacklevel)
+    return eq
 
 
 #: The solver options that are numbers: real (float) or integer ones.
@@ -140,10 +184,15 @@ def solve_prepared(solver: Solver, loads, method="auto") -> Equilibrium:
         loads, shape = solver.check_loads(loads)
         result = _closed_form(solver.arm, loads, shape, solver.s, solver.base)
         if result is not None:
-            return result
+            if solver.stability:
+                from .statics.stability import closed_form_verdict
+
+                result = dataclasses.replace(
+                    result, stability=closed_form_verdict(solver, loads, result))
+            return warn_unstable(result, 4)
         if method == "analytic":
             raise ValueError(
                 "method='analytic' but no exact closed form applies to this arm and these "
                 "loads; use method='auto' or 'numeric'"
             )
-    return solver.solve_from_unloaded(loads)
+    return warn_unstable(solver.solve_from_unloaded(loads), 4)

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Equilibrium"]
+__all__ = ["Equilibrium", "Stability"]
 
 
 def _read_only_throughout(array: np.ndarray) -> bool:
@@ -31,6 +31,55 @@ def _frozen(array) -> np.ndarray:
     array = np.array(array, dtype=np.float64)
     array.setflags(write=False)
     return array
+
+
+@dataclass(frozen=True, eq=False)
+class Stability:
+    """The stability verdict of an equilibrium (docs/stability.md), per load case.
+
+    Attributes
+    ----------
+    index : int or ndarray of int, shape (B...)
+        The Morse index: the number of independent directions in which the equilibrium is
+        unstable (conjugate points of the backward sweep on [0, L), counted with their
+        multiplicity). 0: no unstable direction. -1: a conjugate point at the clamp itself
+        (a critical equilibrium, neither stable nor unstable to first order).
+    conservative : bool or ndarray of bool, shape (B...)
+        False for follower loads and dead couples (nonconservative in 3D, Ziegler): the
+        static test then cannot prove stability (an odd index still proves divergence).
+    stable : bool or ndarray of bool, shape (B...)
+        ``index == 0 and conservative``.
+    """
+
+    index: int | np.ndarray
+    conservative: bool | np.ndarray
+    stable: bool | np.ndarray
+
+    @classmethod
+    def of(cls, index, conservative, shape=None) -> Stability:
+        """The verdict of batch shape ``shape`` (default: index's own) from the indices and
+        the conservative flags (plain Python scalars for shape ())."""
+        index = np.asarray(index, dtype=np.int64)
+        shape = index.shape if shape is None else tuple(shape)
+        index = index.reshape(shape)
+        conservative = np.asarray(conservative, dtype=bool)
+        conservative = (conservative.reshape(shape) if conservative.size == index.size
+                        else np.broadcast_to(conservative, shape)).copy()
+        stable = (index == 0) & conservative
+        if shape == ():
+            return cls(int(index), bool(conservative), bool(stable))
+        index = index.copy()
+        for array in (index, conservative, stable):
+            array.setflags(write=False)
+        return cls(index, conservative, stable)
+
+    @property
+    def unstable(self):
+        """Proven unstable: index > 0 (for a nonconservative load only an odd index is a
+        proof, a divergence; an even one is reported but proves nothing)."""
+        index = np.asarray(self.index)
+        out = (index > 0) & (np.asarray(self.conservative) | (index % 2 == 1))
+        return out if out.shape else bool(out)
 
 
 @dataclass(frozen=True, eq=False)
@@ -119,6 +168,7 @@ class Equilibrium:
     tendon_tensions: np.ndarray | None = None
     tendon_lengths: np.ndarray | None = None
     tendon_length_changes: np.ndarray | None = None
+    stability: Stability | None = None
 
     def __post_init__(self):
         for name in ("s", "poses", "strains", "stresses"):

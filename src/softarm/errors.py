@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-__all__ = ["ApproximationWarning", "CaseError", "CaseTypeError", "ConvergenceError"]
+__all__ = ["ApproximationWarning", "CaseError", "CaseTypeError", "ConvergenceError",
+           "StabilityWarning"]
 
 
 class ConvergenceError(RuntimeError):
@@ -41,3 +42,8 @@ class CaseError(ValueError):
 class CaseTypeError(CaseError, TypeError):
     """A value of the wrong type in a case file (a string, bool or array where a number is
     expected, ...): a :class:`CaseError` that is also a TypeError, as the library raises."""
+
+
+class StabilityWarning(UserWarning):
+    """An equilibrium returned is unstable: a real arm would move away from it (its Morse
+    index counts the unstable directions)."""

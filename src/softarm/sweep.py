@@ -33,7 +33,7 @@ import numpy as np
 from ._sweep_design import DESIGNS, Design, Parameter
 from ._sweep_run import FIELDS, design_of, open_sweep, process_pool, run, solve_chunk
 from ._validate import check_allocation
-from .equilibrium import Equilibrium
+from .equilibrium import Equilibrium, Stability
 from .loads import LOAD_KINDS, as_loads
 
 if TYPE_CHECKING:
@@ -126,7 +126,9 @@ def _solver():
 
     prepared = {}
 
-    def solve(arm, loads, *, method="auto", s=None, tol=1e-8):
+    def solve(arm, loads, *, method="auto", s=None, tol=1e-8, branch=None):
+        if branch == "stable":
+            return dispatch.solve(arm, loads, method=method, s=s, tol=tol, branch=branch)
         key = (arm, s, tol)
         if key not in prepared:
             prepared[key] = Solver(arm, s=s, tol=tol)
@@ -172,9 +174,18 @@ def solve_case(case: Case, *, method: str | None = None, stations: int | None = 
               "tol": float(tol if tol is not None else options.tol)}
     steps = len(case.sweep.values) if case.sweep is not None else 1
     check_allocation(steps, kwargs["s"], "")
+    if options.branch == "stable":
+        kwargs["branch"] = "stable"  # one case at a time: each its own stable branch
     if case.sweep is None:
         return solve(case.arm, case.loads, **kwargs)
     loads = case.batched_loads
+    if options.branch == "stable":
+        parts = []
+        for k in range(len(case.sweep.values)):
+            parts.append(_batched(solve(case.arm, _take(loads, k, k + 1), **kwargs)))
+            if progress is not None:
+                progress(k + 1, len(case.sweep.values))
+        return _concatenate(parts, loads)
     total = len(case.sweep.values)
     start = time.perf_counter()
     parts = [solve(case.arm, _take(loads, 0, 1), **kwargs)]
@@ -191,6 +202,21 @@ def solve_case(case: Case, *, method: str | None = None, stations: int | None = 
         if progress is not None:
             progress(done, total)
     return _concatenate(parts, loads)
+
+
+def _batched(eq: Equilibrium) -> Equilibrium:
+    """A single case as a batch of one (branch='stable' solves one case at a time)."""
+    if eq.batch_shape:
+        return eq
+    verdict = eq.stability
+    if verdict is not None:
+        verdict = Stability.of(np.array([verdict.index]), np.array([verdict.conservative]),
+                                 (1,))
+    return replace(eq, poses=eq.poses[None], strains=eq.strains[None],
+                   stresses=eq.stresses[None], residual=np.array([eq.residual]),
+                   error_estimate=np.array([eq.error_estimate]), stability=verdict,
+                   tip_compliance=None, compliance=None, base_wrench=None,
+                   tendon_tensions=None, tendon_lengths=None, tendon_length_changes=None)
 
 
 def _take(loads: tuple, start: int, stop: int) -> tuple:
@@ -213,6 +239,12 @@ def _concatenate(parts: list[Equilibrium], loads: tuple) -> Equilibrium:
         return array
 
     methods = sorted({p.method for p in parts})
+    stability = None
+    if all(p.stability is not None for p in parts):
+        stability = Stability.of(
+            np.concatenate([np.atleast_1d(p.stability.index) for p in parts]),
+            np.concatenate([np.broadcast_to(p.stability.conservative, p.batch_shape)
+                            for p in parts]), (sum(p.batch_shape[0] for p in parts),))
     return Equilibrium(
         s=first.s,
         poses=fields("poses"),
@@ -220,5 +252,5 @@ def _concatenate(parts: list[Equilibrium], loads: tuple) -> Equilibrium:
         stresses=fields("stresses"),
         arm=first.arm, loads=loads, method="+".join(methods),
         exact=all(bool(p.exact) for p in parts),
-        residual=cat("residual"), error_estimate=cat("error_estimate"))
+        residual=cat("residual"), error_estimate=cat("error_estimate"), stability=stability)
 

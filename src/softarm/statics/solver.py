@@ -320,6 +320,9 @@ class Solver:
         Largest number of RK4 steps tried before giving up on ``tol`` (ConvergenceError).
     max_shootings : int
         Budget of trajectory integrations per load case before a ConvergenceError.
+    stability : bool
+        Compute the stability verdict of every case (``Equilibrium.stability``; a backward
+        sweep of the linearised equations, docs/stability.md). Default True.
 
     Examples
     --------
@@ -332,7 +335,8 @@ class Solver:
     """
 
     def __init__(self, arm, *, s=None, tol=1e-8, base=None, max_iterations=12,
-                 max_load_step=1.0, steps=None, max_steps=_N_MAX, max_shootings=10000):
+                 max_load_step=1.0, steps=None, max_steps=_N_MAX, max_shootings=10000,
+                 stability=True):
         self.arm = _check_arm(arm)
         self._data = _arm_data(arm)
         self.length = self._data.length
@@ -358,6 +362,9 @@ class Solver:
         self.steps = steps
         self.max_steps = count(max_steps, "max_steps", 4)
         self.max_shootings = count(max_shootings, "max_shootings", 1)
+        if not isinstance(stability, (bool, np.bool_)):
+            raise TypeError(f"stability must be True or False, got {stability!r}")
+        self.stability = bool(stability)
         self._coarse_ratio = 4  # the path runs on N / 4 steps (benchmarks/run.py measures it)
         self.reset()
 
@@ -506,6 +513,13 @@ class Solver:
                 jac, motion, shape)
             actuation.update(actuation_jacobian=tip_inputs,
                              station_actuation_jacobian=station_inputs)
+        if self.stability:
+            from .stability import verdict
+
+            # from the tip (the last station when it is s = L) on the coarse grid N
+            tips = poses[:, -1] if self.s[-1] == self.length else None
+            actuation["stability"] = verdict(channels, self._base_kernel, base_wrench,
+                                             info[:, 4], shape, tips)
         # fresh arrays, frozen before reshaping: Equilibrium takes them without a copy
         for array in (poses, strains, stresses, info):
             array.setflags(write=False)
@@ -538,6 +552,26 @@ class Solver:
                 cache.pop(next(iter(cache)))
             cache[key] = _input_channels(loads, pieces, self._data, width)
         return cache[key]
+
+    def solve_near(self, loads, x, steps: int) -> Equilibrium:
+        """The equilibrium of the single case ``loads`` continued from the base reaction
+        ``x`` (N, N m, spatial), a solution on ``steps`` RK4 steps over the arm (from
+        continuation), refined to tol like any solve: the branch x is on, not the one
+        connected to the unloaded arm. Leaves this Solver at that equilibrium."""
+        k = _kernels()
+        self.reset()
+        _, shape, _, pieces, channels = self._prepare(loads)
+        if shape != ():
+            raise ValueError(f"Solver.solve_near takes a single load case, got batch shape "
+                             f"{shape}")
+        self._last = (pieces[0], channels.piece[0].copy(), channels.tip_loads[0].copy(),
+                      channels.signature())
+        memory = np.zeros(k.MEMORY)
+        memory[0:6] = memory[6:12] = np.asarray(x, dtype=np.float64)
+        memory[12] = max(1, int(steps) // 2)
+        memory[13] = 1.0
+        self._memory = memory
+        return self.solve(loads)
 
     def shoot(self, loads, x, load_factor=1.0, *, steps=None) -> ShootResult:
         """One integration from the base reaction ``x`` = (n(0); m(0)) (N, N m, spatial) at

@@ -31,7 +31,7 @@ GATED = ("pass", "fail")
 
 #: The reference tables shipped in ``softarm/validation/data`` (each with its provenance).
 TABLES = ("mattiasson_cantilever.json", "princeton_beam.json", "rod_benchmarks.json",
-          "actuation_benchmarks.json")
+          "actuation_benchmarks.json", "buckling.json")
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,128 @@
+"""Stability of equilibria by the backward sweep of the linearised equations (docs/stability.md).
+
+The numerical work is in :mod:`softarm.statics._kernels` (``stability_cases``,
+``sweep_point``); this module prepares its inputs and reads its outputs.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..equilibrium import Stability
+from ..loads import TipLoad, as_loads
+
+__all__ = ["conservative", "verdict"]
+
+
+def _k():
+    from .solver import _kernels
+
+    return _kernels()
+
+
+def conservative(piece: np.ndarray, tip: np.ndarray) -> np.ndarray:
+    """Per case of the kernel's load channels (piece (B, P, C), tip (B, 12)): False where a
+    follower load (force or couple, distributed, point or at the tip) or a dead couple acts.
+
+    A dead force, gravity, a tendon at fixed tension (potential τ × its length), a chamber at
+    fixed pressure (potential -p × its volume change, linear in the strain) and a hard magnet
+    in a field (potential -(R m)·B(p)) are conservative. A follower load is not (Beck's
+    column). A couple of fixed direction is not conservative in 3D (Ziegler, *Principles of
+    Structural Stability*: the work of an axial couple depends on the path of finite
+    rotations), so a dead couple also makes the static test inconclusive.
+    """
+    k = _k()
+    piece = np.abs(piece)
+    tip = np.abs(tip)
+    follower = (piece[..., k.FF:k.FF + 3].sum((-1, -2)) + piece[..., k.LF:k.LF + 3].sum((-1, -2))
+                + piece[..., k.JF:k.JF + 6].sum((-1, -2)) + tip[..., k.TF:k.TF + 6].sum(-1))
+    couple = (piece[..., k.LD:k.LD + 3].sum((-1, -2))
+              + piece[..., k.JD + 3:k.JD + 6].sum((-1, -2)) + tip[..., k.TD + 3:k.TD + 6].sum(-1))
+    return (follower == 0.0) & (couple == 0.0)
+
+
+def verdict(channels, base, xs, Ns, shape, tips=None, factor=1) -> Stability:
+    """The stability of every case solved by ``solve_cases`` (loads from zero to the
+    channels' values, solution xs), swept on factor × Ns steps; ``tips`` (B, 4, 4): the
+    solution's tip poses (the forward pass to the tip is then skipped)."""
+    k = _k()
+    count = xs.shape[0]
+    index = np.zeros(count, dtype=np.int64)
+    theta0 = np.zeros((count, 6, 6))
+    tips = np.zeros((0, 4, 4)) if tips is None else np.ascontiguousarray(tips)
+    flags = np.empty(count, dtype=np.bool_)
+    k.stability_cases(base, channels.arm_tuple(), (channels.piece, channels.tip_loads), xs,
+                      np.ascontiguousarray(Ns, dtype=np.float64), tips, int(factor), index,
+                      theta0, flags)
+    return make(index, flags, shape)
+
+
+def make(index, conservative_, shape) -> Stability:
+    """A :class:`Stability` of batch shape ``shape``."""
+    return Stability.of(index, conservative_, shape)
+
+
+def _closed_form_steps(channels, data) -> np.ndarray:
+    """RK4 steps for the sweep of each closed-form case: the Jacobi fields vary on the
+    scales 1/√(F/EI) and EI/(F L), EI/M; 8 + 2 (kL + F L²/EI + M L/EI) steps keep h k and
+    the turning per step below about 1/2, in [12, 256]."""
+    k = _k()
+    tip = np.abs(channels.tip_loads)
+    force = np.linalg.norm(tip[:, k.TD:k.TD + 3] + tip[:, k.TF:k.TF + 3], axis=-1)
+    moment = np.linalg.norm(tip[:, k.TD + 3:k.TD + 6] + tip[:, k.TF + 3:k.TF + 6], axis=-1)
+    EI = float(np.min(data.K[:, [4, 5], [4, 5]]))
+    L = data.length
+    n = 8 + 2 * (np.sqrt(force * L * L / EI) + force * L * L / EI + moment * L / EI)
+    return np.clip(np.ceil(n), 12, 256)
+
+
+def _axial_index(eq, data, loads):
+    """The Morse index of the straight arm under a dead axial tip force (a compression P),
+    in closed form, or None where it does not apply: each bending plane loses stability at
+    every P_n with P_n (1 + P_n (1/GA - 1/EA)) = (2n - 1)² π² EI/(4L²) (the linearised
+    extensible, shearable rod; buckling.json, cosserat_cantilever_extensible_shearable)."""
+    K = data.K
+    if K.shape[0] != 1 or np.any(K[0] != np.diag(np.diagonal(K[0]))) or np.any(data.f0[:, 1:]):
+        return None
+    if not all(isinstance(load, TipLoad) and not load.follower for load in loads):
+        return None
+    P = -np.asarray(eq.stresses[..., 0, 0])  # the compression (material axial force)
+    EA, GAy, GAz, _, EIy, EIz = np.diagonal(K[0])
+    L = data.length
+    index = np.zeros(P.shape, dtype=np.int64)
+    for EI, GA in ((EIy, GAz), (EIz, GAy)):
+        c = 1.0 / GA - 1.0 / EA
+        # the n >= 1 with P_n < P: P (1 + c P) > (2n - 1)² Q1, Q1 = π² EI/(4 L²)
+        Q1 = np.pi ** 2 * EI / (4 * L * L)
+        root = np.sqrt(np.maximum(np.where(P > 0, P * (1 + c * P), 0.0), 0.0) / Q1)
+        n = np.ceil((root + 1.0) / 2.0) - 1.0  # the n with 2n - 1 < root
+        index += np.where(P > 0, n, 0).astype(np.int64)
+    return index
+
+
+def closed_form_verdict(solver, loads, eq) -> Stability | None:
+    """The stability of a closed-form equilibrium ``eq`` of ``loads`` on ``solver``'s arm.
+
+    The straight arm under a dead axial force has its index in closed form; every other
+    closed form gets the backward sweep from its base reaction (the internal wrench at
+    s = 0, spatial) and its tip pose (when the last station is s = L), on a grid that
+    resolves the Jacobi fields (:func:`_closed_form_steps`). None where the base reaction is
+    not available (no station at s = 0, or actuators, whose share of the base wrench the
+    closed form does not return)."""
+    if eq.s[0] != 0.0:
+        return None
+    data = solver._data
+    if eq.method == "analytic.axial_force":
+        index = _axial_index(eq, data, as_loads(loads))
+        if index is not None:
+            return make(index, np.ones(index.shape, dtype=bool), index.shape)
+    _, shape, count, _, channels = solver._prepare(loads)
+    if channels.actuators:
+        return None
+    xs = np.concatenate([eq.forces_spatial[..., 0, :], eq.moments_spatial[..., 0, :]], -1)
+    xs = np.ascontiguousarray(np.broadcast_to(xs, (*shape, 6)).reshape(count, 6))
+    tips = None
+    if eq.s[-1] == solver.length:
+        tips = np.broadcast_to(eq.poses[..., -1, :, :], (*shape, 4, 4)).reshape(count, 4, 4)
+    return verdict(channels, solver._base_kernel, xs, _closed_form_steps(channels, data),
+                   shape, tips)
