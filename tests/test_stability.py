@@ -386,3 +386,27 @@ def test_closed_form_axial_index_agrees_with_the_count_and_the_sweep():
     assert closed.method == "analytic.axial_force"
     np.testing.assert_array_equal(closed.stability.index, expected)
     np.testing.assert_array_equal(numeric.stability.index, expected)
+
+
+def test_the_live_app_shows_the_verdict():
+    # an upright heavy column (gravity along -e1), qL³/EI = 10 above Greenhill's 7.8373
+    # (buckling.json): the live app's reply says it is unstable (index 2: a round section
+    # buckles in two planes at once); at qL³/EI = 5 it says stable
+    import tomllib
+
+    from softarm.app import LiveCase
+    from softarm.case import parse_case
+
+    text = """
+[arm]
+length = 1.0
+stiffness = { EA = 1e9, GAy = 1e9, GAz = 1e9, GJ = 1.0, EIy = 1.0, EIz = 1.0 }
+mass_per_length = {mu}
+[[load]]
+kind = "gravity"
+acceleration = [-1.0, 0.0, 0.0]
+"""
+    unstable = LiveCase(parse_case(tomllib.loads(text.replace("{mu}", "10.0")))).solve()
+    assert unstable["stability"].startswith("UNSTABLE (Morse index 2")
+    stable = LiveCase(parse_case(tomllib.loads(text.replace("{mu}", "5.0")))).solve()
+    assert stable["stability"] == "stable (Morse index 0)"

@@ -10,7 +10,8 @@ solver to the unloaded arm.
 Endpoints: ``GET /`` the page; ``GET /plotly.min.js``; ``GET /solve?NAME=VALUE&...`` the
 equilibrium for these inputs (names as listed by ``GET /inputs``; absent ones keep their last
 value) as JSON ``{"data": [...traces], "title", "tip": [x, y, z], "solve_ms", "method",
-"residual"}``; ``GET /reset`` the same after returning to the unloaded arm. A bad request (an
+"residual", "stability"}`` (the verdict in words); ``GET /reset`` the same after returning
+to the unloaded arm. A bad request (an
 unknown name, a value that is not a finite number or is out of its slider's range) gets
 HTTP 400 with ``{"error": message}``; a load the solver cannot follow (a fold, a load too large
 for the arm) gets HTTP 422 with the message, and the arm stays where it was.
@@ -205,7 +206,9 @@ class LiveCase:
                 "data": scene_traces(result, self.scales), "title": _title(self.case, loads),
                 "tip": np.asarray(result.tip_position).tolist(),
                 "solve_ms": 1e3 * seconds, "method": result.method,
-                "residual": float(np.max(result.residual))}
+                "residual": float(np.max(result.residual)),
+                "stability": None if result.stability is None else
+                result.stability.describe()}
 
     def _grow_limits(self, result) -> None:
         """Enlarge the axis cube to hold the drawing of ``result`` (with a 30 % margin the
@@ -343,7 +346,8 @@ async function send(path) {{
     const tip = body.tip.map(v => v.toPrecision(4)).join(", ");
     status.textContent = "tip  (" + tip + ") m\\nsolve  " + body.solve_ms.toFixed(2) +
       " ms (" + body.method + ")\\nserver round trip  " + (t1 - t0).toFixed(1) +
-      " ms\\nredraw  " + (t2 - t1).toFixed(1) + " ms";
+      " ms\\nredraw  " + (t2 - t1).toFixed(1) + " ms" +
+      (body.stability ? "\\nstability  " + body.stability : "");
     status.dataset.tip = JSON.stringify(body.tip);
     window.softarmTimings.push({{solve: body.solve_ms, fetch: t1 - t0, redraw: t2 - t1,
                                 total: t2 - t0}});

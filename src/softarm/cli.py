@@ -782,23 +782,9 @@ def _summary(case: Case, result, seconds: float) -> str:
                          f"{_vector(result.base_wrench[:3])} N, moment "
                          f"{_vector(result.base_wrench[3:])} N m")
         if result.stability is not None:
-            lines.append(f"stability {_verdict(result.stability)}")
+            lines.append(f"stability {result.stability.describe()}")
     lines.append(f"time      {seconds:.3g} s")
     return "\n".join(lines)
-
-
-def _verdict(verdict) -> str:
-    """One case's stability verdict in words."""
-    index = int(verdict.index)
-    if index < 0:
-        return "critical (a conjugate point at the clamp: neither stable nor unstable)"
-    if not verdict.conservative:
-        return (f"not decided: follower loads or dead couples are not conservative (Morse "
-                f"index {index}{', odd: unstable by divergence' if index % 2 else ''})")
-    if index == 0:
-        return "stable (Morse index 0)"
-    return (f"UNSTABLE (Morse index {index}: a real arm would move away; solve with "
-            "branch = \"stable\")")
 
 
 def _sweep_table(case: Case, result) -> str:

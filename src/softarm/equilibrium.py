@@ -73,6 +73,19 @@ class Stability:
             array.setflags(write=False)
         return cls(index, conservative, stable)
 
+    def describe(self) -> str:
+        """The verdict of one (unbatched) case in words, e.g. "stable (Morse index 0)"."""
+        index = int(self.index)
+        if index < 0:
+            return "critical (a conjugate point at the clamp: neither stable nor unstable)"
+        if not self.conservative:
+            return (f"not decided: follower loads or dead couples are not conservative (Morse "
+                    f"index {index}{', odd: unstable by divergence' if index % 2 else ''})")
+        if index == 0:
+            return "stable (Morse index 0)"
+        return (f"UNSTABLE (Morse index {index}: a real arm would move away; solve with "
+                "branch = \"stable\")")
+
     @property
     def unstable(self):
         """Proven unstable: index > 0 (for a nonconservative load only an odd index is a

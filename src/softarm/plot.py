@@ -203,8 +203,10 @@ def plot_equilibrium(result, *, fig=None, path: str | os.PathLike | None = None,
     tip = p[-1]
     fig.suptitle(title if title is not None else
                  _wrapped(f"{name or 'softarm'}: {describe_loads(result.loads)}"), fontsize=11)
+    verdict = "" if result.stability is None else f"; {result.stability.describe()}"
     fig.text(0.02, 0.02, f"tip at {_fmt(tip, 'm')}; method {result.method}"
-             f"{'' if result.exact else ' (approximate)'}", fontsize=8, color="0.3")
+             f"{'' if result.exact else ' (approximate)'}{verdict}", fontsize=8,
+             color="0.1" if "UNSTABLE" in verdict else "0.3")
     return _finish(fig, path)
 
 
