@@ -48,6 +48,10 @@ __all__ = ["MEMORY", "OPTIONS", "PIECE_LOADS", "TIP_LOADS", "shoot", "solve_case
 
 #: numba's cached compile (in memory, with a warning, where the cache cannot be written)
 _jit = partial(jit, what="the shooting solver's kernels")
+#: The same, inlined into its callers at numba's level (the RK4 step and its right-hand side:
+#: left to LLVM, they stay out of line once the actuated path exists, and every station and
+#: step then pays a call that passes the arm's arrays by value)
+_inline = partial(jit, what="the shooting solver's kernels", inline="always")
 
 
 # Status codes returned per load case.
@@ -330,28 +334,23 @@ def _actuated(arm, j):
     return False
 
 
-@_jit
+@_inline
 def _deriv(work, twork, nt, stage, s, arm, j, now, rate, law):
     """F(y) and the right-hand side of the first nt tangent columns, on piece j at arc
     length s.
 
     Reads the state from ``work[4]`` and the tangents from ``twork[4]``; writes F(y) into
-    ``work[stage]`` and the tangent derivatives into ``twork[stage]``. A piece with actuators
-    or a magnetisation goes to :func:`_actuated_deriv`. A passive piece is done here, with
-    the linear law, in scalars (no array views in the innermost loop, no allocation).
+    ``work[stage]`` and the tangent derivatives into ``twork[stage]``. Scalars throughout
+    where it matters: no array views in the passive arm's path, no allocation.
 
-    Design note: the passive path writes out the formulas of :func:`_state_rates` and
-    :func:`_tangent_rates` (which the actuated path calls) on purpose. This function must
-    stay small enough for LLVM to inline it into the RK4 step; through calls with thirty
-    scalar arguments, or with the actuated path in the same body, it is not inlined and a
-    passive solve costs 1.5-2.5× more (measured against 0.1's kernel in alternation).
-    numba's own inlining (``inline="always"``) refuses calls with that many arguments.
+    Design note: this function and :func:`_rk4` are inlined into their callers by numba
+    (``inline="always"``). Left to LLVM, they stay out of line once the actuated path is in
+    the body, and every RK4 step and output station then pays calls that pass the arm's
+    arrays by value: a passive solve measured 1.5-2× slower than 0.1's kernel that way,
+    and at parity inlined. The actuated path's own work is in :func:`_law`.
     """
-    mag = arm[12]
-    if _actuated(arm, j) or mag[j, 0] != 0.0 or mag[j, 1] != 0.0 or mag[j, 2] != 0.0:
-        _actuated_deriv(work, twork, nt, stage, s, arm, j, now, rate, law)
-        return
     C, f0, zero, diag = arm[2], arm[3], arm[4], arm[5]
+    mag = arm[12]
     Y = 4
     R00, R01, R02 = work[Y, _R], work[Y, _R + 1], work[Y, _R + 2]
     R10, R11, R12 = work[Y, _R + 3], work[Y, _R + 4], work[Y, _R + 5]
@@ -365,7 +364,11 @@ def _deriv(work, twork, nt, stage, s, arm, j, now, rate, law):
     s3 = R00 * mx + R10 * my + R20 * mz
     s4 = R01 * mx + R11 * my + R21 * mz
     s5 = R02 * mx + R12 * my + R22 * mz
-    v0, v1, v2, u0, u1, u2 = _strain(C, f0, j, diag, s0, s1, s2, s3, s4, s5)
+    actuated = _actuated(arm, j)
+    if actuated:
+        v0, v1, v2, u0, u1, u2 = _law(arm, j, s, now, law, s0, s1, s2, s3, s4, s5)
+    else:
+        v0, v1, v2, u0, u1, u2 = _strain(C, f0, j, diag, s0, s1, s2, s3, s4, s5)
     # follower loads in spatial components: R f_f, R l_f
     ff0, ff1, ff2 = now[j, _FF], now[j, _FF + 1], now[j, _FF + 2]
     lf0, lf1, lf2 = now[j, _LF], now[j, _LF + 1], now[j, _LF + 2]
@@ -391,195 +394,6 @@ def _deriv(work, twork, nt, stage, s, arm, j, now, rate, law):
     w[_M] = -(py * nz - pz * ny) - (now[j, _LD] + R00 * lf0 + R01 * lf1 + R02 * lf2)
     w[_M + 1] = -(pz * nx - px * nz) - (now[j, _LD + 1] + R10 * lf0 + R11 * lf1 + R12 * lf2)
     w[_M + 2] = -(px * ny - py * nx) - (now[j, _LD + 2] + R20 * lf0 + R21 * lf1 + R22 * lf2)
-    for a in range(18, w.size):
-        w[a] = 0.0  # no tendon runs here
-    for d in range(nt):
-        t = twork[Y, d]
-        th0, th1, th2 = t[_TT], t[_TT + 1], t[_TT + 2]
-        dn0, dn1, dn2 = t[_TN], t[_TN + 1], t[_TN + 2]
-        dm0, dm1, dm2 = t[_TM], t[_TM + 1], t[_TM + 2]
-        # δσ = (Rᵀδn + σ_n × δθ; Rᵀδm + σ_m × δθ); δ(v; u) by the constitutive step
-        c0, c1, c2, c3, c4, c5 = _strain(
-            C, zero, j, diag,
-            R00 * dn0 + R10 * dn1 + R20 * dn2 + s1 * th2 - s2 * th1,
-            R01 * dn0 + R11 * dn1 + R21 * dn2 + s2 * th0 - s0 * th2,
-            R02 * dn0 + R12 * dn1 + R22 * dn2 + s0 * th1 - s1 * th0,
-            R00 * dm0 + R10 * dm1 + R20 * dm2 + s4 * th2 - s5 * th1,
-            R01 * dm0 + R11 * dm1 + R21 * dm2 + s5 * th0 - s3 * th2,
-            R02 * dm0 + R12 * dm1 + R22 * dm2 + s3 * th1 - s4 * th0)
-        # δp' = R (δθ × v + δv)
-        a0 = th1 * v2 - th2 * v1 + c0
-        a1 = th2 * v0 - th0 * v2 + c1
-        a2 = th0 * v1 - th1 * v0 + c2
-        q0 = R00 * a0 + R01 * a1 + R02 * a2
-        q1 = R10 * a0 + R11 * a1 + R12 * a2
-        q2 = R20 * a0 + R21 * a1 + R22 * a2
-        # -R (δθ × f_f) and -R (δθ × l_f), material cross products rotated to spatial
-        b0 = -(th1 * ff2 - th2 * ff1)
-        b1 = -(th2 * ff0 - th0 * ff2)
-        b2 = -(th0 * ff1 - th1 * ff0)
-        e0 = -(th1 * lf2 - th2 * lf1)
-        e1 = -(th2 * lf0 - th0 * lf2)
-        e2 = -(th0 * lf1 - th1 * lf0)
-        if d >= LAM:  # the loads' own change along rate[d - LAM]
-            rr = d - LAM
-            b0 -= rate[rr, j, _FF]
-            b1 -= rate[rr, j, _FF + 1]
-            b2 -= rate[rr, j, _FF + 2]
-            e0 -= rate[rr, j, _LF]
-            e1 -= rate[rr, j, _LF + 1]
-            e2 -= rate[rr, j, _LF + 2]
-        g0 = R00 * b0 + R01 * b1 + R02 * b2
-        g1 = R10 * b0 + R11 * b1 + R12 * b2
-        g2 = R20 * b0 + R21 * b1 + R22 * b2
-        k0 = R00 * e0 + R01 * e1 + R02 * e2
-        k1 = R10 * e0 + R11 * e1 + R12 * e2
-        k2 = R20 * e0 + R21 * e1 + R22 * e2
-        if d >= LAM:
-            rr = d - LAM
-            g0 -= rate[rr, j, _FD]
-            g1 -= rate[rr, j, _FD + 1]
-            g2 -= rate[rr, j, _FD + 2]
-            k0 -= rate[rr, j, _LD]
-            k1 -= rate[rr, j, _LD + 1]
-            k2 -= rate[rr, j, _LD + 2]
-        o = twork[stage, d]
-        o[_TP] = q0
-        o[_TP + 1] = q1
-        o[_TP + 2] = q2
-        o[_TT] = -(u1 * th2 - u2 * th1) + c3
-        o[_TT + 1] = -(u2 * th0 - u0 * th2) + c4
-        o[_TT + 2] = -(u0 * th1 - u1 * th0) + c5
-        o[_TN] = g0
-        o[_TN + 1] = g1
-        o[_TN + 2] = g2
-        # δm' = -δp' × n - p' × δn - R (δθ × l_f) - ∂_λ l
-        o[_TM] = -(q1 * nz - q2 * ny) - (py * dn2 - pz * dn1) + k0
-        o[_TM + 1] = -(q2 * nx - q0 * nz) - (pz * dn0 - px * dn2) + k1
-        o[_TM + 2] = -(q0 * ny - q1 * nx) - (px * dn1 - py * dn0) + k2
-
-
-@_jit
-def _state_rates(w, R00, R01, R02, R10, R11, R12, R20, R21, R22, v0, v1, v2, u0, u1, u2,
-                 nx, ny, nz, now, j):
-    """F(y) of the rod with the loads of piece j (``now[j]``): p' = R v, R' = R û,
-    n' = -(f_d + R f_f), m' = -p' × n - (l_d + R l_f), into w[:18]. Returns p'."""
-    ff0, ff1, ff2 = now[j, _FF], now[j, _FF + 1], now[j, _FF + 2]
-    lf0, lf1, lf2 = now[j, _LF], now[j, _LF + 1], now[j, _LF + 2]
-    px = R00 * v0 + R01 * v1 + R02 * v2
-    py = R10 * v0 + R11 * v1 + R12 * v2
-    pz = R20 * v0 + R21 * v1 + R22 * v2
-    w[_P] = px
-    w[_P + 1] = py
-    w[_P + 2] = pz
-    w[_R] = R01 * u2 - R02 * u1
-    w[_R + 1] = -R00 * u2 + R02 * u0
-    w[_R + 2] = R00 * u1 - R01 * u0
-    w[_R + 3] = R11 * u2 - R12 * u1
-    w[_R + 4] = -R10 * u2 + R12 * u0
-    w[_R + 5] = R10 * u1 - R11 * u0
-    w[_R + 6] = R21 * u2 - R22 * u1
-    w[_R + 7] = -R20 * u2 + R22 * u0
-    w[_R + 8] = R20 * u1 - R21 * u0
-    w[_N] = -(now[j, _FD] + R00 * ff0 + R01 * ff1 + R02 * ff2)
-    w[_N + 1] = -(now[j, _FD + 1] + R10 * ff0 + R11 * ff1 + R12 * ff2)
-    w[_N + 2] = -(now[j, _FD + 2] + R20 * ff0 + R21 * ff1 + R22 * ff2)
-    w[_M] = -(py * nz - pz * ny) - (now[j, _LD] + R00 * lf0 + R01 * lf1 + R02 * lf2)
-    w[_M + 1] = -(pz * nx - px * nz) - (now[j, _LD + 1] + R10 * lf0 + R11 * lf1 + R12 * lf2)
-    w[_M + 2] = -(px * ny - py * nx) - (now[j, _LD + 2] + R20 * lf0 + R21 * lf1 + R22 * lf2)
-    return px, py, pz
-
-
-@_jit
-def _tangent_rates(o, t, d, R00, R01, R02, R10, R11, R12, R20, R21, R22, v0, v1, v2, u0, u1,
-                   u2, c0, c1, c2, c3, c4, c5, nx, ny, nz, px, py, pz, now, rate, j):
-    """The right-hand side o of tangent column d (row t) given its strain change
-    δ(v; u) = (c0..c5):
-
-        δθ' = -u × δθ + δu,   δp' = R (δθ × v + δv),
-        δn' = -R (δθ × f_f) - ∂(f_d + R f_f),   δm' = -δp' × n - p' × δn - R (δθ × l_f) - ∂l,
-
-    the ∂ terms (the loads' own change along ``rate[d - LAM]``) in the load columns only."""
-    ff0, ff1, ff2 = now[j, _FF], now[j, _FF + 1], now[j, _FF + 2]
-    lf0, lf1, lf2 = now[j, _LF], now[j, _LF + 1], now[j, _LF + 2]
-    th0, th1, th2 = t[_TT], t[_TT + 1], t[_TT + 2]
-    dn0, dn1, dn2 = t[_TN], t[_TN + 1], t[_TN + 2]
-    # δp' = R (δθ × v + δv)
-    a0 = th1 * v2 - th2 * v1 + c0
-    a1 = th2 * v0 - th0 * v2 + c1
-    a2 = th0 * v1 - th1 * v0 + c2
-    q0 = R00 * a0 + R01 * a1 + R02 * a2
-    q1 = R10 * a0 + R11 * a1 + R12 * a2
-    q2 = R20 * a0 + R21 * a1 + R22 * a2
-    # -R (δθ × f_f) and -R (δθ × l_f), material cross products rotated to spatial
-    b0 = -(th1 * ff2 - th2 * ff1)
-    b1 = -(th2 * ff0 - th0 * ff2)
-    b2 = -(th0 * ff1 - th1 * ff0)
-    e0 = -(th1 * lf2 - th2 * lf1)
-    e1 = -(th2 * lf0 - th0 * lf2)
-    e2 = -(th0 * lf1 - th1 * lf0)
-    rr = max(d - LAM, 0)
-    if d >= LAM:
-        b0 -= rate[rr, j, _FF]
-        b1 -= rate[rr, j, _FF + 1]
-        b2 -= rate[rr, j, _FF + 2]
-        e0 -= rate[rr, j, _LF]
-        e1 -= rate[rr, j, _LF + 1]
-        e2 -= rate[rr, j, _LF + 2]
-    g0 = R00 * b0 + R01 * b1 + R02 * b2
-    g1 = R10 * b0 + R11 * b1 + R12 * b2
-    g2 = R20 * b0 + R21 * b1 + R22 * b2
-    k0 = R00 * e0 + R01 * e1 + R02 * e2
-    k1 = R10 * e0 + R11 * e1 + R12 * e2
-    k2 = R20 * e0 + R21 * e1 + R22 * e2
-    if d >= LAM:
-        g0 -= rate[rr, j, _FD]
-        g1 -= rate[rr, j, _FD + 1]
-        g2 -= rate[rr, j, _FD + 2]
-        k0 -= rate[rr, j, _LD]
-        k1 -= rate[rr, j, _LD + 1]
-        k2 -= rate[rr, j, _LD + 2]
-    o[_TP] = q0
-    o[_TP + 1] = q1
-    o[_TP + 2] = q2
-    o[_TT] = -(u1 * th2 - u2 * th1) + c3
-    o[_TT + 1] = -(u2 * th0 - u0 * th2) + c4
-    o[_TT + 2] = -(u0 * th1 - u1 * th0) + c5
-    o[_TN] = g0
-    o[_TN + 1] = g1
-    o[_TN + 2] = g2
-    o[_TM] = -(q1 * nz - q2 * ny) - (py * dn2 - pz * dn1) + k0
-    o[_TM + 1] = -(q2 * nx - q0 * nz) - (pz * dn0 - px * dn2) + k1
-    o[_TM + 2] = -(q0 * ny - q1 * nx) - (px * dn1 - py * dn0) + k2
-
-
-@_jit
-def _actuated_deriv(work, twork, nt, stage, s, arm, j, now, rate, law):
-    """:func:`_deriv` on a piece with actuators (the constitutive law :func:`_law`, strain
-    changes by H⁻¹ for all columns at once) or a magnetisation (its force and torque
-    densities and their variations), and the tendons' length rates."""
-    C, f0, zero, diag = arm[2], arm[3], arm[4], arm[5]
-    mag = arm[12]
-    Y = 4
-    R00, R01, R02 = work[Y, _R], work[Y, _R + 1], work[Y, _R + 2]
-    R10, R11, R12 = work[Y, _R + 3], work[Y, _R + 4], work[Y, _R + 5]
-    R20, R21, R22 = work[Y, _R + 6], work[Y, _R + 7], work[Y, _R + 8]
-    nx, ny, nz = work[Y, _N], work[Y, _N + 1], work[Y, _N + 2]
-    mx, my, mz = work[Y, _M], work[Y, _M + 1], work[Y, _M + 2]
-    s0 = R00 * nx + R10 * ny + R20 * nz
-    s1 = R01 * nx + R11 * ny + R21 * nz
-    s2 = R02 * nx + R12 * ny + R22 * nz
-    s3 = R00 * mx + R10 * my + R20 * mz
-    s4 = R01 * mx + R11 * my + R21 * mz
-    s5 = R02 * mx + R12 * my + R22 * mz
-    actuated = _actuated(arm, j)
-    if actuated:
-        v0, v1, v2, u0, u1, u2 = _law(arm, j, s, now, law, s0, s1, s2, s3, s4, s5)
-    else:
-        v0, v1, v2, u0, u1, u2 = _strain(C, f0, j, diag, s0, s1, s2, s3, s4, s5)
-    w = work[stage]
-    px, py, pz = _state_rates(w, R00, R01, R02, R10, R11, R12, R20, R21, R22, v0, v1, v2,
-                              u0, u1, u2, nx, ny, nz, now, j)
     # a hard magnetisation m (material, A m²/m) in B(x) = B0 + G x: force Gᵀ (R m), torque
     # (R m) × B(p) per unit length
     ma0, ma1, ma2 = mag[j, 0], mag[j, 1], mag[j, 2]
@@ -595,14 +409,27 @@ def _actuated_deriv(work, twork, nt, stage, s, arm, j, now, rate, law):
             arm[10][a] == TENDON else 0.0
     if nt == 0:
         return
-    # δ(v; u) = H⁻¹ δσ for all columns at once (one factorisation), with the actuators' own
-    # change along each load column
+    # δσ = (Rᵀδn + σ_n × δθ; Rᵀδm + σ_m × δθ), then δ(v; u) = dstrain δσ (+ the actuators'
+    # own change with λ), all columns at once: one factorisation of H when actuated
     M = law[0]
-    if actuated:
-        for d in range(nt):
+    for d in range(nt):
+        t = twork[Y, d]
+        th0, th1, th2 = t[_TT], t[_TT + 1], t[_TT + 2]
+        dn0, dn1, dn2 = t[_TN], t[_TN + 1], t[_TN + 2]
+        dm0, dm1, dm2 = t[_TM], t[_TM + 1], t[_TM + 2]
+        d0 = R00 * dn0 + R10 * dn1 + R20 * dn2 + s1 * th2 - s2 * th1
+        d1 = R01 * dn0 + R11 * dn1 + R21 * dn2 + s2 * th0 - s0 * th2
+        d2 = R02 * dn0 + R12 * dn1 + R22 * dn2 + s0 * th1 - s1 * th0
+        d3 = R00 * dm0 + R10 * dm1 + R20 * dm2 + s4 * th2 - s5 * th1
+        d4 = R01 * dm0 + R11 * dm1 + R21 * dm2 + s5 * th0 - s3 * th2
+        d5 = R02 * dm0 + R12 * dm1 + R22 * dm2 + s3 * th1 - s4 * th0
+        if actuated:
+            M[0, 6 + d], M[1, 6 + d], M[2, 6 + d] = d0, d1, d2
+            M[3, 6 + d], M[4, 6 + d], M[5, 6 + d] = d3, d4, d5
+        else:
             (M[0, 6 + d], M[1, 6 + d], M[2, 6 + d], M[3, 6 + d], M[4, 6 + d],
-             M[5, 6 + d]) = _dsigma(twork[Y, d], R00, R01, R02, R10, R11, R12, R20, R21, R22,
-                                    s0, s1, s2, s3, s4, s5)
+             M[5, 6 + d]) = _strain(C, zero, j, diag, d0, d1, d2, d3, d4, d5)
+    if actuated:
         for d in range(LAM, nt):
             _actuator_rates(arm, j, rate[d - LAM], law, law[2][4])
             for i in range(6):
@@ -614,37 +441,67 @@ def _actuated_deriv(work, twork, nt, stage, s, arm, j, now, rate, law):
                     M[i, 6 + d] = np.nan
     for d in range(nt):
         t = twork[Y, d]
-        if actuated:
-            c0, c1, c2 = M[0, 6 + d], M[1, 6 + d], M[2, 6 + d]
-            c3, c4, c5 = M[3, 6 + d], M[4, 6 + d], M[5, 6 + d]
-        else:
-            d0, d1, d2, d3, d4, d5 = _dsigma(t, R00, R01, R02, R10, R11, R12, R20, R21, R22,
-                                             s0, s1, s2, s3, s4, s5)
-            c0, c1, c2, c3, c4, c5 = _strain(C, zero, j, diag, d0, d1, d2, d3, d4, d5)
-        o = twork[stage, d]
-        _tangent_rates(o, t, d, R00, R01, R02, R10, R11, R12, R20, R21, R22, v0, v1, v2,
-                       u0, u1, u2, c0, c1, c2, c3, c4, c5, nx, ny, nz, px, py, pz, now, rate, j)
+        th0, th1, th2 = t[_TT], t[_TT + 1], t[_TT + 2]
+        dn0, dn1, dn2 = t[_TN], t[_TN + 1], t[_TN + 2]
+        c0, c1, c2 = M[0, 6 + d], M[1, 6 + d], M[2, 6 + d]
+        c3, c4, c5 = M[3, 6 + d], M[4, 6 + d], M[5, 6 + d]
+        # δp' = R (δθ × v + δv)
+        a0 = th1 * v2 - th2 * v1 + c0
+        a1 = th2 * v0 - th0 * v2 + c1
+        a2 = th0 * v1 - th1 * v0 + c2
+        q0 = R00 * a0 + R01 * a1 + R02 * a2
+        q1 = R10 * a0 + R11 * a1 + R12 * a2
+        q2 = R20 * a0 + R21 * a1 + R22 * a2
+        # -R (δθ × f_f) and -R (δθ × l_f), material cross products rotated to spatial
+        b0 = -(th1 * ff2 - th2 * ff1)
+        b1 = -(th2 * ff0 - th0 * ff2)
+        b2 = -(th0 * ff1 - th1 * ff0)
+        e0 = -(th1 * lf2 - th2 * lf1)
+        e1 = -(th2 * lf0 - th0 * lf2)
+        e2 = -(th0 * lf1 - th1 * lf0)
+        rr = max(d - LAM, 0)  # columns from LAM on: the loads' own change along rate[d - LAM]
+        if d >= LAM:
+            b0 -= rate[rr, j, _FF]
+            b1 -= rate[rr, j, _FF + 1]
+            b2 -= rate[rr, j, _FF + 2]
+            e0 -= rate[rr, j, _LF]
+            e1 -= rate[rr, j, _LF + 1]
+            e2 -= rate[rr, j, _LF + 2]
+        g0 = R00 * b0 + R01 * b1 + R02 * b2
+        g1 = R10 * b0 + R11 * b1 + R12 * b2
+        g2 = R20 * b0 + R21 * b1 + R22 * b2
+        k0 = R00 * e0 + R01 * e1 + R02 * e2
+        k1 = R10 * e0 + R11 * e1 + R12 * e2
+        k2 = R20 * e0 + R21 * e1 + R22 * e2
+        if d >= LAM:
+            g0 -= rate[rr, j, _FD]
+            g1 -= rate[rr, j, _FD + 1]
+            g2 -= rate[rr, j, _FD + 2]
+            k0 -= rate[rr, j, _LD]
+            k1 -= rate[rr, j, _LD + 1]
+            k2 -= rate[rr, j, _LD + 2]
         if magnetic:  # the magnetic force and torque densities' variations
-            _dipole(work[Y], twork[Y], d + 1, ma0, ma1, ma2, now[j],
-                    rate[max(d - LAM, 0), j], law[2][3])
-            for i in range(3):
-                o[_TN + i] -= law[2][3, i]
-                o[_TM + i] -= law[2][3, 3 + i]
-
-
-@_jit
-def _dsigma(t, R00, R01, R02, R10, R11, R12, R20, R21, R22, s0, s1, s2, s3, s4, s5):
-    """δσ = (Rᵀδn + σ_n × δθ; Rᵀδm + σ_m × δθ) of the tangent row t: the change of the
-    material stress resultant (σ_n, σ_m) = (s0..s2, s3..s5)."""
-    th0, th1, th2 = t[_TT], t[_TT + 1], t[_TT + 2]
-    dn0, dn1, dn2 = t[_TN], t[_TN + 1], t[_TN + 2]
-    dm0, dm1, dm2 = t[_TM], t[_TM + 1], t[_TM + 2]
-    return (R00 * dn0 + R10 * dn1 + R20 * dn2 + s1 * th2 - s2 * th1,
-            R01 * dn0 + R11 * dn1 + R21 * dn2 + s2 * th0 - s0 * th2,
-            R02 * dn0 + R12 * dn1 + R22 * dn2 + s0 * th1 - s1 * th0,
-            R00 * dm0 + R10 * dm1 + R20 * dm2 + s4 * th2 - s5 * th1,
-            R01 * dm0 + R11 * dm1 + R21 * dm2 + s5 * th0 - s3 * th2,
-            R02 * dm0 + R12 * dm1 + R22 * dm2 + s3 * th1 - s4 * th0)
+            _dipole(work[Y], twork[Y], d + 1, ma0, ma1, ma2, now[j], rate[rr, j], law[2][3])
+            g0 -= law[2][3, 0]
+            g1 -= law[2][3, 1]
+            g2 -= law[2][3, 2]
+            k0 -= law[2][3, 3]
+            k1 -= law[2][3, 4]
+            k2 -= law[2][3, 5]
+        o = twork[stage, d]
+        o[_TP] = q0
+        o[_TP + 1] = q1
+        o[_TP + 2] = q2
+        o[_TT] = -(u1 * th2 - u2 * th1) + c3
+        o[_TT + 1] = -(u2 * th0 - u0 * th2) + c4
+        o[_TT + 2] = -(u0 * th1 - u1 * th0) + c5
+        o[_TN] = g0
+        o[_TN + 1] = g1
+        o[_TN + 2] = g2
+        # δm' = -δp' × n - p' × δn - R (δθ × l_f) - ∂_λ l
+        o[_TM] = -(q1 * nz - q2 * ny) - (py * dn2 - pz * dn1) + k0
+        o[_TM + 1] = -(q2 * nx - q0 * nz) - (pz * dn0 - px * dn2) + k1
+        o[_TM + 2] = -(q0 * ny - q1 * nx) - (px * dn1 - py * dn0) + k2
 
 
 @_jit
@@ -704,7 +561,7 @@ def _dipole(y, T, which, m0, m1, m2, now, rate, out):
     out[5] = e0 * b1 - e1 * b0 + a0 * g1 - a1 * g0
 
 
-@_jit
+@_inline
 def _rk4(y, T, nt, h, s, arm, j, now, rate, work, twork, law):
     """One RK4 step of length h from arc length s on piece j in place (the state and the
     first nt tangent columns of T), then R ← R (3I - RᵀR)/2: one Björck step towards the
