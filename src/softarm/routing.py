@@ -77,10 +77,12 @@ class Routing:
             total += sum(abs(c) * max(length, 1.0) ** k for k, c in enumerate(coefficients))
         return float(total)
 
-    def kernel_row(self, degree: int) -> np.ndarray:
-        """The solver's routing row (see ``statics/_kernels.py``): bound, helix radius,
-        angular rate 2π n, phase, then ``degree`` coefficients of y and of z."""
+    def kernel_row(self, degree: int, length: float) -> np.ndarray:
+        """The solver's routing row (see ``statics/_kernels.py``) on an arm of this length:
+        the bound of |r|, helix radius, angular rate 2π n, phase, then ``degree``
+        coefficients of y and of z."""
         row = np.zeros(4 + 2 * degree)
+        row[0] = self.bound(length)
         row[1] = self.helix[0]
         row[2] = 2.0 * np.pi * self.helix[1]
         row[3] = self.helix[2]

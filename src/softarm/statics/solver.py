@@ -183,8 +183,7 @@ class _Channels:
         self.tip_loads = np.zeros((count, k.TIP_LOADS))
         self._piece = self.piece.reshape(*shape, P, k.PIECE_LOADS)
         self._tip = self.tip_loads.reshape(*shape, k.TIP_LOADS)
-        self.actuators = []  # (kind code, routing, active rows) per actuator column
-        self.has_field = False
+        self.actuators = []  # (kind code, routing, active rows, span) per actuator column
 
     def _rows(self, span):
         if span is None:
@@ -237,7 +236,6 @@ class _Channels:
 
     def field(self, field, gradient=None):
         k = self.k
-        self.has_field = True
         self._piece[..., :, k.FB:k.FB + 3] += np.asarray(field)[..., None, :]
         if gradient is not None:
             G = np.asarray(gradient).reshape(*np.shape(gradient)[:-2], 9)
@@ -252,8 +250,7 @@ class _Channels:
         kinds = np.zeros(A, dtype=np.int64)
         active = np.zeros((self.starts.size, A))
         for a, (kind, routing, rows, _) in enumerate(self.actuators):
-            routes[a] = routing.kernel_row(degree)
-            routes[a, 0] = routing.bound(self.length)
+            routes[a] = routing.kernel_row(degree, self.length)
             kinds[a] = kind
             active[:, a] = rows
         return (*pieces[:8], pieces[8], routes, kinds, active, pieces[9], pieces[10])
