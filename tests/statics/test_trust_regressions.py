@@ -369,7 +369,11 @@ def test_r6_sweep_direction_that_overflows_cli(tmp_path):
         out = tmp_path / f"{case.stem}.csv"
         run = subprocess.run([sys.executable, "-m", "softarm", "solve", str(case), "-o",
                               str(out)], capture_output=True, text=True, timeout=600)
-        assert run.returncode == 0 and run.stderr == "", (run.returncode, run.stderr)
+        # nothing on stderr but the progress bar, which a slow first run shows (a subprocess
+        # that compiles a kernel variant the suite has not cached yet)
+        said = [line for line in run.stderr.splitlines()
+                if line.strip() and not line.startswith("solving [")]
+        assert run.returncode == 0 and not said, (run.returncode, run.stderr)
         tables.append(np.genfromtxt(out, delimiter=",", skip_header=1))
     np.testing.assert_allclose(tables[0], tables[1], rtol=0, atol=1e-12)
 
