@@ -731,17 +731,18 @@ def _eliminate(M):
     """Gaussian elimination with partial pivoting of the 6 rows of M in place (the first 6
     columns are the matrix, any further ones right-hand sides). Returns the sign of the
     determinant (the permutation's sign times the pivots'), 0.0 if singular."""
-    return _eliminate_upto(M, M.shape[1])
+    return _eliminate_upto(M, 6, M.shape[1])
 
 
 @_jit
-def _eliminate_upto(M, cols):
-    """:func:`_eliminate` on the first ``cols`` columns of M only."""
+def _eliminate_upto(M, n, cols):
+    """:func:`_eliminate` of the first n rows of M, on its first ``cols`` columns only (the
+    first n the matrix)."""
     sign = 1.0
-    for c in range(6):
+    for c in range(n):
         p = c
         best = abs(M[c, c])
-        for i in range(c + 1, 6):
+        for i in range(c + 1, n):
             if abs(M[i, c]) > best:
                 best = abs(M[i, c])
                 p = i
@@ -753,7 +754,7 @@ def _eliminate_upto(M, cols):
                 M[c, k], M[p, k] = M[p, k], M[c, k]
         if M[c, c] < 0.0:
             sign = -sign
-        for i in range(c + 1, 6):
+        for i in range(c + 1, n):
             g = M[i, c] / M[c, c]
             for k in range(c, cols):
                 M[i, k] -= g * M[c, k]
@@ -764,7 +765,7 @@ def _eliminate_upto(M, cols):
 def _eliminate_columns(M, k):
     """Solve M[:, :6] X = M[:, 6:6+k] in place (X overwrites those k columns; M[:, :6] is
     destroyed). Returns the sign of the determinant, 0.0 if singular."""
-    sign = _eliminate_upto(M, 6 + k)
+    sign = _eliminate_upto(M, 6, 6 + k)
     if sign == 0.0:
         return 0.0
     for col in range(6, 6 + k):
@@ -1595,28 +1596,14 @@ def _block(T, nt, length, out):
 
 @_jit
 def _small_solve(A, B, n, work, out):
-    """out = A⁻¹ B for n × n matrices (Gaussian elimination, partial pivoting); False if A
-    is singular."""
+    """out = A⁻¹ B for n × n matrices (:func:`_eliminate_upto` on [A | B]); False if A is
+    singular."""
     for i in range(n):
         for k in range(n):
             work[i, k] = A[i, k]
             work[i, n + k] = B[i, k]
-    for c in range(n):
-        p = c
-        best = abs(work[c, c])
-        for i in range(c + 1, n):
-            if abs(work[i, c]) > best:
-                best = abs(work[i, c])
-                p = i
-        if not best > 0.0:
-            return False
-        if p != c:
-            for k in range(2 * n):
-                work[c, k], work[p, k] = work[p, k], work[c, k]
-        for i in range(c + 1, n):
-            g = work[i, c] / work[c, c]
-            for k in range(c, 2 * n):
-                work[i, k] -= g * work[c, k]
+    if _eliminate_upto(work, n, 2 * n) == 0.0:
+        return False
     for col in range(n):
         for c in range(n - 1, -1, -1):
             acc = work[c, n + col]
@@ -1624,34 +1611,6 @@ def _small_solve(A, B, n, work, out):
                 acc -= work[c, i] * out[i, col]
             out[c, col] = acc / work[c, c]
     return True
-
-
-@_jit
-def _det_small(A, n, work):
-    """The determinant of the n × n matrix A (Gaussian elimination)."""
-    for i in range(n):
-        for k in range(n):
-            work[i, k] = A[i, k]
-    det = 1.0
-    for c in range(n):
-        p = c
-        best = abs(work[c, c])
-        for i in range(c + 1, n):
-            if abs(work[i, c]) > best:
-                best = abs(work[i, c])
-                p = i
-        if not best > 0.0:
-            return 0.0
-        if p != c:
-            det = -det
-            for k in range(n):
-                work[c, k], work[p, k] = work[p, k], work[c, k]
-        det *= work[c, c]
-        for i in range(c + 1, n):
-            g = work[i, c] / work[c, c]
-            for k in range(c, n):
-                work[i, k] -= g * work[c, k]
-    return det
 
 
 @_jit
