@@ -600,6 +600,21 @@ def _rk4(y, T, nt, h, s, arm, j, now, rate, work, twork, law):
 
 
 @_jit
+def _steps(y, T, nt, h, s, n, arm, j, now, rate, work, twork, law):
+    """``n`` RK4 steps of length h (negative: towards the base) from arc length s on piece j,
+    in place.
+
+    Design note: this is the one function the inlined step (:func:`_rk4` with :func:`_deriv`)
+    is compiled into. Every integration (the shooting pass, the output pass, the stability
+    sweep) calls it for a run of steps, so numba and LLVM build and optimise the right-hand
+    side once instead of once per caller (cold compile 110 s -> see statics/README.md), and a
+    call costs once per run of steps, not once per stage.
+    """
+    for i in range(n):
+        _rk4(y, T, nt, h, s + i * h, arm, j, now, rate, work, twork, law)
+
+
+@_jit
 def _jump(y, T, nt, now, rate, j, arm, law):
     """The point wrench at the start of piece j: n and m drop by W_d + R W_f (and their
     tangents by R (δθ × W_f), plus ∂_λ W in the load-factor column), and by the wrench of a
@@ -720,9 +735,8 @@ def _integrate(x, lam, nt, steps, base, arm, case, scratch, r, J):
     _start(y, T, nt, base, x)
     for j in range(piece_len.size):
         _jump(y, T, nt, now, rate, j, arm, law)
-        h = piece_len[j] / steps[j]
-        for i in range(steps[j]):
-            _rk4(y, T, nt, h, piece_start[j] + i * h, arm, j, now, rate, work, twork, law)
+        _steps(y, T, nt, piece_len[j] / steps[j], piece_start[j], steps[j], arm, j, now, rate,
+               work, twork, law)
     _tip_residual(y, T, nt, tip_now, tip_rate, r, J, arm, now, rate, law)
 
 
@@ -1103,10 +1117,22 @@ def _record(x, nt, steps, base, arm, case, lam, scratch, s_out, out, b, r, J):
     k = 0
     ns = s_out.size
     npieces = piece_len.size
+    one = np.int64(1)  # not a literal 1: _steps is compiled once for every caller
     for j in range(npieces):
         _jump(y, T, nt, now, rate, j, arm, law)
         h = piece_len[j] / steps[j]
-        for i in range(steps[j]):
+        i = 0
+        while i < steps[j]:
+            # the steps surely before the next station's step, as one run (one step of
+            # margin against rounding: the step-by-step branch below decides exactly)
+            run = steps[j] - i
+            if k < ns:
+                run = min(run, max(int((s_out[k] - piece_start[j]) / h) - 1 - i, 0))
+            if run > 0:
+                _steps(y, T, nt, h, piece_start[j] + i * h, run, arm, j, now, rate, work,
+                       twork, law)
+                i += run
+                continue
             t0 = piece_start[j] + i * h
             last = j == npieces - 1 and i == steps[j] - 1
             t1 = piece_start[j] + (i + 1) * h if i < steps[j] - 1 else (
@@ -1119,11 +1145,13 @@ def _record(x, nt, steps, base, arm, case, lam, scratch, s_out, out, b, r, J):
                 for d in range(nt):
                     for a in range(NT):
                         Ts[d, a] = T[d, a]
-                _rk4(ys, Ts, nt, s_out[k] - t0, t0, arm, j, now, rate, work, twork, law)
+                _steps(ys, Ts, nt, s_out[k] - t0, t0, one, arm, j, now, rate, work, twork,
+                       law)
                 _write(ys, Ts, nt, j, s_out[k], arm, now, law, poses[k], strains[k],
                        stresses[k], E[k])
                 k += 1
-            _rk4(y, T, nt, h, t0, arm, j, now, rate, work, twork, law)
+            _steps(y, T, nt, h, t0, one, arm, j, now, rate, work, twork, law)
+            i += 1
     for i in range(k, ns):
         _write(y, T, nt, npieces - 1, arm[6], arm, now, law, poses[i], strains[i],
                stresses[i], E[i])
@@ -1693,6 +1721,10 @@ def _sweep(x, lam, steps, base, arm, case, scratch, nt, r, J, states, fields, th
     rate, tip_rate = case[1], case[3]
     length = arm[6]
     scale = arm[7]
+    # no tangents: a variable, not a literal 0, and x copied (it may be read-only), so that
+    # the callees are the same compiled versions as the solver's (one compile, not two)
+    none = nt - nt
+    one = np.int64(1)
     if tip.shape[0] == 4:
         _set_loads(lam, case, now, tip_now)
         for i in range(y.size):
@@ -1701,11 +1733,11 @@ def _sweep(x, lam, steps, base, arm, case, scratch, nt, r, J, states, fields, th
             y[_P + i] = tip[i, 3]
             for k2 in range(3):
                 y[_R + 3 * i + k2] = tip[i, k2]
-        _tip_residual(y, T, 0, tip_now, tip_rate, r, J, arm, now, rate, law)
+        _tip_residual(y, T, none, tip_now, tip_rate, r, J, arm, now, rate, law)
         for i in range(6):
             y[_N + i] = -r[i]  # the total wrench at the tip equals the tip loads
     else:
-        _integrate(x, lam, 0, steps, base, arm, case, scratch, r, J)
+        _integrate(x.copy(), lam, none, steps, base, arm, case, scratch, r, J)
     # seeds: unit rotations of the tip section (and translations with nt = 6), with the δn,
     # δm of the linearised tip loads (follower and dipole terms), so that δr(L) = 0
     for d in range(nt):
@@ -1752,7 +1784,7 @@ def _sweep(x, lam, steps, base, arm, case, scratch, nt, r, J, states, fields, th
         h = piece_len[j] / steps[j]
         for i in range(steps[j] - 1, -1, -1):
             top = piece_start[j] + (i + 1) * h
-            _rk4(y, T, nt, -h, top, arm, j, now, rate, work, twork, law)
+            _steps(y, T, nt, -h, top, one, arm, j, now, rate, work, twork, law)
             _block(T, nt, length, new)
             c = _crossings(old, new, nt, lu, M, _AT_CLAMP if j == 0 and i == 0 else 0.0)
             if c < 0:
