@@ -46,6 +46,10 @@ from .._jit import jit
 __all__ = ["MEMORY", "OPTIONS", "PIECE_LOADS", "TIP_LOADS", "shoot", "solve_cases"]
 
 
+# Integer constants passed to compiled callees are written np.int64(k): a bare literal makes
+# numba compile the callee once more for the type Literal[int](k), and every such version is
+# linked and optimised again in each caller's module (cold compile time).
+
 #: numba's cached compile (in memory, with a warning, where the cache cannot be written)
 _jit = partial(jit, what="the shooting solver's kernels")
 #: The same, inlined into its callers at numba's level (the RK4 step and its right-hand side:
@@ -281,7 +285,7 @@ def _law(arm, j, s, now, law, s0, s1, s2, s3, s4, s5):
             for k in range(6):
                 M[i, k] = H[i, k]
             M[i, 6] = -F[i]
-        if _eliminate_columns(M, 1) == 0.0:
+        if _eliminate_columns(M, np.int64(1)) == 0.0:
             return np.nan, np.nan, np.nan, np.nan, np.nan, np.nan
         size = 0.0
         for i in range(6):
@@ -399,7 +403,7 @@ def _deriv(work, twork, nt, stage, s, arm, j, now, rate, law):
     ma0, ma1, ma2 = mag[j, 0], mag[j, 1], mag[j, 2]
     magnetic = ma0 != 0.0 or ma1 != 0.0 or ma2 != 0.0
     if magnetic:
-        _dipole(work[Y], twork[Y], 0, ma0, ma1, ma2, now[j], rate[0, j], law[2][3])
+        _dipole(work[Y], twork[Y], np.int64(0), ma0, ma1, ma2, now[j], rate[0, j], law[2][3])
         for i in range(3):
             w[_N + i] -= law[2][3, i]
             w[_M + i] -= law[2][3, 3 + i]
@@ -659,7 +663,7 @@ def _dipole_jump(y, T, nt, dipoles, at, now, rate, j, out, ydst, Tdst, sign):
                 Tdst[d, _TN + i] += sign * out[i]
             else:
                 Tdst[i, d] += sign * out[i]
-    _dipole(y, T, 0, m0, m1, m2, now, rate[0, j], out)
+    _dipole(y, T, np.int64(0), m0, m1, m2, now, rate[0, j], out)
     for i in range(6):
         ydst[off + i] += sign * out[i]
 
@@ -745,7 +749,7 @@ def _eliminate(M):
     """Gaussian elimination with partial pivoting of the 6 rows of M in place (the first 6
     columns are the matrix, any further ones right-hand sides). Returns the sign of the
     determinant (the permutation's sign times the pivots'), 0.0 if singular."""
-    return _eliminate_upto(M, 6, M.shape[1])
+    return _eliminate_upto(M, np.int64(6), M.shape[1])
 
 
 @_jit
@@ -779,7 +783,7 @@ def _eliminate_upto(M, n, cols):
 def _eliminate_columns(M, k):
     """Solve M[:, :6] X = M[:, 6:6+k] in place (X overwrites those k columns; M[:, :6] is
     destroyed). Returns the sign of the determinant, 0.0 if singular."""
-    sign = _eliminate_upto(M, 6, 6 + k)
+    sign = _eliminate_upto(M, np.int64(6), 6 + k)
     if sign == 0.0:
         return 0.0
     for col in range(6, 6 + k):
@@ -1447,7 +1451,7 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
                 # the path on a coarse grid (N / coarse_ratio steps) unless that failed
                 n_path = N if fine_path or N <= 6 else max(3, (N + coarse_ratio - 1)
                                                            // coarse_ratio)
-                _fill_steps(length, arm[1], n_path, 1, steps)
+                _fill_steps(length, arm[1], n_path, np.int64(1), steps)
                 for i in range(6):
                     if not warm:
                         x[i] = 0.0
@@ -1477,7 +1481,7 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
                     break
                 # the coarse solution at N, from the end of the path (a checked Newton; from
                 # the last prediction when the path ran on the coarser grid)
-                _fill_steps(length, arm[1], N, 1, steps)
+                _fill_steps(length, arm[1], N, np.int64(1), steps)
                 if not _corrector(x, 1.0, six, steps, base, arm, case, scratch, scale,
                                   dscale, length, threshold, max_iterations,
                                   _DIST_MAX if coarse else _REFINE_MAX, final_step, r, J,
@@ -1493,7 +1497,7 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
                 status[b] = BUDGET
                 break
             # the fine solution, 2N steps (from the coarse one, or where a check left it)
-            _fill_steps(length, arm[1], N, 2, steps)
+            _fill_steps(length, arm[1], N, np.int64(2), steps)
             if not resume:
                 _copy(x, x_f)
             resume = False
@@ -1535,7 +1539,7 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
             # order 4: the coarse N whose fine partner meets tol with a margin
             grow = (estimate / (0.3 * tol)) ** 0.25
             N = min(n_max // 2, max(N + 1, math.ceil(N * grow)))
-            _fill_steps(length, arm[1], N, 1, steps)
+            _fill_steps(length, arm[1], N, np.int64(1), steps)
             _copy(x_f, x)
             path = not _corrector(x, 1.0, six, steps, base, arm, case, scratch, scale, dscale,
                                   length, threshold, max_iterations, _REFINE_MAX, final_step, r, J,
@@ -1552,7 +1556,7 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
                 memory[_MVALID] = 0.0
             continue
         if not recorded:
-            _fill_steps(length, arm[1], N, 2, steps)
+            _fill_steps(length, arm[1], N, np.int64(2), steps)
             _output(x_f, nt_out, steps, base, arm, case, piece_loads[b], tip_loads[b],
                     inputs, scratch, s_out, out, b, r, J, J_out)
             counter[0] += 1
@@ -1850,7 +1854,7 @@ def stability_cases(base, arm, loads, xs, Ns, tips, factor, index, theta0, conse
     piece_loads, tip_loads = loads
     npieces = arm[1].size
     width = piece_loads.shape[2]
-    scratch = _scratch(npieces, width - PIECE_LOADS, 7)
+    scratch = _scratch(npieces, width - PIECE_LOADS, np.int64(7))
     start = np.zeros((npieces, width))
     tip_start = np.zeros(TIP_LOADS)
     r = np.empty(6)
@@ -1878,7 +1882,7 @@ def sweep_point(x, lam, steps, base, arm, case, theta0, states, fields):
     ``states`` (K + 1, 18 + A), ``fields`` (K + 1, 2 nt, 12), K the total number of steps,
     the state and the orthonormalised Jacobi fields at every grid point (with the changes of
     basis, see :func:`_sweep`)."""
-    scratch = _scratch(arm[1].size, case[0].shape[1] - PIECE_LOADS, 7)
+    scratch = _scratch(arm[1].size, case[0].shape[1] - PIECE_LOADS, np.int64(7))
     r = np.empty(6)
     J = np.empty((6, 7))
     return _sweep(x, lam, steps, base, arm, case, scratch, theta0.shape[0], r, J, states,
@@ -1894,7 +1898,7 @@ def record_points(base, arm, loads, xs, steps, s_out, out):
     piece_loads, tip_loads = loads
     npieces = arm[1].size
     width = piece_loads.shape[2]
-    scratch = _scratch(npieces, width - PIECE_LOADS, 7)
+    scratch = _scratch(npieces, width - PIECE_LOADS, np.int64(7))
     start = np.zeros((npieces, width))
     tip_start = np.zeros(TIP_LOADS)
     r = np.empty(6)
