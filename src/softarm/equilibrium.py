@@ -59,6 +59,10 @@ class Stability:
     def of(cls, index, conservative, shape=None) -> Stability:
         """The verdict of batch shape ``shape`` (default: index's own) from the indices and
         the conservative flags (plain Python scalars for shape ())."""
+        if shape == () and np.size(index) == 1 and np.size(conservative) == 1:
+            # one case (the common call of a closed form): scalars, no array work
+            i, c = int(np.ravel(index)[0]), bool(np.ravel(conservative)[0])
+            return cls(i, c, i == 0 and c)
         index = np.asarray(index, dtype=np.int64)
         shape = index.shape if shape is None else tuple(shape)
         index = index.reshape(shape)
