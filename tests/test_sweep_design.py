@@ -213,7 +213,7 @@ def test_progress_counts_cases_with_rate_and_eta():
     from softarm import cli
 
     stream = io.StringIO()
-    progress = cli._CaseProgress(stream, width=10, delay=0.0)
+    progress = cli._Progress(stream, width=10, delay=0.0, label="sweep", unit="cases", rate=True)
     progress.start -= 5.0
     progress(1000, 10000, 0)  # the first report starts the rate clock
     progress.first = (progress.first[0] - 2.0, 1000)  # 2 s ago

@@ -53,22 +53,44 @@ _PICTURE_SUFFIXES = (".png", ".pdf", ".svg")
 
 
 class _Progress:
-    """A plain-text progress bar on stderr, shown only once a run has taken over a second."""
+    """A plain-text progress bar on stderr, shown only once a run has taken over ``delay``
+    seconds and redrawn at most every 0.1 s: ``solving [###...] 12/40 steps, 3.1 s``, or with
+    ``rate=True`` (a sweep) ``sweep [###...] 1200/10000 cases, 512 cases/s, ETA 0:17`` and the
+    number of failed cases. The rate counts from the first report (after resuming)."""
 
-    def __init__(self, stream=None, delay: float = 1.0, width: int = 30):
+    def __init__(self, stream=None, delay: float = 1.0, width: int = 30, *,
+                 label: str = "solving", unit: str = "steps", rate: bool = False):
         self.stream = sys.stderr if stream is None else stream
         self.delay = delay
         self.width = width
+        self.label, self.unit, self.rate = label, unit, rate
         self.start = time.perf_counter()
+        self.first: tuple[float, int] | None = None
         self.shown = False
+        self.last = 0.0
 
-    def __call__(self, done: int, total: int) -> None:
-        elapsed = time.perf_counter() - self.start
-        if elapsed < self.delay and not self.shown:
+    def __call__(self, done: int, total: int, failed: int = 0) -> None:
+        now = time.perf_counter()
+        if self.first is None:
+            self.first = (now, done)
+        if (now - self.start < self.delay or now - self.last < 0.1) and done < total:
             return
-        filled = round(self.width * done / total)
+        if done == total and not self.shown:
+            return  # finished before the bar was due: nothing to show
+        self.last = now
+        filled = round(self.width * done / max(total, 1))
         bar = "#" * filled + "." * (self.width - filled)
-        self.stream.write(f"\rsolving [{bar}] {done}/{total} steps, {elapsed:.1f} s")
+        text = f"\r{self.label} [{bar}] {done}/{total} {self.unit}"
+        if self.rate:
+            elapsed = now - self.first[0]
+            rate = (done - self.first[1]) / elapsed if elapsed > 0 else 0.0
+            if rate > 0:
+                text += f", {rate:.4g} {self.unit}/s, ETA {_duration((total - done) / rate)}"
+        else:
+            text += f", {now - self.start:.1f} s"
+        if failed:
+            text += f", {failed} failed"
+        self.stream.write(text)
         self.stream.flush()
         self.shown = True
 
@@ -76,6 +98,7 @@ class _Progress:
         if self.shown:
             self.stream.write("\n")
             self.stream.flush()
+            self.shown = False
 
 
 class _Parser(argparse.ArgumentParser):
@@ -582,48 +605,6 @@ def _run_app(args) -> int:
         raise CaseError(str(error)) from None
 
 
-class _CaseProgress:
-    """Progress of a sweep on stderr: cases (not chunks), rate and ETA."""
-
-    def __init__(self, stream=None, width: int = 30, delay: float = 1.0):
-        self.stream = sys.stderr if stream is None else stream
-        self.width = width
-        self.delay = delay
-        self.start = time.perf_counter()
-        self.first: tuple[float, int] | None = None
-        self.shown = False
-        self.last = 0.0
-
-    def __call__(self, done: int, total: int, failed: int) -> None:
-        now = time.perf_counter()
-        if self.first is None:  # the rate counts from the first chunk (after resuming)
-            self.first = (now, done)
-        if (now - self.start < self.delay or now - self.last < 0.1) and done < total:
-            return
-        if done == total and not self.shown:
-            return
-        self.last = now
-        elapsed = now - self.first[0]
-        rate = (done - self.first[1]) / elapsed if elapsed > 0 else 0.0
-        eta = (total - done) / rate if rate > 0 else float("nan")
-        filled = round(self.width * done / max(total, 1))
-        bar = "#" * filled + "." * (self.width - filled)
-        text = f"\rsweep [{bar}] {done}/{total} cases"
-        if rate > 0:
-            text += f", {rate:.4g} cases/s, ETA {_duration(eta)}"
-        if failed:
-            text += f", {failed} failed"
-        self.stream.write(text)
-        self.stream.flush()
-        self.shown = True
-
-    def close(self) -> None:
-        if self.shown:
-            self.stream.write("\n")
-            self.stream.flush()
-            self.shown = False
-
-
 def _duration(seconds: float) -> str:
     if not np.isfinite(seconds):
         return "?"
@@ -659,7 +640,7 @@ def _run_sweep(args) -> int:
     if args.path and (args.scheduler is not None or args.workers > 1):
         raise CaseError("--path follows the cases one after the other, in this process; give "
                         "no --workers or --scheduler")
-    progress = _CaseProgress()
+    progress = _Progress(label="sweep", unit="cases", rate=True)
     start = time.perf_counter()
     try:
         if args.scheduler is not None:
