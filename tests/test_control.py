@@ -153,3 +153,62 @@ def test_the_tracking_example_runs(tmp_path, capsys):
         sys.argv = argv
     assert "60/60 targets reached" in capsys.readouterr().out
     assert (tmp_path / "track.png").stat().st_size > 10_000
+
+
+def test_shoot_input_columns_match_differences_and_the_solver_jacobian():
+    """``Solver.shoot(..., inputs=True)`` (the fast inverse route's linearisation): its input
+    columns against central differences of shoot itself at fixed steps, and the actuation
+    Jacobian they give at the solution (A = E_q - E_x J_x⁻¹ J_q) against the solver's own
+    ``actuation_jacobian`` on the same grid (a second route: the output pass's columns)."""
+    arm = robot()
+    q = np.array([2.7, 0.9, 0.4])
+    loads = [GRAVITY, *tendons(q)]
+    solver = softarm.statics.Solver(arm, tol=1e-8)
+    eq = solver.solve(loads, jacobians=True)
+    x, N = solver.last_solution()
+    shot = solver.shoot(loads, x, steps=("solution", N), inputs=True)
+    assert np.max(np.abs(shot.residual) / solver._data.scale) < 1e-9
+    h = 1e-4
+    for i in range(3):
+        dq = np.zeros(3)
+        dq[i] = h
+        up = solver.shoot([GRAVITY, *tendons(q + dq)], x, steps=("solution", N))
+        down = solver.shoot([GRAVITY, *tendons(q - dq)], x, steps=("solution", N))
+        fd_r = (up.residual - down.residual) / (2 * h)
+        fd_p = (up.tip_pose[:3, 3] - down.tip_pose[:3, 3]) / (2 * h)
+        assert np.allclose(shot.jacobian_inputs[:, i], fd_r, rtol=0, atol=1e-6 * np.abs(fd_r).max())
+        assert np.allclose(shot.tip_motion_inputs[:3, i], fd_p, rtol=0,
+                           atol=1e-6 * np.abs(fd_p).max())
+    A = shot.tip_motion_inputs - shot.tip_motion_x @ np.linalg.solve(shot.jacobian_x,
+                                                                     shot.jacobian_inputs)
+    assert np.allclose(A, eq.actuation_jacobian, rtol=0,
+                       atol=1e-7 * np.abs(eq.actuation_jacobian).max())
+
+
+def test_tracking_takes_the_shooting_route_and_agrees_with_forward_solves():
+    """Tracking close targets goes through the one-integration-per-iteration route (no full
+    solve inside the iteration); each answer's tip, recomputed by an independent forward
+    solve of the returned tensions, is on its target to 1e-6 L."""
+    arm = robot()
+    phase = np.linspace(0.0, 0.5, 12)
+    pattern = 1.5 + 1.2 * np.cos(phase[:, None] - 2 * np.pi * np.arange(3) / 3)
+    targets = forward(arm, pattern).tip_position
+    tracker = InverseSolver(arm, tendons(), [GRAVITY])
+    tracker.solve(targets[0])
+    routes = []
+    original = InverseSolver._shooting_newton
+
+    def spy(self, *args):
+        out = original(self, *args)
+        routes.append(out is not None)
+        return out
+
+    InverseSolver._shooting_newton = spy
+    try:
+        result = tracker.track(targets[1:])
+    finally:
+        InverseSolver._shooting_newton = original
+    assert all(routes) and len(routes) == 11
+    assert result.reached.all()
+    again = forward(arm, result.inputs).tip_position
+    assert np.max(np.linalg.norm(again - targets[1:], axis=-1)) / L <= 1e-6

@@ -171,7 +171,7 @@ def _route(routes, a, s):
     return y, z, dy, dz
 
 
-@_jit
+@_inline
 def _law(arm, j, s, now, law, s0, s1, s2, s3, s4, s5):
     """The constitutive law of piece j at arc length s with its actuators (Rucker & Webster
     2011, in total-wrench form): the strains ε = (v; u) solving
@@ -328,7 +328,7 @@ def _actuator_rates(arm, j, rate, law, ds):
             ds[5] += q * y * t0
 
 
-@_jit
+@_inline
 def _actuated(arm, j):
     """Whether actuators act on piece j (the constitutive law then is :func:`_law`)."""
     active = arm[11]

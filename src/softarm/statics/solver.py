@@ -283,6 +283,10 @@ class ShootResult:
     jacobian_load: np.ndarray
     tip_pose: np.ndarray
     tip_motion_x: np.ndarray
+    #: with ``inputs=True``: ∂r/∂q (6, n) and ∂(δp(L); δθ(L))/∂q (6, n, spatial), q the
+    #: actuation inputs in load order (as ``Equilibrium.actuation_jacobian``)
+    jacobian_inputs: np.ndarray | None = None
+    tip_motion_inputs: np.ndarray | None = None
 
 
 class Solver:
@@ -570,36 +574,63 @@ class Solver:
         self._memory = memory
         return self.solve(loads)
 
-    def shoot(self, loads, x, load_factor=1.0, *, steps=None) -> ShootResult:
+    def shoot(self, loads, x, load_factor=1.0, *, steps=None, inputs=False) -> ShootResult:
         """One integration from the base reaction ``x`` = (n(0); m(0)) (N, N m, spatial) at
         load factor λ (the loads scaled by λ): the shooting primitive that continuation,
         stability and inverse statics are written against.
 
         ``loads`` must be a single case (batch shape ()). ``steps``: RK4 steps over the arm
-        (default: a fixed 200, spread over the pieces in proportion to their length).
+        (default: a fixed 200, spread over the pieces in proportion to their length), or
+        ``("solution", N)``: the grid of a solve whose coarse step count is N (2N steps, as
+        :meth:`last_solution` reports it). ``inputs=True`` adds the columns of every
+        actuation input (``jacobian_inputs``, ``tip_motion_inputs``).
         """
         k = _kernels()
-        _, shape, _, pieces, channels = self._prepare(loads)
+        loads, shape, _, pieces, channels = self._prepare(loads)
         if shape != ():
             raise ValueError(f"Solver.shoot takes a single load case, got batch shape {shape}")
         x = np.asarray(x, dtype=np.float64)
         if x.shape != (6,) or not np.all(np.isfinite(x)):
             raise ValueError(f"x must be 6 finite numbers (n(0); m(0)), got {x!r}")
-        n = 200 if steps is None else count(steps, "steps", 1)
-        counts = np.maximum(1, np.floor(n * pieces[1] / self.length + 0.5)).astype(np.int64)
-        case = (np.zeros_like(channels.piece[0]), channels.piece[0][None].copy(),
-                np.zeros(k.TIP_LOADS), channels.tip_loads[0][None].copy())
-        r, J = np.empty(6), np.empty((6, 7))
-        y, T = np.empty(18 + len(channels.actuators)), np.empty((7, 12))
-        k.shoot(x.copy(), float(load_factor), counts, self._base_kernel, channels.arm_tuple(),
-                case, r, J, y, T)
+        if isinstance(steps, tuple) and len(steps) == 2 and steps[0] == "solution":
+            N = count(steps[1], "steps", 1)
+            counts = 2 * np.maximum(1, np.floor(N * pieces[1] / self.length + 0.5))
+        else:
+            n = 200 if steps is None else count(steps, "steps", 1)
+            counts = np.maximum(1, np.floor(n * pieces[1] / self.length + 0.5))
+        counts = counts.astype(np.int64)
+        lam = float(load_factor)
+        piece, tip = channels.piece[0], channels.tip_loads[0]
+        if inputs:  # at λ·loads; the columns after x along each input's channels
+            unit_piece, unit_tip = self._input_channels(loads, pieces, piece.shape[1])
+            case = (lam * piece, lam * unit_piece, lam * tip, lam * unit_tip)
+            lam = 0.0
+        else:
+            case = (np.zeros_like(piece), piece[None].copy(), np.zeros(k.TIP_LOADS),
+                    tip[None].copy())
+        ncols = 6 + case[1].shape[0]
+        r, J = np.empty(6), np.empty((6, ncols))
+        y, T = np.empty(18 + len(channels.actuators)), np.empty((ncols, 12))
+        k.shoot(x.copy(), lam, counts, self._base_kernel, channels.arm_tuple(), case, r, J, y,
+                T)
         R = y[3:12].reshape(3, 3)
         pose = np.eye(4)
         pose[:3, :3], pose[:3, 3] = R, y[:3]
-        motion = np.empty((6, 6))
-        motion[:3] = T[:6, :3].T
-        motion[3:] = R @ T[:6, 3:6].T
-        return ShootResult(r, J[:, :6].copy(), J[:, 6].copy(), pose, motion)
+        motion = np.empty((6, ncols))
+        motion[:3] = T[:, :3].T
+        motion[3:] = R @ T[:, 3:6].T
+        if inputs:
+            return ShootResult(r, J[:, :6].copy(), None, pose, motion[:, :6].copy(),
+                               J[:, 6:].copy(), motion[:, 6:].copy())
+        return ShootResult(r, J[:, :6].copy(), J[:, 6].copy(), pose, motion[:, :6].copy())
+
+    def last_solution(self):
+        """(x, N) of the last case a chained :meth:`solve` reached: its base reaction (N, N m,
+        spatial) and coarse step count (the solution is on 2N steps), or None."""
+        memory = self._memory
+        if memory is None or memory[13] != 1.0:
+            return None
+        return memory[6:12].copy(), int(memory[12])
 
 
 def _actuation(channels, base_wrench, lengths, shape) -> dict:
