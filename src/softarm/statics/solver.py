@@ -234,6 +234,13 @@ class _Channels:
         self.actuators.append((k.TENDON if kind == "tendon" else k.CHAMBER, routing, active,
                                (float(span[0]), float(span[1]))))
 
+    def displaced_tendon(self, displacement, routing, span):
+        raise ValueError(
+            "a displacement-controlled Tendon (Tendon(displacement=...)) is solved by "
+            "softarm.solve and Solver.solve only; this route (shoot, continuation, "
+            "branch='stable', stability sweeps) takes tension-controlled tendons: use "
+            "Tendon.with_tension(eq.tendon_tensions[...]) from a solved equilibrium")
+
     def field(self, field, gradient=None):
         k = self.k
         self._piece[..., :, k.FB:k.FB + 3] += np.asarray(field)[..., None, :]
@@ -457,6 +464,16 @@ class Solver:
     def _solve(self, loads, *, chained: bool, jacobians: bool) -> Equilibrium:
         if not isinstance(jacobians, (bool, np.bool_)):
             raise TypeError(f"jacobians must be True or False, got {jacobians!r}")
+        loads = as_loads(loads)
+        if any(load.displacement_controlled for load in loads):
+            # the tensions are unknowns: a bounded Newton method over tension-controlled
+            # solves from the unloaded arm (statics/displacement.py); a chained Solver
+            # restarts from the unloaded arm after it
+            from .displacement import solve_displaced
+
+            if chained:
+                self.reset()
+            return solve_displaced(self, loads, jacobians=jacobians)
         k = _kernels()
         last = self._last if chained else None
         loads, shape, count, pieces, channels = self._prepare(
