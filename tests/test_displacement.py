@@ -315,3 +315,47 @@ def test_displacement_tendons_in_a_case_file_round_trip(tmp_path):
     np.testing.assert_array_equal(eq.positions, python.positions)
     np.testing.assert_allclose(eq.tendon_length_changes[:2], [-0.006, 0.001], rtol=0,
                                atol=1e-12)
+
+
+def test_the_cli_summary_reports_displacement_control_and_slack(tmp_path, capsys):
+    from softarm import cli
+
+    text = (EXAMPLES / "tendon_robot.toml").read_text()
+    text = text.replace("tension = 3.0 ", "displacement = -0.004 ").replace(
+        "tension = 1.0\n", "displacement = 0.004\n")  # the second one paid out: slack
+    path = tmp_path / "robot.toml"
+    path.write_text(text)
+    assert cli.main(["solve", str(path)]) == 0
+    out = capsys.readouterr().out
+    lines = [line for line in out.splitlines() if "tension" in line and "mm" in line]
+    assert len(lines) == 3
+    assert "displacement-controlled: set -4 mm)" in lines[0] and "SLACK" not in lines[0]
+    assert "displacement-controlled: set +4 mm; SLACK" in lines[1]
+    assert "tension 0 N" in lines[1]
+    assert "displacement" not in lines[2]  # the third tendon is tension-controlled
+
+
+def test_inverse_with_displacement_inputs_reaches_a_target_made_by_displacements():
+    # the target: the tip of a displacement-controlled solve; the answer's displacements,
+    # solved forward again by displacement control, put the tip there
+    case = load_case(EXAMPLES / "tendon_robot.toml")
+    arm, gravity = case.arm, case.loads[0]
+    routes = [load.routing for load in case.loads[1:]]
+    hidden = [Tendon(routing=r, displacement=d) for r, d in zip(routes, [-0.003, 0.001, 0.0],
+                                                                   strict=True)]
+    target = softarm.solve(arm, [gravity, *hidden]).tip_position
+    guess = [Tendon(routing=r, displacement=0.0) for r in routes]
+    answer = softarm.inverse(arm, guess, target, loads=[gravity], tol=1e-6)
+    assert answer.reached and answer.error <= 1e-6
+    forward = softarm.solve(arm, [gravity, *[Tendon(routing=r, displacement=d) for r, d in
+                                             zip(routes, answer.inputs, strict=True)]])
+    np.testing.assert_allclose(forward.tip_position, target, rtol=0, atol=2e-6 * arm.length)
+    np.testing.assert_allclose(answer.equilibrium.tendon_length_changes, answer.inputs,
+                               rtol=0, atol=1e-12)
+    assert all(load.displacement_controlled for load in answer.equilibrium.loads[1:])
+    # its Jacobian is per metre of displacement: a taut tendon's own length row is 1
+    taut = ~answer.equilibrium.tendon_slack
+    np.testing.assert_allclose(answer.equilibrium.tendon_length_jacobian[taut][:, taut],
+                               np.eye(int(taut.sum())), rtol=0, atol=1e-9)
+    with pytest.raises(ValueError, match="bounds on a displacement input"):
+        softarm.inverse(arm, guess, target, loads=[gravity], bounds=(0.0, 10.0))

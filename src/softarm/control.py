@@ -18,6 +18,7 @@ An unreachable target gives the closest reachable point with ``reached=False``.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -41,7 +42,8 @@ class InverseResult:
     ----------
     inputs : ndarray, shape (B..., n)
         The actuation inputs, in the order of the actuators' input fields (each tendon's
-        tension in N, each chamber's pressure in Pa, each field's B0 components in T).
+        tension in N, or its displacement in m if it is displacement-controlled, each
+        chamber's pressure in Pa, each field's B0 components in T).
     equilibrium : Equilibrium
         The equilibrium they produce (batched like ``inputs``).
     reached : bool or ndarray (B...)
@@ -74,11 +76,18 @@ class InverseSolver:
     ----------
     arm : Arm or SegmentedArm
     actuators : sequence of loads with actuation inputs (``Tendon``, ``Chamber``,
-        ``MagneticField``), unbatched; their current values are the first guess.
+        ``MagneticField``), unbatched; their current values are the first guess. A
+        displacement-controlled ``Tendon`` (``Tendon(displacement=...)``) has its
+        displacement (m) as input: the problem is solved in its tension (>= 0, its least
+        effort Σ τ² like any tendon's) and the answer reports the tendon's length change
+        there, the displacement that gives that equilibrium (for a slack tendon, at
+        tension 0, the one that just makes it taut: any larger one gives the same
+        equilibrium). Bounds on a displacement input are not supported.
     loads : sequence of loads, optional
         The other loads (gravity, a payload), held fixed.
     bounds : (lower, upper), optional
-        Per input (arrays of shape (n,), ±inf allowed). Tensions are always >= 0.
+        Per input (arrays of shape (n,), ±inf allowed). Tensions are always >= 0;
+        displacement inputs take no bound (±inf).
     scales : array_like, shape (n,), optional
         Input scales s_i of the effort Σ (q_i/s_i)² minimised when the task is redundant, and
         of the Levenberg–Marquardt damping (default: 1 in SI units for every input).
@@ -107,9 +116,12 @@ class InverseSolver:
             raise ValueError(f"tol must be > 0, got {tol!r}")
         self.max_iterations = count(max_iterations, "max_iterations", 1)
         self.length = float(arm.length)
+        solver_tol = 0.1 * self.tol if solver_tol is None else solver_tol
+        # displacement-controlled tendons are solved in their tensions (self._actuators)
+        self._actuators, self._displaced = self._in_tensions(arm, s, solver_tol)
         self._slots = []  # (actuator index, field, component, is tension)
         values = []
-        for i, load in enumerate(self.actuators):
+        for i, load in enumerate(self._actuators):
             for name in load.inputs:
                 value = np.atleast_1d(np.asarray(getattr(load, name), dtype=float))
                 for c in range(value.size):
@@ -126,6 +138,14 @@ class InverseSolver:
                                  f"numbers (one per input), got {bounds!r}") from None
             lower, upper = lo.copy(), hi.copy()
         tension = np.array([slot[3] for slot in self._slots], dtype=bool)
+        by_length = np.array([slot[0] in self._displaced for slot in self._slots], dtype=bool)
+        if np.any(np.isfinite(lower[by_length]) | np.isfinite(upper[by_length])):
+            raise ValueError(
+                f"bounds on a displacement input are not supported (the inverse problem is "
+                f"solved in the tendon's tension, >= 0): give -inf, inf for inputs "
+                f"{np.flatnonzero(by_length).tolist()}, got lower {lower.tolist()}, upper "
+                f"{upper.tolist()}")
+        self._by_length = by_length
         lower[tension] = np.maximum(lower[tension], 0.0)
         if np.any(lower > upper) or np.any(np.isnan(lower)) or np.any(np.isnan(upper)):
             raise ValueError(f"bounds must satisfy lower <= upper (tensions >= 0), got "
@@ -136,23 +156,68 @@ class InverseSolver:
         if not np.all(self.scales > 0):
             raise ValueError(f"scales must be > 0, got {self.scales.tolist()}")
         self.q = np.clip(self.q, lower, upper)
-        self.solver = Solver(arm, s=s, tol=0.1 * self.tol if solver_tol is None else solver_tol)
+        self.solver = Solver(arm, s=s, tol=solver_tol)
+
+    def _in_tensions(self, arm, s, solver_tol):
+        """The actuators with each displacement-controlled tendon under tension control,
+        pulled with the tension its displacement needs (the first guess; 0 N if that solve
+        fails), and the indices of those tendons."""
+        displaced = [i for i, load in enumerate(self.actuators) if load.displacement_controlled]
+        if not displaced:
+            return self.actuators, displaced
+        try:
+            eq = Solver(arm, s=2, tol=solver_tol).solve_from_unloaded(
+                [*self.loads, *self.actuators])
+            tensions = eq.tendon_tensions
+        except ConvergenceError:
+            tensions = None
+        tendons = [i for i, load in enumerate([*self.loads, *self.actuators])
+                   if load.kind == "tendon"]
+        out = list(self.actuators)
+        for i in displaced:
+            row = tendons.index(len(self.loads) + i)
+            out[i] = out[i].with_tension(0.0 if tensions is None else float(tensions[row]))
+        return tuple(out), displaced
 
     @property
     def n_inputs(self) -> int:
         return self.q.size
 
-    def _actuators_at(self, q) -> list:
+    def _actuators_at(self, q, actuators=None) -> list:
+        given = actuators is not None  # the slots of a displaced tendon are its tension's
+        actuators = actuators if given else self._actuators
         fields: dict[tuple[int, str], np.ndarray] = {}
         for value, (i, name, c, _) in zip(q, self._slots, strict=True):
+            name = "displacement" if given and i in self._displaced else name
             current = fields.setdefault((i, name), np.atleast_1d(np.array(
-                getattr(self.actuators[i], name), dtype=float)))
+                getattr(actuators[i], name), dtype=float)))
             current[c] = value
-        out = list(self.actuators)
+        out = list(actuators)
         for (i, name), value in fields.items():
-            shape = np.shape(getattr(self.actuators[i], name))
+            shape = np.shape(getattr(actuators[i], name))
             out[i] = out[i].replace(**{name: value.reshape(shape)})
         return out
+
+    def actuators_at(self, inputs) -> list:
+        """The actuators (as given: tension- or displacement-controlled) with these inputs
+        (``InverseResult.inputs``)."""
+        return self._actuators_at(inputs, self.actuators)
+
+    def _displacement_answer(self, q, eq):
+        """The inputs and the equilibrium of the tensions q with the displacement-controlled
+        tendons' inputs as displacements (their length changes at q; the Jacobians' columns
+        per metre of displacement)."""
+        if not self._displaced:
+            return q.copy(), eq
+        from .statics.displacement import displaced_columns, displacement_jacobians
+
+        inputs = q.copy()
+        # the given loads: the displacement-controlled tendons' rows and input columns
+        _, rows, cols = displaced_columns([*self.loads, *self.actuators])
+        inputs[self._by_length] = eq.tendon_length_changes[rows]
+        actuators = self.actuators_at(inputs)
+        changes = displacement_jacobians(eq, rows, cols, ())
+        return inputs, dataclasses.replace(eq, loads=(*self.loads, *actuators), **changes)
 
     def _forward(self, q):
         """The equilibrium at inputs q (followed quasi-statically from the last one) and the
@@ -226,7 +291,8 @@ class InverseSolver:
         singular = np.linalg.svd((w[:, None] * A[:e.size]) * self.scales, compute_uv=False)
         condition = float(singular[0] / singular[-1]) if singular[-1] > 0 else np.inf
         at_bound = (q <= self.lower) | (q >= self.upper)
-        return InverseResult(q.copy(), eq, bool(size <= self.tol), float(size), iterations,
+        inputs, eq = self._displacement_answer(q, eq)
+        return InverseResult(inputs, eq, bool(size <= self.tol), float(size), iterations,
                              at_bound, condition)
 
     def track(self, targets, orientations=None) -> InverseResult:
@@ -306,5 +372,9 @@ def inverse(arm, actuators, target, *, loads=(), bounds=None, orientation=None, 
         if x0.shape != (solver.n_inputs,) or not np.all(np.isfinite(x0)):
             raise ValueError(f"x0 must be {solver.n_inputs} finite numbers (one per input), "
                              f"got {x0!r}")
-        solver.q = np.clip(x0, solver.lower, solver.upper)
+        if solver._displaced:  # a displacement first guess: its tensions, solved again
+            solver = InverseSolver(arm, solver.actuators_at(x0), loads, bounds=bounds,
+                                   scales=scales, tol=tol, max_iterations=max_iterations)
+        else:
+            solver.q = np.clip(x0, solver.lower, solver.upper)
     return solver.solve(target, orientation)

@@ -32,7 +32,7 @@ from .._bounded import box_least_squares
 from ..errors import ConvergenceError
 from ..loads import Tendon
 
-__all__ = ["solve_displaced"]
+__all__ = ["displaced_columns", "displacement_jacobians", "solve_displaced"]
 
 #: Newton iterations per load case before a ConvergenceError.
 MAX_ITERATIONS = 30
@@ -41,6 +41,17 @@ MAX_ITERATIONS = 30
 def _input_count(load) -> int:
     return sum(int(np.prod(np.shape(getattr(load, name))[len(load.batch_shape):]) or 1)
                for name in load.inputs)
+
+
+def displaced_columns(loads):
+    """Where the displacement-controlled tendons of ``loads`` are: (their indices in
+    ``loads``, their rows among the tendons (``Equilibrium.tendon_lengths``), their columns
+    among the actuation inputs (``Equilibrium.actuation_jacobian``))."""
+    displaced = [i for i, load in enumerate(loads) if load.displacement_controlled]
+    tendons = [i for i, load in enumerate(loads) if isinstance(load, Tendon)]
+    rows = np.array([tendons.index(i) for i in displaced], dtype=np.int64)
+    first = np.cumsum([0] + [_input_count(load) for load in loads])
+    return displaced, rows, first[displaced].astype(np.int64)
 
 
 def _flat(load, shape, count):
@@ -94,11 +105,7 @@ def solve_displaced(solver, loads, *, jacobians: bool):
     """
     loads, shape = solver.check_loads(loads)
     count = math.prod(shape)
-    displaced = [i for i, load in enumerate(loads) if load.displacement_controlled]
-    tendons = [i for i, load in enumerate(loads) if isinstance(load, Tendon)]
-    rows = np.array([tendons.index(i) for i in displaced])
-    first = np.cumsum([0] + [_input_count(load) for load in loads])
-    cols = first[displaced]
+    displaced, rows, cols = displaced_columns(loads)
     target = np.stack([np.broadcast_to(loads[i].displacement, shape).reshape(count)
                        for i in displaced], axis=-1)
     flat = [_flat(load, shape, count) for load in loads]
@@ -150,7 +157,7 @@ def solve_displaced(solver, loads, *, jacobians: bool):
         last = _reshaped(last, shape)
     changes = {"loads": loads}
     if jacobians:
-        changes.update(_displacement_jacobians(last, rows, cols, shape))
+        changes.update(displacement_jacobians(last, rows, cols, shape))
     return dataclasses.replace(last, **changes)
 
 
@@ -169,10 +176,12 @@ def _reshaped(eq, shape):
     return dataclasses.replace(eq, **fields)
 
 
-def _displacement_jacobians(eq, rows, cols, shape) -> dict:
-    """The Jacobians in the inputs where each displacement-controlled tendon's input is its
-    displacement: with S its taut ones (G_SS their lengths per their tensions), dτ_S =
-    G_SS⁻¹ (dd_S - G_SO dq_O) (O the other inputs), a slack one's dτ = 0."""
+def displacement_jacobians(eq, rows, cols, shape) -> dict:
+    """The Jacobian fields of ``eq`` (solved with tension-controlled tendons, jacobians=True)
+    in the inputs where the tendons at ``rows`` (tendon rows) and ``cols`` (input columns)
+    have their displacement as input instead of their tension: with S the taut ones (G_SS
+    their lengths per their tensions), dτ_S = G_SS⁻¹ (dd_S - G_SO dq_O) (O the other
+    inputs), a slack one's dτ = 0."""
     G = np.asarray(eq.tendon_length_jacobian)
     n = G.shape[-1]
     count = math.prod(shape)
