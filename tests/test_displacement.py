@@ -144,6 +144,10 @@ def test_tendon_robot_round_trip_from_its_reported_length_changes():
     assert by_length.tendon_tensions[2] == 0.0
     assert by_length.tendon_slack.tolist() == [False, False, True]
     assert isinstance(by_length.loads[2], Tendon) and by_length.loads[2].displacement_controlled
+    # the same kind of result as any solve: its own stability verdict, no Jacobians unasked
+    assert by_length.stability.index == by_tension.stability.index == 0
+    assert by_length.actuation_jacobian is None and by_length.tip_compliance is None
+    assert isinstance(by_length.residual, float) and by_length.poses.shape == (101, 4, 4)
 
 
 def test_mixed_control_agrees_with_fsolve_over_tension_controlled_solves():
@@ -231,6 +235,7 @@ def test_batched_displacements_equal_looped():
         np.testing.assert_allclose(batch.actuation_jacobian[i, j], one.actuation_jacobian,
                                    rtol=0, atol=1e-8 * np.abs(one.actuation_jacobian).max())
     assert batch.tendon_slack[2, :, 0].all() and not batch.tendon_slack[:2, :, 0].any()
+    assert batch.stability.index.shape == batch.residual.shape == (3, 2)
 
 
 def test_jacobians_in_displacement_inputs_match_central_differences():

@@ -116,8 +116,9 @@ def solve_displaced(solver, loads, *, jacobians: bool):
     last = None
     iterations = 0
     residual = np.zeros(1)
+    previous = np.full(count, np.nan)  # each case's residual at its last iterate
+    final = False  # whether this iterate is predicted to be the last one
     try:
-        solver.stability = False  # the verdict of the final equilibrium only
         while active.size:
             if iterations == MAX_ITERATIONS:
                 worst = float(np.max(residual))
@@ -129,6 +130,8 @@ def solve_displaced(solver, loads, *, jacobians: bool):
                     f"(tolerance {tol_length:.3e} m)", worst,
                     f"{MAX_ITERATIONS} bounded Newton steps on the tensions")
             iterations += 1
+            # the stability verdict only where the result is likely to be returned
+            solver.stability = stability and final
             case = [load.take(active) if load.batch_shape else load for load in flat]
             eq = solver.solve_from_unloaded(_with_tensions(case, displaced, tau[active]),
                                             jacobians=True)
@@ -137,42 +140,55 @@ def solve_displaced(solver, loads, *, jacobians: bool):
                 active.size, -1, eq.tendon_length_jacobian.shape[-1])[:, rows][:, :, cols]
             residual = _residual(change, target[active], tau[active])
             done = residual <= tol_length
-            last = eq if done.all() and active.size == count else None
-            keep = []
+            last = eq if done.all() and active.size == count and \
+                solver.stability == stability else None
+            keep, predicted = [], []
             for k, b in enumerate(active):
                 if done[k]:
                     continue
                 step = _newton_step(H[k], change[k] - target[b], tau[b])
                 tau[b] = np.maximum(tau[b] + step, 0.0)
                 keep.append(b)
+                # quadratic convergence, r' ≈ C r² with C ≈ r / r_prev²: done after this?
+                predicted.append(residual[k] ** 3 <= 0.1 * tol_length * previous[b] ** 2)
+                previous[b] = residual[k]
             active = np.array(keep, dtype=np.int64)
+            final = bool(predicted) and all(predicted)
     finally:
         solver.stability = stability
-    if last is None or stability or not jacobians:
+    if last is None:
         # the converged tensions, solved once more as one batch (with the verdict if asked)
         last = solver.solve_from_unloaded(
             _with_tensions(loads, displaced, tau.reshape(*shape, len(displaced))),
             jacobians=jacobians)
     else:
-        last = _reshaped(last, shape)
+        last = _reshaped(last, shape, jacobians)
     changes = {"loads": loads}
     if jacobians:
         changes.update(displacement_jacobians(last, rows, cols, shape))
     return dataclasses.replace(last, **changes)
 
 
-def _reshaped(eq, shape):
-    """A batch-of-one equilibrium (from the iterations) as a single case of ``shape`` ()."""
-    if shape:
-        return eq
+#: The fields of a solve with jacobians=True that a solve without has as None.
+_JACOBIANS = ("tip_compliance", "compliance", "actuation_jacobian",
+              "station_actuation_jacobian", "tendon_length_jacobian")
+
+
+def _reshaped(eq, shape, jacobians):
+    """The equilibrium of the flattened batch (count,) of the iterations with the batch
+    shape ``shape`` (and without its Jacobians unless ``jacobians``)."""
     fields = {}
     for field in dataclasses.fields(eq):
         value = getattr(eq, field.name)
-        if field.name not in ("s",) and isinstance(value, np.ndarray) and value.ndim and \
-                value.shape[0] == 1:
-            fields[field.name] = value[0]
-    for name in ("residual", "error_estimate"):
-        fields[name] = float(np.asarray(getattr(eq, name)).reshape(-1)[0])
+        if field.name in _JACOBIANS and not jacobians:
+            fields[field.name] = None
+        elif field.name == "stability" and value is not None:
+            fields[field.name] = type(value).of(value.index, value.conservative, shape)
+        elif field.name in ("residual", "error_estimate"):
+            value = np.asarray(value).reshape(shape)
+            fields[field.name] = float(value) if not shape else value
+        elif field.name != "s" and isinstance(value, np.ndarray):
+            fields[field.name] = value.reshape(*shape, *value.shape[1:])
     return dataclasses.replace(eq, **fields)
 
 
