@@ -443,7 +443,9 @@ class Solver:
     def solve(self, loads, *, jacobians: bool = False) -> Equilibrium:
         """The equilibrium reached by driving the arm slowly from its previous equilibrium
         (the unloaded arm after construction or :meth:`reset`) to ``loads``; a batch is
-        followed case after case in order.
+        followed case after case in order. Loads with a displacement-controlled
+        :class:`~softarm.Tendon` are solved from the unloaded arm instead (its tension is an
+        unknown, ``docs/control.md``), and the quasi-static memory restarts after them.
 
         Raises
         ------
