@@ -97,16 +97,18 @@ def inputs(case: Case) -> list[Input]:
         kind = load.kind
         out.append(Input(f"l{i + 1}.on", f"{i + 1}: {load.describe()}", "", 0.0, 1.0, 1.0, i))
         for name, unit, shape in load.arrays:
-            if shape != ():
+            if shape != () or getattr(load, name) is None:  # (a tendon's unused control)
                 continue
             value = float(np.asarray(getattr(load, name), dtype=float))
+            reach = None if value != 0.0 else load.routing.bound(float(case.arm.length)) or 1.0
             if value != 0.0:
                 half = _nice(2.0 * abs(value))
+            elif unit == "m":  # a tendon's displacement: about a radian of bending, ρ
+                half = _nice(reach)
             else:  # about a radian of bending: τ ρ L / EI ≈ 1 (p A for a chamber)
-                reach = load.routing.bound(float(case.arm.length)) or 1.0
                 half = _nice(_bending(case.arm) / (float(case.arm.length) * reach
                                                    * getattr(load, "area", 1.0)))
-            low = 0.0 if value >= 0.0 else -half
+            low = 0.0 if value >= 0.0 and unit != "m" else -half  # a displacement: either way
             out.append(Input(f"l{i + 1}.{name}", f"{kind} {name}", unit, low, half, value, i,
                              name, -1))
         for name, unit in load.vectors:
@@ -255,7 +257,7 @@ def _fields(load, i: int, values: dict, on: float) -> dict:
     fields = {name: [values[f"l{i + 1}.{name}.{axis}"] * on for axis in "xyz"]
               for name, _ in load.vectors}
     fields.update({name: values[f"l{i + 1}.{name}"] * on for name, _, shape in load.arrays
-                   if shape == ()})
+                   if shape == () and getattr(load, name) is not None})
     return fields
 
 

@@ -508,7 +508,7 @@ def _run_inverse(args) -> int:
     start = time.perf_counter()
     answer = solver.solve(target)
     seconds = time.perf_counter() - start
-    solved = [*others, *solver._actuators_at(answer.inputs)]
+    solved = [*others, *solver.actuators_at(answer.inputs)]
     names = [f"{load.kind} {k + 1} {name}" for k, load in enumerate(actuators)
              for name in load.inputs for _ in range(_input_size(load, name))]
     units = [dict((n, u) for n, u, _ in load.arrays)[name] for load in actuators
@@ -753,11 +753,7 @@ def _summary(case: Case, result, seconds: float) -> str:
             f"{name:<22} {value:.4g} {unit:<3} at s = {where:.4g} m"
             for name, values, unit in rows for value, where in [_peak(values, s)]))
         if result.tendon_tensions is not None:
-            lines.append("tendons   " + "\n          ".join(
-                f"{k + 1}: tension {t:.4g} N, length {length:.6g} m, change "
-                f"{1e3 * change:+.4g} mm" for k, (t, length, change) in enumerate(zip(
-                    result.tendon_tensions, result.tendon_lengths,
-                    result.tendon_length_changes, strict=True))))
+            lines.append("tendons   " + "\n          ".join(_tendon_lines(result)))
         if result.base_wrench is not None:
             lines.append(f"base      total wrench (clamp and actuators) force "
                          f"{_vector(result.base_wrench[:3])} N, moment "
@@ -766,6 +762,24 @@ def _summary(case: Case, result, seconds: float) -> str:
             lines.append(f"stability {result.stability.describe()}")
     lines.append(f"time      {seconds:.3g} s")
     return "\n".join(lines)
+
+
+def _tendon_lines(result) -> list[str]:
+    """One line per tendon of a single equilibrium: its tension, length and length change,
+    how it is controlled and, under displacement control, whether it is slack."""
+    tendons = [load for load in result.loads if load.kind == "tendon"]
+    lines = []
+    for k, (load, t, length, change) in enumerate(zip(
+            tendons, result.tendon_tensions, result.tendon_lengths,
+            result.tendon_length_changes, strict=True)):
+        line = (f"{k + 1}: tension {t:.4g} N, length {length:.6g} m, change "
+                f"{1e3 * change:+.4g} mm")
+        if load.displacement_controlled:
+            line += f" (displacement-controlled: set {1e3 * float(load.displacement):+.4g} mm"
+            line += "; SLACK: given more length than its path needs, no tension)" \
+                if result.tendon_slack[k] else ")"
+        lines.append(line)
+    return lines
 
 
 def _sweep_table(case: Case, result) -> str:

@@ -18,10 +18,12 @@ An unreachable target gives the closest reachable point with ``reached=False``.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
 
+from ._bounded import box_least_squares as _box_least_squares
 from ._validate import count, real
 from .errors import ConvergenceError
 from .lie import so3
@@ -40,7 +42,8 @@ class InverseResult:
     ----------
     inputs : ndarray, shape (B..., n)
         The actuation inputs, in the order of the actuators' input fields (each tendon's
-        tension in N, each chamber's pressure in Pa, each field's B0 components in T).
+        tension in N, or its displacement in m if it is displacement-controlled, each
+        chamber's pressure in Pa, each field's B0 components in T).
     equilibrium : Equilibrium
         The equilibrium they produce (batched like ``inputs``).
     reached : bool or ndarray (B...)
@@ -66,39 +69,6 @@ class InverseResult:
     condition: float | np.ndarray
 
 
-def _box_least_squares(A, b, lower, upper, iterations: int = 100):
-    """argmin |A x - b|² subject to lower <= x <= upper (A of full column rank; 0 feasible),
-    by an active-set method (bounded-variable least squares, Stark & Parker 1995): the free
-    variables solved by least squares; a variable that would leave its box is fixed at the
-    bound it reaches first along the way; a fixed one is freed when the objective's slope
-    points into the box."""
-    n = A.shape[1]
-    x = np.zeros(n)
-    fixed = np.zeros(n, dtype=bool)
-    for _ in range(iterations):
-        free = ~fixed
-        z = x.copy()
-        if free.any():
-            z[free] = np.linalg.lstsq(A[:, free], b - A[:, fixed] @ x[fixed], rcond=None)[0]
-        below, above = free & (z < lower), free & (z > upper)
-        if below.any() or above.any():
-            d = z - x
-            with np.errstate(divide="ignore", invalid="ignore"):
-                t = np.where(below, (lower - x) / d, np.where(above, (upper - x) / d, np.inf))
-            k = int(np.argmin(t))
-            x[free] += np.clip(t[k], 0.0, 1.0) * d[free]
-            x[k] = lower[k] if below[k] else upper[k]
-            fixed[k] = True
-            continue
-        x = z
-        g = A.T @ (A @ x - b)  # the objective's slope (half of it)
-        wants_in = fixed & (((x <= lower) & (g < 0.0)) | ((x >= upper) & (g > 0.0)))
-        if not wants_in.any():
-            return x
-        fixed[int(np.argmax(np.abs(g) * wants_in))] = False
-    return np.clip(x, lower, upper)
-
-
 class InverseSolver:
     """A prepared inverse-statics problem: an arm, its actuators, the other loads, bounds.
 
@@ -106,11 +76,18 @@ class InverseSolver:
     ----------
     arm : Arm or SegmentedArm
     actuators : sequence of loads with actuation inputs (``Tendon``, ``Chamber``,
-        ``MagneticField``), unbatched; their current values are the first guess.
+        ``MagneticField``), unbatched; their current values are the first guess. A
+        displacement-controlled ``Tendon`` (``Tendon(displacement=...)``) has its
+        displacement (m) as input: the problem is solved in its tension (>= 0, its least
+        effort Σ τ² like any tendon's) and the answer reports the tendon's length change
+        there, the displacement that gives that equilibrium (for a slack tendon, at
+        tension 0, the one that just makes it taut: any larger one gives the same
+        equilibrium). Bounds on a displacement input are not supported.
     loads : sequence of loads, optional
         The other loads (gravity, a payload), held fixed.
     bounds : (lower, upper), optional
-        Per input (arrays of shape (n,), ±inf allowed). Tensions are always >= 0.
+        Per input (arrays of shape (n,), ±inf allowed). Tensions are always >= 0;
+        displacement inputs take no bound (±inf).
     scales : array_like, shape (n,), optional
         Input scales s_i of the effort Σ (q_i/s_i)² minimised when the task is redundant, and
         of the Levenberg–Marquardt damping (default: 1 in SI units for every input).
@@ -139,9 +116,12 @@ class InverseSolver:
             raise ValueError(f"tol must be > 0, got {tol!r}")
         self.max_iterations = count(max_iterations, "max_iterations", 1)
         self.length = float(arm.length)
+        solver_tol = 0.1 * self.tol if solver_tol is None else solver_tol
+        # displacement-controlled tendons are solved in their tensions (self._actuators)
+        self._actuators, self._displaced = self._in_tensions(arm, s, solver_tol)
         self._slots = []  # (actuator index, field, component, is tension)
         values = []
-        for i, load in enumerate(self.actuators):
+        for i, load in enumerate(self._actuators):
             for name in load.inputs:
                 value = np.atleast_1d(np.asarray(getattr(load, name), dtype=float))
                 for c in range(value.size):
@@ -158,6 +138,14 @@ class InverseSolver:
                                  f"numbers (one per input), got {bounds!r}") from None
             lower, upper = lo.copy(), hi.copy()
         tension = np.array([slot[3] for slot in self._slots], dtype=bool)
+        by_length = np.array([slot[0] in self._displaced for slot in self._slots], dtype=bool)
+        if np.any(np.isfinite(lower[by_length]) | np.isfinite(upper[by_length])):
+            raise ValueError(
+                f"bounds on a displacement input are not supported (the inverse problem is "
+                f"solved in the tendon's tension, >= 0): give -inf, inf for inputs "
+                f"{np.flatnonzero(by_length).tolist()}, got lower {lower.tolist()}, upper "
+                f"{upper.tolist()}")
+        self._by_length = by_length
         lower[tension] = np.maximum(lower[tension], 0.0)
         if np.any(lower > upper) or np.any(np.isnan(lower)) or np.any(np.isnan(upper)):
             raise ValueError(f"bounds must satisfy lower <= upper (tensions >= 0), got "
@@ -168,23 +156,68 @@ class InverseSolver:
         if not np.all(self.scales > 0):
             raise ValueError(f"scales must be > 0, got {self.scales.tolist()}")
         self.q = np.clip(self.q, lower, upper)
-        self.solver = Solver(arm, s=s, tol=0.1 * self.tol if solver_tol is None else solver_tol)
+        self.solver = Solver(arm, s=s, tol=solver_tol)
+
+    def _in_tensions(self, arm, s, solver_tol):
+        """The actuators with each displacement-controlled tendon under tension control,
+        pulled with the tension its displacement needs (the first guess; 0 N if that solve
+        fails), and the indices of those tendons."""
+        displaced = [i for i, load in enumerate(self.actuators) if load.displacement_controlled]
+        if not displaced:
+            return self.actuators, displaced
+        try:
+            eq = Solver(arm, s=2, tol=solver_tol).solve_from_unloaded(
+                [*self.loads, *self.actuators])
+            tensions = eq.tendon_tensions
+        except ConvergenceError:
+            tensions = None
+        tendons = [i for i, load in enumerate([*self.loads, *self.actuators])
+                   if load.kind == "tendon"]
+        out = list(self.actuators)
+        for i in displaced:
+            row = tendons.index(len(self.loads) + i)
+            out[i] = out[i].with_tension(0.0 if tensions is None else float(tensions[row]))
+        return tuple(out), displaced
 
     @property
     def n_inputs(self) -> int:
         return self.q.size
 
-    def _actuators_at(self, q) -> list:
+    def _actuators_at(self, q, actuators=None) -> list:
+        given = actuators is not None  # the slots of a displaced tendon are its tension's
+        actuators = actuators if given else self._actuators
         fields: dict[tuple[int, str], np.ndarray] = {}
         for value, (i, name, c, _) in zip(q, self._slots, strict=True):
+            name = "displacement" if given and i in self._displaced else name
             current = fields.setdefault((i, name), np.atleast_1d(np.array(
-                getattr(self.actuators[i], name), dtype=float)))
+                getattr(actuators[i], name), dtype=float)))
             current[c] = value
-        out = list(self.actuators)
+        out = list(actuators)
         for (i, name), value in fields.items():
-            shape = np.shape(getattr(self.actuators[i], name))
+            shape = np.shape(getattr(actuators[i], name))
             out[i] = out[i].replace(**{name: value.reshape(shape)})
         return out
+
+    def actuators_at(self, inputs) -> list:
+        """The actuators (as given: tension- or displacement-controlled) with these inputs
+        (``InverseResult.inputs``)."""
+        return self._actuators_at(inputs, self.actuators)
+
+    def _displacement_answer(self, q, eq):
+        """The inputs and the equilibrium of the tensions q with the displacement-controlled
+        tendons' inputs as displacements (their length changes at q; the Jacobians' columns
+        per metre of displacement)."""
+        if not self._displaced:
+            return q.copy(), eq
+        from .statics.displacement import displaced_columns, displacement_jacobians
+
+        inputs = q.copy()
+        # the given loads: the displacement-controlled tendons' rows and input columns
+        _, rows, cols = displaced_columns([*self.loads, *self.actuators])
+        inputs[self._by_length] = eq.tendon_length_changes[rows]
+        actuators = self.actuators_at(inputs)
+        changes = displacement_jacobians(eq, rows, cols, ())
+        return inputs, dataclasses.replace(eq, loads=(*self.loads, *actuators), **changes)
 
     def _forward(self, q):
         """The equilibrium at inputs q (followed quasi-statically from the last one) and the
@@ -230,7 +263,8 @@ class InverseSolver:
         the last solution), from the Solver's last equilibrium; then one solve at the answer
         (``solve_near``: refined to tol, with its stability verdict) that must confirm the
         task error. None (the caller takes the full-solve route) when there is no last
-        equilibrium, or the iteration does not converge or the confirmation fails.
+        equilibrium, displacement-controlled tendons are among the actuators, or the
+        iteration does not converge or the confirmation fails.
 
         Linearised, r + J_x δx + J_q δq = 0 gives δx = -J_x⁻¹ (r + J_q δq), and the task
         error e = w (target - p(L)) changes by -w (E_x δx + E_q δq): the step solves
@@ -238,8 +272,8 @@ class InverseSolver:
         (exact when r = 0), under the same bounds and effort term as the full route.
         """
         last = self.solver.last_solution()
-        if last is None:
-            return None
+        if last is None or self._displaced:  # (displacement answers need the full route's
+            return None                     # Jacobians, per metre of displacement)
         x, N = last
         scale = self.solver._data.scale
         first = sum(_input_count(load) for load in self.loads)
@@ -351,7 +385,8 @@ class InverseSolver:
         singular = np.linalg.svd((w[:, None] * A[:e.size]) * self.scales, compute_uv=False)
         condition = float(singular[0] / singular[-1]) if singular[-1] > 0 else np.inf
         at_bound = (q <= self.lower) | (q >= self.upper)
-        return InverseResult(q.copy(), eq, bool(size <= self.tol), float(size), iterations,
+        inputs, eq = self._displacement_answer(q, eq)
+        return InverseResult(inputs, eq, bool(size <= self.tol), float(size), iterations,
                              at_bound, condition)
 
     def track(self, targets, orientations=None) -> InverseResult:
@@ -432,5 +467,9 @@ def inverse(arm, actuators, target, *, loads=(), bounds=None, orientation=None, 
         if x0.shape != (solver.n_inputs,) or not np.all(np.isfinite(x0)):
             raise ValueError(f"x0 must be {solver.n_inputs} finite numbers (one per input), "
                              f"got {x0!r}")
-        solver.q = np.clip(x0, solver.lower, solver.upper)
+        if solver._displaced:  # a displacement first guess: its tensions, solved again
+            solver = InverseSolver(arm, solver.actuators_at(x0), loads, bounds=bounds,
+                                   scales=scales, tol=tol, max_iterations=max_iterations)
+        else:
+            solver.q = np.clip(x0, solver.lower, solver.upper)
     return solver.solve(target, orientation)

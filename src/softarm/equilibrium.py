@@ -165,6 +165,16 @@ class Equilibrium:
         Per :class:`~softarm.Tendon`, in the order given: its tension (N), its length from
         the base to its anchor (m), and that length less the unloaded arm's (m; negative
         when pulled in: what a motor encoder measures). None without tendons.
+    tendon_length_jacobian : ndarray, shape (B..., T, n), or None
+        With ``solve(..., jacobians=True)`` and tendons: each tendon's length (m) per unit
+        change of each actuation input (columns as in ``actuation_jacobian``). Exact (the
+        implicit function theorem, like ``actuation_jacobian``). For tension inputs of a
+        conservative system it is symmetric and negative semi-definite (the Hessian of the
+        potential's complementary energy): more tension, a shorter tendon.
+    tendon_slack : ndarray of bool, shape (B..., T), or None
+        Per tendon: True where it carries no tension (τ = 0): a displacement-controlled
+        tendon given more length than its path needs, or a tension-controlled one at 0 N.
+        None without tendons.
     """
 
     s: np.ndarray
@@ -185,6 +195,8 @@ class Equilibrium:
     tendon_tensions: np.ndarray | None = None
     tendon_lengths: np.ndarray | None = None
     tendon_length_changes: np.ndarray | None = None
+    tendon_length_jacobian: np.ndarray | None = None
+    tendon_slack: np.ndarray | None = None
     stability: Stability | None = None
 
     def __post_init__(self):

@@ -107,6 +107,12 @@ class LoadTarget(Protocol):
         """An actuator acting through the constitutive law on ``span`` (m): ``kind``
         "tendon" (``magnitude`` its tension τ, N) or "chamber" (p A, N), along ``routing``."""
 
+    def displaced_tendon(self, displacement, routing: Routing,
+                         span: tuple[float, float]) -> None:
+        """A displacement-controlled tendon (its tension an unknown). A target that does not
+        define it does not handle them: the statics solver replaces such tendons by
+        tension-controlled ones before applying loads (``Tendon.with_tension``)."""
+
     def field(self, field, gradient=None) -> None:
         """A magnetic field B(x) = B0 + G x, spatial (T, T/m), acting on the arm's
         magnetisation and dipoles."""
@@ -176,6 +182,9 @@ class Load(abc.ABC):
     #: The fields that are actuation inputs (a tendon's tension, a chamber's pressure, a
     #: field's B0): every component is one column of an actuation Jacobian, in load order.
     inputs: ClassVar[tuple[str, ...]] = ()
+    #: True for a load whose magnitude is an unknown of the solve (a tendon under
+    #: displacement control, :class:`Tendon`).
+    displacement_controlled: ClassVar[bool] = False
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
@@ -604,12 +613,19 @@ def _check_path(obj, arm, start, end) -> None:
 
 @dataclass(frozen=True, eq=False)
 class Tendon(Load):
-    """A frictionless tendon pulled with tension τ, anchored at arc length ``end``, running
-    along ``routing`` through the sections from the base (Rucker & Webster 2011).
+    """A frictionless tendon pulled with tension τ, or pulled in by a prescribed length
+    (``displacement``), anchored at arc length ``end``, running along ``routing`` through
+    the sections from the base (Rucker & Webster 2011).
 
     The arm and its tendons are solved together: the tendon acts through the constitutive
     law (``docs/actuation.md``), its pull on the sections it bends around and its anchor
     load included exactly.
+
+    Give exactly one of ``tension`` (tension control) and ``displacement`` (displacement
+    control: what a motor with an encoder sets). Under displacement control the tension is
+    an unknown, solved so that the tendon's length less its length on the unloaded arm equals
+    ``displacement``; a tendon that would need τ < 0 (given more length than its path
+    needs) is *slack*: τ = 0, reported in ``Equilibrium.tendon_slack`` (``docs/control.md``).
 
     Parameters
     ----------
@@ -619,25 +635,37 @@ class Tendon(Load):
         The path r(s) in the section, material frame, as a function of the arm's arc length.
     end : float, optional
         Arc length in m where the tendon is anchored (default: the tip).
+    displacement : float or array_like, shape (...), keyword-only
+        The prescribed change of the tendon's length from the unloaded arm, m (negative:
+        pulled in), batchable; instead of ``tension``.
 
     Examples
     --------
     >>> from softarm.routing import Straight
     >>> Tendon(2.0, Straight(0.0, 0.01)).describe()
     'tendon 2 N, straight at (y, z) = (0, 0.01) m, anchored at the tip'
+    >>> Tendon(routing=Straight(0.0, 0.01), displacement=-0.002).describe()
+    'tendon pulled in by 0.002 m, straight at (y, z) = (0, 0.01) m, anchored at the tip'
     """
 
     kind: ClassVar[str] = "tendon"
-    inputs: ClassVar = ("tension",)
-    schema: ClassVar = (Key("tension", "magnitude", "N", required=True),
+    schema: ClassVar = (Key("tension", "magnitude", "N"), Key("displacement", "magnitude", "m"),
                         Key("routing", "routing", required=True), Key("end", "number", "m"))
 
-    tension: np.ndarray
-    routing: Routing
+    tension: np.ndarray | None = None
+    routing: Routing | None = None
     end: float | None = None
+    displacement: np.ndarray | None = field(default=None, kw_only=True)
 
     def __post_init__(self):
-        _magnitude(self, "tension", nonnegative=True, unit="N")
+        if (self.tension is None) == (self.displacement is None):
+            given = "both" if self.tension is not None else "neither"
+            raise TypeError(f"Tendon needs exactly one of tension (N, tension control) and "
+                            f"displacement (m, displacement control), got {given}")
+        if self.tension is not None:
+            _magnitude(self, "tension", nonnegative=True, unit="N")
+        else:
+            _magnitude(self, "displacement", nonnegative=False, unit="m")
         _routing(self)
         if self.end is not None:
             end = real(self.end, "Tendon.end", "m")
@@ -646,8 +674,23 @@ class Tendon(Load):
             object.__setattr__(self, "end", end)
 
     @property
+    def inputs(self) -> tuple[str, ...]:
+        """The actuation input: ("tension",) or, under displacement control,
+        ("displacement",)."""
+        return ("tension",) if self.displacement is None else ("displacement",)
+
+    @property
+    def displacement_controlled(self) -> bool:
+        """True if the tendon's length change is prescribed (its tension an unknown)."""
+        return self.displacement is not None
+
+    def with_tension(self, tension) -> Tendon:
+        """The same tendon under tension control, pulled with ``tension`` (N)."""
+        return Tendon(tension, self.routing, self.end)
+
+    @property
     def batch_shape(self) -> tuple[int, ...]:
-        return self.tension.shape
+        return (self.tension if self.displacement is None else self.displacement).shape
 
     def check(self, arm) -> None:
         _check_on_arm(self, arm, "end")
@@ -661,6 +704,13 @@ class Tendon(Load):
         return 0.0, length if self.end is None else min(self.end, length)
 
     def apply(self, target: LoadTarget) -> None:
+        if self.displacement is not None:
+            # the tension is an unknown: a solver that handles displacement control replaces
+            # the tendon by :meth:`with_tension` first; any other target (a closed form)
+            # learns that it meets a load it does not know
+            target.displaced_tendon(self.displacement, self.routing,
+                                    self.path_span(target.length))
+            return
         target.actuator("tendon", self.tension, self.routing, self.path_span(target.length))
 
     def in_base_frame(self, R, origin=None) -> Tendon:
@@ -668,8 +718,15 @@ class Tendon(Load):
 
     def describe(self, swept=None) -> str:
         where = "the tip" if self.end is None else f"s = {self.end:.4g} m"
-        return (f"tendon {_magnitude_text(self.tension, 'N', swept, 'tension')}, "
-                f"{self.routing.describe()}, anchored at {where}")
+        if self.displacement is not None:
+            d = self.displacement
+            if (swept is not None and swept[0] == "displacement") or d.ndim or d >= 0:
+                what = f"length change {_magnitude_text(d, 'm', swept, 'displacement')}"
+            else:
+                what = f"pulled in by {-float(d):.4g} m"
+        else:
+            what = _magnitude_text(self.tension, "N", swept, "tension")
+        return f"tendon {what}, {self.routing.describe()}, anchored at {where}"
 
 
 @dataclass(frozen=True, eq=False)

@@ -216,7 +216,8 @@ def _batched(eq: Equilibrium) -> Equilibrium:
                    stresses=eq.stresses[None], residual=np.array([eq.residual]),
                    error_estimate=np.array([eq.error_estimate]), stability=verdict,
                    tip_compliance=None, compliance=None, base_wrench=None,
-                   tendon_tensions=None, tendon_lengths=None, tendon_length_changes=None)
+                   tendon_tensions=None, tendon_lengths=None, tendon_length_changes=None,
+                   tendon_slack=None)
 
 
 def _take(loads: tuple, start: int, stop: int) -> tuple:

@@ -165,6 +165,9 @@ def actuated(arm, loads, s=None):
                      tendon_lengths=_frozen(lengths.reshape(*shape, len(tendons))),
                      tendon_length_changes=_frozen((lengths - unloaded).reshape(
                          *shape, len(tendons))))
+        slack = tensions == 0.0
+        slack.setflags(write=False)
+        extra["tendon_slack"] = slack
     return dataclasses.replace(result, **extra)
 
 

@@ -506,6 +506,28 @@ def _deriv(work, twork, nt, stage, s, arm, j, now, rate, law):
         o[_TM] = -(q1 * nz - q2 * ny) - (py * dn2 - pz * dn1) + k0
         o[_TM + 1] = -(q2 * nx - q0 * nz) - (pz * dn0 - px * dn2) + k1
         o[_TM + 2] = -(q0 * ny - q1 * nx) - (px * dn1 - py * dn0) + k2
+    if twork.shape[2] > NT:  # the tendons' lengths' tangents (actuated arms only)
+        _length_rates(twork[stage], nt, arm, j, actuated, law)
+
+
+@_inline
+def _length_rates(out, nt, arm, j, actuated, law):
+    """The tangent rates of the tendons' lengths, out[d, NT + a] = δ|w_a| = g_aᵀ δε for
+    the first nt columns: δw = δv + δu × r = J δε (J = [I, -r~]), so δ|w| = tᵀ J δε with
+    Jᵀ t = g = (t; r × t), t = w/|w| (from ``law[1]``), δε the columns' strain variations
+    (``law[0][:, 6 + d]``); 0 where tendon a does not run, and for a chamber."""
+    kinds, active = arm[10], arm[11]
+    tw, M = law[1], law[0]
+    for a in range(out.shape[1] - NT):
+        if not (actuated and active[j, a] != 0.0 and kinds[a] == TENDON):
+            for d in range(nt):
+                out[d, NT + a] = 0.0
+            continue
+        t0, t1, t2, y, z = tw[a, 0], tw[a, 1], tw[a, 2], tw[a, 4], tw[a, 5]
+        g3, g4, g5 = y * t2 - z * t1, z * t0, -y * t0
+        for d in range(nt):
+            out[d, NT + a] = (t0 * M[0, 6 + d] + t1 * M[1, 6 + d] + t2 * M[2, 6 + d]
+                              + g3 * M[3, 6 + d] + g4 * M[4, 6 + d] + g5 * M[5, 6 + d])
 
 
 @_jit
@@ -582,6 +604,10 @@ def _rk4(y, T, nt, h, s, arm, j, now, rate, work, twork, law):
         for d in range(nt):
             for i in range(NT):
                 twork[4, d, i] = T[d, i] + a * twork[prev, d, i] if stage else T[d, i]
+        if T.shape[1] > NT:  # the tendons' lengths' tangents (actuated arms only)
+            for d in range(nt):
+                for i in range(NT, T.shape[1]):
+                    twork[4, d, i] = T[d, i] + a * twork[prev, d, i] if stage else T[d, i]
         _deriv(work, twork, nt, stage, s + a, arm, j, now, rate, law)
     w = h / 6.0
     for i in range(y.size):
@@ -590,6 +616,11 @@ def _rk4(y, T, nt, h, s, arm, j, now, rate, work, twork, law):
         for i in range(NT):
             T[d, i] += w * (twork[0, d, i] + 2.0 * twork[1, d, i] + 2.0 * twork[2, d, i]
                             + twork[3, d, i])
+    if T.shape[1] > NT:
+        for d in range(nt):
+            for i in range(NT, T.shape[1]):
+                T[d, i] += w * (twork[0, d, i] + 2.0 * twork[1, d, i] + 2.0 * twork[2, d, i]
+                                + twork[3, d, i])
     g00 = 1.5 - 0.5 * (y[3] * y[3] + y[6] * y[6] + y[9] * y[9])
     g11 = 1.5 - 0.5 * (y[4] * y[4] + y[7] * y[7] + y[10] * y[10])
     g22 = 1.5 - 0.5 * (y[5] * y[5] + y[8] * y[8] + y[11] * y[11])
@@ -680,7 +711,7 @@ def _start(y, T, nt, base, x):
     for i in range(18, y.size):
         y[i] = 0.0  # the tendons' lengths
     for d in range(nt):
-        for i in range(NT):
+        for i in range(T.shape[1]):  # with the tendons' lengths' (0 at the base)
             T[d, i] = 0.0
         if d < 6:
             T[d, _TN + d] = 1.0  # δ(n(0); m(0)) = e_d
@@ -1147,7 +1178,7 @@ def _record(x, nt, steps, base, arm, case, lam, scratch, s_out, out, b, r, J):
                 for a in range(y.size):
                     ys[a] = y[a]
                 for d in range(nt):
-                    for a in range(NT):
+                    for a in range(T.shape[1]):
                         Ts[d, a] = T[d, a]
                 _steps(ys, Ts, nt, s_out[k] - t0, t0, one, arm, j, now, rate, work, twork,
                        law)
@@ -1160,6 +1191,9 @@ def _record(x, nt, steps, base, arm, case, lam, scratch, s_out, out, b, r, J):
         _write(y, T, nt, npieces - 1, arm[6], arm, now, law, poses[i], strains[i],
                stresses[i], E[i])
     _tip_residual(y, T, nt, tip_now, tip_rate, r, J, arm, now, rate, law)
+    for a in range(J.shape[0] - 6):  # rows 6 + a (when given): tendon a's length's tangents
+        for d in range(nt):
+            J[6 + a, d] = T[d, NT + a]
     base_out, lengths = out[7], out[8]
     for i in range(6):
         base_out[b, i] = x[i]
@@ -1308,9 +1342,9 @@ def _scratch(npieces, nact, ncols):
     width = 18 + nact
     law = (np.empty((6, 6 + ncols)), np.zeros((max(nact, 1), 8)), np.zeros((6, 6)),
            np.zeros((6, 6)))
-    return (np.empty(width), np.empty((ncols, NT)), np.empty((6, width)),
-            np.empty((5, ncols, NT)), np.empty((npieces, PIECE_LOADS + nact)),
-            np.empty(TIP_LOADS), np.empty(width), np.empty((ncols, NT)), law)
+    return (np.empty(width), np.empty((ncols, NT + nact)), np.empty((6, width)),
+            np.empty((5, ncols, NT + nact)), np.empty((npieces, PIECE_LOADS + nact)),
+            np.empty(TIP_LOADS), np.empty(width), np.empty((ncols, NT + nact)), law)
 
 
 @_jit
@@ -1396,7 +1430,8 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
     tip_start = np.zeros(TIP_LOADS)
     tip_rate = np.empty((1, TIP_LOADS))
     case = (start, rate, tip_start, tip_rate)
-    J_out = np.empty((6, 6 + n_inputs))  # the output pass's Jacobian: x, then the inputs
+    # the output pass's Jacobian: x, then the inputs; rows 6 + a: tendon a's length's
+    J_out = np.empty((6 + width - PIECE_LOADS, 6 + n_inputs))
     r = np.empty(6)
     J = np.empty((6, 7))
     J_c = np.empty((6, 7))
@@ -1568,8 +1603,8 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
         info[b, 3] = counter[0]
         if not math.isfinite(residual):
             status[b] = NOT_FINITE
-        for i in range(6):
-            for k in range(jac.shape[2] if nt_out else 0):
+        for i in range(jac.shape[1] if nt_out else 0):
+            for k in range(jac.shape[2]):
                 jac[b, i, k] = J_out[i, k] if n_inputs else J[i, k]
         if chained:
             for i in range(6):

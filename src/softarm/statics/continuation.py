@@ -130,7 +130,7 @@ class Path:
         self.grid = np.concatenate(grid)
         self._r, self._J = np.empty(6), np.empty((6, 7))
         self._y = np.empty(18 + len(channels.actuators))
-        self._T = np.empty((7, 12))
+        self._T = np.empty((7, 12 + len(channels.actuators)))
         self.shootings = 0
 
     # nondimensional variables: z = (x / xscale, λ)

@@ -234,6 +234,13 @@ class _Channels:
         self.actuators.append((k.TENDON if kind == "tendon" else k.CHAMBER, routing, active,
                                (float(span[0]), float(span[1]))))
 
+    def displaced_tendon(self, displacement, routing, span):
+        raise ValueError(
+            "a displacement-controlled Tendon (Tendon(displacement=...)) is solved by "
+            "softarm.solve and Solver.solve only; this route (shoot, continuation, "
+            "branch='stable', stability sweeps) takes tension-controlled tendons: use "
+            "Tendon.with_tension(eq.tendon_tensions[...]) from a solved equilibrium")
+
     def field(self, field, gradient=None):
         k = self.k
         self._piece[..., :, k.FB:k.FB + 3] += np.asarray(field)[..., None, :]
@@ -440,7 +447,9 @@ class Solver:
     def solve(self, loads, *, jacobians: bool = False) -> Equilibrium:
         """The equilibrium reached by driving the arm slowly from its previous equilibrium
         (the unloaded arm after construction or :meth:`reset`) to ``loads``; a batch is
-        followed case after case in order.
+        followed case after case in order. Loads with a displacement-controlled
+        :class:`~softarm.Tendon` are solved from the unloaded arm instead (its tension is an
+        unknown, ``docs/control.md``), and the quasi-static memory restarts after them.
 
         Raises
         ------
@@ -461,6 +470,16 @@ class Solver:
     def _solve(self, loads, *, chained: bool, jacobians: bool) -> Equilibrium:
         if not isinstance(jacobians, (bool, np.bool_)):
             raise TypeError(f"jacobians must be True or False, got {jacobians!r}")
+        loads = as_loads(loads)
+        if any(load.displacement_controlled for load in loads):
+            # the tensions are unknowns: a bounded Newton method over tension-controlled
+            # solves from the unloaded arm (statics/displacement.py); a chained Solver
+            # restarts from the unloaded arm after it
+            from .displacement import solve_displaced
+
+            if chained:
+                self.reset()
+            return solve_displaced(self, loads, jacobians=jacobians)
         k = _kernels()
         last = self._last if chained else None
         loads, shape, count, pieces, channels = self._prepare(
@@ -490,7 +509,9 @@ class Solver:
             if jacobians else (np.zeros((0, *channels.piece.shape[1:])),
                                np.zeros((0, k.TIP_LOADS)))
         n_in = inputs[0].shape[0]
-        jac = np.zeros((count, 6, 6 + n_in) if jacobians else (0, 6, 6))
+        # rows 6 + a: actuator a's length per column (a tendon's; 0 for a chamber)
+        jac = np.zeros((count, 6 + len(channels.actuators), 6 + n_in) if jacobians
+                       else (0, 6, 6))
         motion = np.zeros((count, S, 6, 6 + n_in) if jacobians else (1, S, 6, 6))
         base_wrench = np.empty((count, 6))
         lengths = np.empty((count, len(channels.actuators)))
@@ -510,10 +531,11 @@ class Solver:
                           channels.signature())
         tip_compliance = compliance = None
         if jacobians:
-            tip_compliance, compliance, tip_inputs, station_inputs = _compliances(
-                jac, motion, shape)
+            tip_compliance, compliance, tip_inputs, station_inputs, lengths_inputs = \
+                _compliances(jac, motion, shape, _tendon_rows(channels))
             actuation.update(actuation_jacobian=tip_inputs,
-                             station_actuation_jacobian=station_inputs)
+                             station_actuation_jacobian=station_inputs,
+                             tendon_length_jacobian=lengths_inputs)
         if self.stability:
             from .stability import verdict
 
@@ -610,7 +632,8 @@ class Solver:
                     tip[None].copy())
         ncols = 6 + case[1].shape[0]
         r, J = np.empty(6), np.empty((6, ncols))
-        y, T = np.empty(18 + len(channels.actuators)), np.empty((ncols, 12))
+        A = len(channels.actuators)  # the tangent rows carry the A tendon lengths
+        y, T = np.empty(18 + A), np.empty((ncols, 12 + A))
         k.shoot(x.copy(), lam, counts, self._base_kernel, channels.arm_tuple(), case, r, J, y,
                 T)
         R = y[3:12].reshape(3, 3)
@@ -649,10 +672,13 @@ def _actuation(channels, base_wrench, lengths, shape) -> dict:
     for array in (length, tension):
         array.setflags(write=False)
     change = length - unloaded
-    change.setflags(write=False)
+    slack = tension == 0.0
+    for array in (change, slack):
+        array.setflags(write=False)
     out.update(tendon_tensions=tension.reshape(*shape, len(tendons)),
                tendon_lengths=length.reshape(*shape, len(tendons)),
-               tendon_length_changes=change.reshape(*shape, len(tendons)))
+               tendon_length_changes=change.reshape(*shape, len(tendons)),
+               tendon_slack=slack.reshape(*shape, len(tendons)))
     return out
 
 
@@ -701,13 +727,25 @@ def _recut(old_starts, old_piece, new_starts) -> np.ndarray:
     return out
 
 
-def _compliances(jac, motion, shape):
+def _tendon_rows(channels) -> np.ndarray:
+    """The actuator columns (in the kernel's order) that are tendons, in the order given."""
+    k = channels.k
+    return np.array([a for a, actuator in enumerate(channels.actuators)
+                     if actuator[0] == k.TENDON], dtype=np.int64)
+
+
+def _compliances(jac, motion, shape, tendons):
     """Tip and station compliances C(s) = E_x(s) J_x⁻¹ (dead tip wrench → (δp; δθ)
     spatial): a dead tip wrench δW changes the residual by -δW, so the base reaction by
     J_x⁻¹ δW. And the actuation Jacobians (implicit function theorem): an input change δq
     moves the residual by J_q δq at fixed x, so x by -J_x⁻¹ J_q δq and the stations by
-    (E_q - E_x J_x⁻¹ J_q) δq. Returns (tip compliance, station compliances, tip actuation
-    Jacobian, station actuation Jacobians); the last two None without inputs."""
+    (E_q - E_x J_x⁻¹ J_q) δq; the tendons' lengths likewise by (E_ℓq - E_ℓx J_x⁻¹ J_q) δq
+    (``jac`` rows 6 + a: actuator a's length's tangents; ``tendons`` the actuators that
+    are tendons). Returns (tip compliance, station compliances, tip actuation Jacobian,
+    station actuation Jacobians, tendon length Jacobian (B..., T, n)); the last three None
+    without inputs (the last also without tendons)."""
+    lengths = jac[:, 6 + tendons, :]
+    jac = jac[:, :6]
     inverse = np.linalg.inv(jac[:, :, :6])
     station = np.einsum("bsij,bjk->bsik", motion[..., :6], inverse)
     tip = station[:, -1].copy()
@@ -718,8 +756,13 @@ def _compliances(jac, motion, shape):
         through_x = np.einsum("bij,bjk->bik", inverse, jac[:, :, 6:])
         inputs = motion[..., 6:] - np.einsum("bsij,bjk->bsik", motion[..., :6], through_x)
         out += [inputs[:, -1].copy().reshape(*shape, 6, n), inputs.reshape(*shape, S, 6, n)]
+        if tendons.size:
+            out.append((lengths[..., 6:] - np.einsum("bij,bjk->bik", lengths[..., :6],
+                                                     through_x)).reshape(*shape, -1, n))
+        else:
+            out.append(None)
     else:
-        out += [None, None]
+        out += [None, None, None]
     for array in out:
         if array is not None:
             array.setflags(write=False)
