@@ -52,9 +52,18 @@ __all__ = ["MEMORY", "OPTIONS", "PIECE_LOADS", "TIP_LOADS", "shoot", "solve_case
 
 #: numba's cached compile (in memory, with a warning, where the cache cannot be written)
 _jit = partial(jit, what="the shooting solver's kernels")
-#: The same, inlined into its callers at numba's level (the RK4 step and its right-hand side:
-#: left to LLVM, they stay out of line once the actuated path exists, and every station and
-#: step then pays a call that passes the arm's arrays by value)
+#: The same, inlined into its callers at numba's level: the RK4 step and its right-hand side
+#: (left to LLVM, they stay out of line once the actuated path exists, and every stage then
+#: pays a call that passes the arm's arrays by value), and thin helpers called from one or
+#: two places (_integrate, _output, _chord, _follow, _sweep).
+#:
+#: Design note on compile time. numba links every callee's code into each compiled caller
+#: and optimises and emits the whole module again there: the RK4 right-hand side is built
+#: once per *compiled function above it*. So the step is compiled in one function
+#: (`_steps`), the small layers above it are inlined (one module fewer each), and the
+#: actuated constitutive law `_law` stays a compiled callee (inlined, it made actuated steps
+#: 17 % faster but the cold compile 12 s longer). Measured cold compile of a first solve with
+#: its stability verdict (benchmarks/run.py's figure): 110 s -> 62 s on this 2-core machine.
 _inline = partial(jit, what="the shooting solver's kernels", inline="always")
 
 
@@ -171,7 +180,7 @@ def _route(routes, a, s):
     return y, z, dy, dz
 
 
-@_inline
+@_jit
 def _law(arm, j, s, now, law, s0, s1, s2, s3, s4, s5):
     """The constitutive law of piece j at arc length s with its actuators (Rucker & Webster
     2011, in total-wrench form): the strains ε = (v; u) solving
@@ -756,7 +765,7 @@ def _set_loads(lam, case, now, tip_now):
         tip_now[i] = tip_start[i] + lam * tip_rate[0, i]
 
 
-@_jit
+@_inline
 def _integrate(x, lam, nt, steps, base, arm, case, scratch, r, J):
     """Integrate base → tip from the base reaction x at load factor λ: the residual r (6) and
     the first nt Jacobian columns J[:, :nt] (6 by x, the 7th by λ). The tip state is left in
@@ -1283,7 +1292,7 @@ def _first_steps(arm, tol, turning):
     return min(256, max(2, n))
 
 
-@_jit
+@_inline
 def _chord(x, J_c, steps, base, arm, case, scratch, scale, threshold, max_iterations,
            may_defer, r, J, tip, counter):
     """The solution at λ = 1 with another step count by chord iterations from x (a solution
@@ -1353,7 +1362,7 @@ def _copy(src, dst):
         dst.flat[i] = src.flat[i]
 
 
-@_jit
+@_inline
 def _output(x, nt, steps, base, arm, case, piece_loads, tip_loads, inputs, scratch, s_out,
             out, b, r, J, J_out):
     """The output pass of case b (:func:`_record` at λ = 1); with tangents (nt = 6) and
