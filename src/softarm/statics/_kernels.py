@@ -55,7 +55,7 @@ _jit = partial(jit, what="the shooting solver's kernels")
 #: The same, inlined into its callers at numba's level: the RK4 step and its right-hand side
 #: (left to LLVM, they stay out of line once the actuated path exists, and every stage then
 #: pays a call that passes the arm's arrays by value), and thin helpers called from one or
-#: two places (_integrate, _output, _chord, _follow, _sweep).
+#: two places (_integrate, _output, _chord).
 #:
 #: Design note on compile time. numba links every callee's code into each compiled caller
 #: and optimises and emits the whole module again there: the RK4 right-hand side is built
