@@ -101,6 +101,7 @@ def app_redraws(driver, moves: int) -> list[dict]:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--moves", type=int, default=20)
+    parser.add_argument("--only", choices=("viewer", "app"))
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as folder:
         folder = Path(folder)

@@ -163,3 +163,34 @@ def test_app_slider_resolves_and_redraws(browser, live_server, tmp_path):
     np.testing.assert_allclose(shown, weightless, atol=1e-6)
     errors = _browser.severe_console_messages(browser)
     assert len(errors) == 1 and "oops" in errors[0] and "400" in errors[0]  # the one we sent
+
+
+def test_notebook_outputs_share_one_plotly_js(browser, tmp_path, monkeypatch):
+    # Outputs as a notebook page holds them: only the first display of the kernel session
+    # embeds plotly.js. A view above it on the page (drawn before the library arrives) waits
+    # for it; one below uses it; one without any embedding output on the page says why it
+    # is blank instead of failing.
+    case = softarm.load_case(EXAMPLES / "demo.toml")
+    result = softarm.solve(case.arm, case.loads)
+    monkeypatch.setitem(view._notebook, "embedded", False)
+    first, second, third = (result._repr_html_() for _ in range(3))
+    page = tmp_path / "notebook.html"
+    page.write_text(f"<!DOCTYPE html><html><head><meta charset='utf-8'></head><body>"
+                    f"{second}{first}{third}</body></html>", encoding="utf-8")
+    browser.get(page.as_uri())
+    drawn = ("return Array.from(document.querySelectorAll('.plotly-graph-div'))"
+             ".filter(gd => gd._fullLayout && gd.querySelector('canvas')).length;")
+    assert wait_for(browser, f"{drawn.removesuffix(';')} === 3 ? 3 : 0") == 3
+    ids = browser.execute_script("return Array.from(document.querySelectorAll("
+                                 "'.plotly-graph-div')).map(gd => gd.id)")
+    assert len(set(ids)) == 3
+    for div in ids:  # each draws the equilibrium: its centreline ends at the tip
+        np.testing.assert_allclose(browser.execute_script(tip_js(div)), result.tip_position,
+                                   atol=1e-6)
+    assert _browser.severe_console_messages(browser) == []
+    alone = tmp_path / "alone.html"
+    alone.write_text(f"<!DOCTYPE html><html><body>{third}</body></html>", encoding="utf-8")
+    browser.get(alone.as_uri())
+    text = wait_for(browser, "return document.querySelector('.plotly-graph-div').textContent")
+    assert "waiting for plotly.js" in text and "NOTEBOOK_PLOTLYJS = 'always'" in text
+    assert _browser.severe_console_messages(browser) == []

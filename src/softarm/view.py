@@ -31,11 +31,12 @@ from .geometry import (
     sweep_axis,
     tip_frame,
     tube_mesh,
+    tube_rings,
     tube_surface,
 )
 
-__all__ = ["PLOTLY_MISSING", "figure", "plotly_js_path", "scene_traces", "to_html", "to_json",
-           "view_result_file", "write_html"]
+__all__ = ["NOTEBOOK_PLOTLYJS", "PLOTLY_MISSING", "figure", "notebook_html", "plotly_js_path",
+           "scene_traces", "to_html", "to_json", "view_result_file", "write_html"]
 
 #: The message when plotly is not installed.
 PLOTLY_MISSING = "the browser views need plotly: pip install 'softarm[view]'"
@@ -45,7 +46,11 @@ _LINE = "rgb(214,39,40)"
 _AXES = ("rgb(220,40,40)", "rgb(40,160,40)", "rgb(40,80,220)")
 _FORCE = "rgb(60,60,60)"
 _MOMENT = "rgb(148,103,189)"
-_SIDES = 16  # tube facets: enough for a smooth look, few enough for a small file
+# The tube's mesh: software WebGL (headless or GPU-less browsers) spends its time per vertex,
+# so the tube has at most about _RINGS rings of _SIDES vertices whatever the number of
+# stations (1616 vertices at 101 stations before; the look is the same, see tube_rings).
+_SIDES = 16
+_RINGS = 50
 
 
 def _plotly():
@@ -131,23 +136,27 @@ def _arrow_scales(arrows_per_frame, length: float) -> dict[str, float]:
             for key, value in largest.items() if value > 0}
 
 
-def _scene_traces(result, arrows, scales, radii) -> list[dict]:
-    """The traces of one (unbatched) equilibrium, always the same number and order."""
+def _scene_traces(result, arrows, scales, rings) -> list[dict]:
+    """The traces of one (unbatched) equilibrium, always the same number and order (``rings``:
+    :func:`softarm.geometry.tube_rings` of the arm, or None to draw no tube)."""
     poses = np.asarray(result.poses)
     p = poses[:, :3, 3]
     length = float(result.arm.length)
     traces = []
     custom = np.concatenate([np.asarray(result.s)[:, None], result.strains, result.stresses],
                             axis=-1)
-    if radii is not None:
-        vertices, triangles = tube_mesh(poses, radii, sides=_SIDES)
+    if rings is not None:
+        index, radii = rings
+        vertices, triangles = tube_mesh(poses[index], radii, sides=_SIDES)
         traces.append({"type": "mesh3d", "x": vertices[:, 0], "y": vertices[:, 1],
                        "z": vertices[:, 2], "i": triangles[:, 0], "j": triangles[:, 1],
                        "k": triangles[:, 2], "color": _TUBE, "opacity": 1.0,
-                       "customdata": np.repeat(custom, _SIDES, axis=0),
+                       "customdata": np.repeat(custom[index], _SIDES, axis=0),
                        "hovertemplate": _HOVER.replace("centreline", "arm"), "name": "arm",
                        "showlegend": True})
-    traces.append({"type": "scatter3d", "mode": "lines+markers", "x": p[:, 0], "y": p[:, 1],
+    # inside the opaque tube the stations' markers cannot be seen: drawn without a tube only
+    traces.append({"type": "scatter3d", "mode": "lines" if rings is not None else
+                   "lines+markers", "x": p[:, 0], "y": p[:, 1],
                    "z": p[:, 2], "customdata": custom, "hovertemplate": _HOVER,
                    "line": {"color": _LINE, "width": 4}, "marker": {"size": 2, "color": _LINE},
                    "name": "centreline"})
@@ -175,10 +184,13 @@ def _scene_traces(result, arrows, scales, radii) -> list[dict]:
     return traces
 
 
-def scene_traces(result, scales) -> list[dict]:
-    """The 3D traces of one (unbatched) equilibrium, as in :func:`figure` with ``scales``."""
+def scene_traces(result, scales, *, changing: bool = False) -> list[dict]:
+    """The 3D traces of one (unbatched) equilibrium, as in :func:`figure` with ``scales``;
+    ``changing``: only what changes with the equilibrium (coordinates, hover data), the
+    same for each trace as a sweep's frame holds, to update a drawn figure with."""
     arrows = load_arrows(result.loads, result.poses, result.s, result.arm)
-    return _scene_traces(result, arrows, scales, station_radii(result.arm, result.s))
+    traces = _scene_traces(result, arrows, scales, tube_rings(result.arm, result.s, _RINGS))
+    return [_changing(trace) for trace in traces] if changing else traces
 
 
 def _extent(result, radii, arrows, scales) -> np.ndarray:
@@ -253,7 +265,8 @@ def figure(result, *, name: str | None = None, values=None, label: str | None = 
     layout = {"scene": scene, "height": height, "margin": {"l": 10, "r": 10, "t": 60, "b": 10},
               "legend": {"x": 0.0, "y": 1.0}, "hovermode": "closest",
               "uirevision": "keep the camera"}
-    data = _scene_traces(cases[0], arrows[0], scales, radii)
+    rings = tube_rings(result.arm, result.s, _RINGS)
+    data = _scene_traces(cases[0], arrows[0], scales, rings)
 
     def caption(case) -> str:
         tip = np.asarray(case.tip_position)
@@ -263,6 +276,7 @@ def figure(result, *, name: str | None = None, values=None, label: str | None = 
     layout["title"] = {"text": caption(cases[0]), "x": 0.02, "font": {"size": 14}}
     fig = {"data": data, "layout": layout}
     if not batch:
+        data.append(_cube_anchor(centre, half))
         return fig
 
     steps = batch[0]
@@ -275,20 +289,22 @@ def figure(result, *, name: str | None = None, values=None, label: str | None = 
                      "line": {"color": _AXES[k]}, "marker": {"size": 5},
                      "hovertemplate": f"{label} = %{{x:.4g}}<br>tip {axis} = %{{y:.4g}} m"
                      "<extra></extra>"})
+    shown = len(data)
     data.append({"type": "scatter", "mode": "markers", "x": [values[0]] * 3,
                  "y": tips[0].tolist(), "xaxis": "x", "yaxis": "y", "name": "shown",
                  "marker": {"size": 12, "color": "rgba(0,0,0,0)",
                             "line": {"color": "black", "width": 2}},
                  "hoverinfo": "skip", "showlegend": False})
+    data.append(_cube_anchor(centre, half))
     layout["xaxis"] = {"domain": [0.72, 1.0], "anchor": "y", "title": {"text": label}}
     layout["yaxis"] = {"domain": [0.3, 0.9], "anchor": "x", "title": {"text": "tip (m)"}}
     names = [f"{v:.6g}" for v in values]
     frames = []
     for k, case in enumerate(cases):
-        traces = [_changing(trace) for trace in _scene_traces(case, arrows[k], scales, radii)]
+        traces = [_changing(trace) for trace in _scene_traces(case, arrows[k], scales, rings)]
         traces.append({"x": [values[k]] * 3, "y": tips[k].tolist()})
         frames.append({"name": names[k], "data": traces,
-                       "traces": [*range(n_scene), len(data) - 1],
+                       "traces": [*range(n_scene), shown],
                        "layout": {"title": {"text": caption(case), "x": 0.02,
                                             "font": {"size": 14}}}})
     fig["frames"] = frames
@@ -307,6 +323,20 @@ def figure(result, *, name: str | None = None, values=None, label: str | None = 
                     {"label": "❚❚", "method": "animate", "args": [[None], now]}]}]
     layout["margin"]["b"] = 40
     return fig
+
+
+def _cube_anchor(centre, half) -> dict:
+    """An undrawn trace (mode "none") at two corners of the axis cube.
+
+    plotly.js scales a 3D scene's data by the extent of the data, not of the axes: when the
+    arm moves (a sweep's frame, an app's slider), that scale changes, and with it the axes'
+    tick positions, and the scene rebuilds its grid lines and compiles their shader again on
+    every redraw, which costs software WebGL tens of milliseconds. These two points make the
+    data's extent that of the fixed axis cube, so the scale stays put."""
+    corners = np.array([centre - half, centre + half])
+    return {"type": "scatter3d", "mode": "none", "x": corners[:, 0], "y": corners[:, 1],
+            "z": corners[:, 2], "hoverinfo": "skip", "showlegend": False,
+            "name": "axis cube"}
 
 
 _CHANGING = ("x", "y", "z", "u", "v", "w", "customdata", "text")
@@ -335,13 +365,17 @@ def to_json(fig: dict) -> str:
 def _compact(value):
     """``value`` with numeric arrays as plotly.js typed arrays (``{"dtype": "f4", "bdata":
     base64, "shape": "N, M"}``): float32 keeps 7 significant digits, more than a drawing or
-    its read-outs show, in a fifth of the characters of decimal text."""
+    its read-outs show, in a fifth of the characters of decimal text (fewer digits would
+    not help: plotly.js takes no smaller float type)."""
     if isinstance(value, dict):
         return {k: _compact(v) for k, v in value.items()}
     if isinstance(value, list):
         return [_compact(v) for v in value]
     if isinstance(value, np.ndarray) and value.dtype.kind in "fiu" and value.size:
-        dtype = "<f4" if value.dtype.kind == "f" else "<i4"
+        if value.dtype.kind == "f":
+            dtype = "<f4"
+        else:  # indices (a mesh's triangles): two bytes each while they fit
+            dtype = "<u2" if value.min() >= 0 and value.max() < 2**16 else "<i4"
         data = np.ascontiguousarray(value, dtype=dtype)
         typed = {"dtype": dtype[1:], "bdata": base64.b64encode(data.tobytes()).decode("ascii")}
         if data.ndim > 1:
@@ -350,14 +384,105 @@ def _compact(value):
     return value
 
 
-def to_html(fig: dict, *, full_html: bool = True, div_id: str | None = None) -> str:
-    """A self-contained HTML page (or ``<div>``) of ``fig`` with plotly.js embedded.
+# The page's script for one figure. WebGL draws at the screen's own resolution: plotly.js's
+# default (plotGlPixelRatio 2) draws a 3D scene at twice the resolution on every screen, four
+# times the pixels, which software WebGL (a browser without a GPU, a headless one) pays on
+# every redraw; on a high-density screen (devicePixelRatio 2) nothing changes. Without
+# window.Plotly (a notebook output that relies on an earlier output to have loaded it), the
+# figure waits for the "softarm-plotly-ready" event that an embedding output sends.
+_DRAW = """(function () {
+  var id = %(id)s, fig = %(fig)s, config = {displaylogo: false, responsive: true,
+    plotGlPixelRatio: Math.min(2, Math.max(1, Math.round(window.devicePixelRatio || 1)))};
+  function draw() {
+    var gd = document.getElementById(id);
+    if (!gd || gd.getAttribute("data-drawn")) return;
+    gd.setAttribute("data-drawn", "1");
+    gd.textContent = "";
+    Plotly.newPlot(gd, fig.data, fig.layout, config).then(function () {
+      if (fig.frames) return Plotly.addFrames(gd, fig.frames);
+    });
+  }
+  if (window.Plotly) { draw(); return; }
+  document.getElementById(id).textContent = %(waiting)s;
+  window.addEventListener("softarm-plotly-ready", draw);
+})();"""
 
-    ``div_id``: the id of the figure's ``<div>`` (default: a fresh unique one)."""
-    pio = _plotly()
-    return pio.to_html(_compact(fig), include_plotlyjs=True, full_html=full_html, auto_play=False,
-                       div_id=div_id, validate=False,
-                       config={"displaylogo": False, "responsive": True})
+_WAITING = ("softarm: waiting for plotly.js, which the first softarm view shown in this "
+            "notebook's kernel session carries; it is not on this page (its output was "
+            "cleared, or the page reloaded). Run softarm.view.NOTEBOOK_PLOTLYJS = 'always' "
+            "and this cell again, or restart the kernel and run the notebook from the top.")
+
+
+def _library() -> str:
+    """plotly.js as an inline script that announces itself ("softarm-plotly-ready")."""
+    code = plotly_js_path().read_text(encoding="utf-8")
+    if "</script" in code.lower():  # pragma: no cover - would end the script element early
+        raise ValueError("plotly.min.js contains '</script'; cannot inline it")
+    return ('<script type="text/javascript">window.PlotlyConfig = {MathJaxConfig: "local"};'
+            '</script>\n<script type="text/javascript">' + code +
+            '\nwindow.dispatchEvent(new Event("softarm-plotly-ready"));</script>\n')
+
+
+def to_html(fig: dict, *, full_html: bool = True, div_id: str | None = None,
+            include_plotlyjs: bool = True) -> str:
+    """An HTML page (or, ``full_html=False``, a ``<div>`` with its scripts) drawing ``fig``.
+
+    ``include_plotlyjs``: embed plotly.js (about 4.8 MB; the page opens offline on its own),
+    or not (the figure uses the ``window.Plotly`` of the page it is put in, waiting for it
+    if an embedding figure comes later on the page). ``div_id``: the id of the figure's
+    ``<div>`` (default: a fresh unique one)."""
+    import html
+    import uuid
+
+    if include_plotlyjs:
+        _plotly()
+    div_id = div_id or f"softarm-{uuid.uuid4().hex[:12]}"
+    height = fig.get("layout", {}).get("height", 650)
+    script = _DRAW % {"id": json.dumps(div_id), "fig": to_json(fig).replace("</", "<\\/"),
+                      "waiting": json.dumps(_WAITING)}
+    body = ((_library() if include_plotlyjs else "") +
+            f'<div id="{html.escape(div_id)}" class="plotly-graph-div" '
+            f'style="height:{int(height)}px; width:100%;"></div>\n'
+            f'<script type="text/javascript">{script}</script>\n')
+    if not full_html:
+        return f"<div>{body}</div>"
+    title = html.escape(_plain_title(fig))
+    return (f'<!DOCTYPE html>\n<html lang="en">\n<head><meta charset="utf-8">'
+            f'<title>{title}</title></head>\n<body style="margin:0">\n{body}</body>\n</html>\n')
+
+
+def _plain_title(fig: dict) -> str:
+    text = fig.get("layout", {}).get("title", {}).get("text", "softarm")
+    import re
+
+    return re.sub(r"<[^>]+>", " ", text.split("<br>")[0]).strip() or "softarm"
+
+
+#: How a notebook's rich display of an :class:`~softarm.Equilibrium` carries plotly.js:
+#: ``"once"`` (default): the first display of the kernel session embeds it (about 4.8 MB)
+#: and later ones use it from the page (tens of kB each); a reopened notebook works offline
+#: as long as that first output is still in it (its script loads plotly.js for the views
+#: below, and a view drawn before it waits for it). ``"always"``: every display embeds it
+#: (each output stands alone: for a notebook whose outputs are cleared or moved around, or a
+#: front end that isolates outputs, which Google Colab does and is detected).
+NOTEBOOK_PLOTLYJS = "once"
+_notebook = {"embedded": False}
+
+
+def notebook_html(result, **options) -> str:
+    """The notebook display of ``result`` (:func:`figure`, ``options`` as there), carrying
+    plotly.js as :data:`NOTEBOOK_PLOTLYJS` says."""
+    import sys
+
+    if NOTEBOOK_PLOTLYJS not in ("once", "always"):
+        raise ValueError(f"softarm.view.NOTEBOOK_PLOTLYJS must be 'once' or 'always', got "
+                         f"{NOTEBOOK_PLOTLYJS!r}")
+    fig = figure(result, **options)
+    embed = (NOTEBOOK_PLOTLYJS == "always" or not _notebook["embedded"]
+             or "google.colab" in sys.modules)
+    text = to_html(fig, full_html=False, include_plotlyjs=embed)
+    _notebook["embedded"] = _notebook["embedded"] or embed
+    return text
 
 
 def write_html(result, path: str | os.PathLike, **options) -> Path:
