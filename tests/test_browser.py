@@ -109,6 +109,30 @@ def test_sweep_slider_moves_the_drawn_tip(browser, tmp_path):
         time.sleep(0.05)
     # the drawn tip is that of the last step (τ = 5 N m, from the result file)
     np.testing.assert_allclose(after, saved.result.tip_position[active], atol=1e-6)
+    # the tip plot rings the shown step's tip coordinates
+    shown = browser.execute_script(
+        "const t = document.getElementById('softarm-view-tips')._fullData[3];"
+        "return [Array.from(t.x), Array.from(t.y)];")
+    np.testing.assert_allclose(shown[0], [saved.sweep_values[active]] * 3)
+    np.testing.assert_allclose(shown[1], saved.result.tip_position[active], atol=1e-6)
+    # back to the first step, then play: the frames run to the last one
+    ActionChains(browser).move_to_element_with_offset(rail, -int(0.45 * width), 0).click() \
+        .perform()
+    wait_for(browser, "return document.getElementById('softarm-view')"
+             "._fullLayout.sliders[0].active === 0")
+    browser.execute_script("const gd = document.getElementById('softarm-view');"
+                           "window.seen = []; gd.on('plotly_afterplot', "
+                           "() => window.seen.push(gd._fullLayout.sliders[0].active));")
+    play = browser.find_elements(By.CSS_SELECTOR, ".updatemenu-button")[0]
+    ActionChains(browser).move_to_element(play).click().perform()
+    wait_for(browser, "return document.getElementById('softarm-view')._fullLayout"
+             f".sliders[0].active === {active}", timeout=60)
+    wait_for(browser, f"{tip_js('softarm-view')[:-1].replace('return ', 'const p = ')};"
+             f"return Math.abs(p[0] - {saved.result.tip_position[active][0]}) < 1e-6;")
+    np.testing.assert_allclose(browser.execute_script(tip_js("softarm-view")),
+                               saved.result.tip_position[active], atol=1e-6)
+    seen = browser.execute_script("return window.seen")
+    assert sorted(set(seen)) == list(range(1, active + 1))  # every step on the way, in turn
     assert _browser.severe_console_messages(browser) == []
 
 

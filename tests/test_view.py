@@ -118,11 +118,16 @@ def test_sweep_figure_has_frames_slider_and_tip_plot(sweep):
     slider = fig["layout"]["sliders"][0]
     assert [s["args"][0] for s in slider["steps"]] == [[f["name"]] for f in fig["frames"]]
     assert fig["layout"]["updatemenus"][0]["buttons"][0]["label"] == "▶"
-    # the tip against the parameter: pure bending, tip = (sin(τL)/τ, 0, (1 - cos τL)/τ)
-    # for EI = 1 N m², L = 1 m (circular arc of curvature τ/EI, paper Fig. 2)
-    tip_x, tip_z = traces(fig, "tip x")[0], traces(fig, "tip z")[0]
-    np.testing.assert_allclose(decode(tip_x["x"]), values)
+    # the tip against the parameter, a 2D figure of its own: pure bending, tip =
+    # (sin(τL)/τ, 0, (1 - cos τL)/τ) for EI = 1 N m², L = 1 m (circular arc of curvature
+    # τ/EI, paper Fig. 2); its "shown" marker at each step's tip
+    tips = fig["tips"]
+    tip_x, tip_z = traces(tips, "tip x")[0], traces(tips, "tip z")[0]
     tau = values
+    for k, shown in enumerate(tips["shown"]):
+        np.testing.assert_allclose(shown["x"], [tau[k]] * 3)
+        np.testing.assert_allclose(shown["y"], result.tip_position[k], atol=1e-12)
+    np.testing.assert_allclose(decode(tip_x["x"]), values)
     np.testing.assert_allclose(decode(tip_x["y"]), np.sin(tau) / tau, atol=1e-6)
     np.testing.assert_allclose(np.abs(decode(tip_z["y"])), (1 - np.cos(tau)) / tau, atol=1e-6)
     # each frame redraws the centreline of its own step
@@ -187,7 +192,8 @@ def test_notebook_display(demo, monkeypatch):
 def test_show_writes_the_page(demo, tmp_path):
     _, result = demo
     path = result.show(tmp_path / "shown.html", browser=False)
-    assert path.read_text(encoding="utf-8").count("Plotly.newPlot(") == 1
+    text = path.read_text(encoding="utf-8")
+    assert text.count('class="plotly-graph-div"') == 1 and "plotly.js v" in text[:2000]
 
 
 def test_view_command_does_not_load_the_solver(tmp_path, demo):

@@ -255,7 +255,7 @@ def figure(result, *, name: str | None = None, values=None, label: str | None = 
     scales = _arrow_scales(arrows, length) if scales is None else scales
     centre, half = cube_limits(_extent(result, radii, arrows, scales)) if limits is None \
         else limits
-    scene = {"aspectmode": "cube", "domain": {"x": [0.0, 0.64 if batch else 1.0],
+    scene = {"aspectmode": "cube", "domain": {"x": [0.0, 0.66 if batch else 1.0],
                                               "y": [0.0, 1.0]},
              "camera": {"eye": {"x": 1.1, "y": -1.6, "z": 0.75}}}
     for k, axis in enumerate("xyz"):
@@ -283,44 +283,51 @@ def figure(result, *, name: str | None = None, values=None, label: str | None = 
     values, label = sweep_axis(steps, sweep, values, label)
     tips = np.asarray(result.tip_position)
     n_scene = len(data)
-    for k, axis in enumerate("xyz"):
-        data.append({"type": "scatter", "mode": "lines+markers", "x": values, "y": tips[:, k],
-                     "xaxis": "x", "yaxis": "y", "name": f"tip {axis}",
-                     "line": {"color": _AXES[k]}, "marker": {"size": 5},
-                     "hovertemplate": f"{label} = %{{x:.4g}}<br>tip {axis} = %{{y:.4g}} m"
-                     "<extra></extra>"})
-    shown = len(data)
-    data.append({"type": "scatter", "mode": "markers", "x": [values[0]] * 3,
-                 "y": tips[0].tolist(), "xaxis": "x", "yaxis": "y", "name": "shown",
-                 "marker": {"size": 12, "color": "rgba(0,0,0,0)",
-                            "line": {"color": "black", "width": 2}},
-                 "hoverinfo": "skip", "showlegend": False})
     data.append(_cube_anchor(centre, half))
-    layout["xaxis"] = {"domain": [0.72, 1.0], "anchor": "y", "title": {"text": label}}
-    layout["yaxis"] = {"domain": [0.3, 0.9], "anchor": "x", "title": {"text": "tip (m)"}}
+    # The tip against the parameter is a figure of its own (fig["tips"]), drawn in a second
+    # <div> laid over the right-hand part of the 3D figure's (where its own axes used to be):
+    # a 3D figure redraws all of itself on every frame, 2D axes included, so a separate 2D
+    # plot saves a third of the redraw; the page moves its "shown" marker on each frame.
+    tip_data = []
+    for k, axis in enumerate("xyz"):
+        tip_data.append({"type": "scatter", "mode": "lines+markers", "x": values,
+                         "y": tips[:, k], "name": f"tip {axis}",
+                         "line": {"color": _AXES[k]}, "marker": {"size": 5},
+                         "hovertemplate": f"{label} = %{{x:.4g}}<br>tip {axis} = %{{y:.4g}} m"
+                         "<extra></extra>"})
+    tip_data.append({"type": "scatter", "mode": "markers", "x": [values[0]] * 3,
+                     "y": tips[0].tolist(), "name": "shown",
+                     "marker": {"size": 12, "color": "rgba(0,0,0,0)",
+                                "line": {"color": "black", "width": 2}},
+                     "hoverinfo": "skip", "showlegend": False})
+    fig["tips"] = {"data": tip_data, "layout": {
+        "xaxis": {"title": {"text": label}}, "yaxis": {"title": {"text": "tip (m)"}},
+        "margin": {"l": 60, "r": 10, "t": 30, "b": 50},
+        "legend": {"orientation": "h", "x": 0.0, "y": 1.0, "yanchor": "bottom"},
+        "paper_bgcolor": "rgba(0,0,0,0)", "plot_bgcolor": "rgba(0,0,0,0)",
+        "hovermode": "closest"},
+        # the "shown" marker at each frame (plain lists for the page's script)
+        "shown": [{"x": [float(v)] * 3, "y": tip.tolist()} for v, tip in zip(values, tips,
+                                                                              strict=True)]}
     names = [f"{v:.6g}" for v in values]
     frames = []
     for k, case in enumerate(cases):
         traces = [_changing(trace) for trace in _scene_traces(case, arrows[k], scales, rings)]
-        traces.append({"x": [values[k]] * 3, "y": tips[k].tolist()})
-        frames.append({"name": names[k], "data": traces,
-                       "traces": [*range(n_scene), shown],
+        frames.append({"name": names[k], "data": traces, "traces": list(range(n_scene)),
                        "layout": {"title": {"text": caption(case), "x": 0.02,
                                             "font": {"size": 14}}}})
+    # The frames are shown by the page's script (to_html; "skip": plotly.js only draws the
+    # slider and the buttons): one Plotly.react per frame, see _DRAW.
     fig["frames"] = frames
-    now = {"mode": "immediate", "frame": {"duration": 0, "redraw": True},
-           "transition": {"duration": 0}}
     layout["sliders"] = [{
         "active": 0, "x": 0.05, "len": 0.9, "y": 0.0, "pad": {"t": 10},
         "currentvalue": {"prefix": f"{label} = ", "font": {"size": 13}},
-        "steps": [{"label": n, "method": "animate", "args": [[n], now]} for n in names]}]
-    play = {"mode": "immediate", "fromcurrent": True, "frame": {"duration": 400, "redraw": True},
-            "transition": {"duration": 0}}
+        "steps": [{"label": n, "method": "skip", "args": [[n]]} for n in names]}]
     layout["updatemenus"] = [{
         "type": "buttons", "direction": "left", "x": 0.05, "y": 0.08, "xanchor": "right",
         "showactive": False,
-        "buttons": [{"label": "▶", "method": "animate", "args": [None, play]},
-                    {"label": "❚❚", "method": "animate", "args": [[None], now]}]}]
+        "buttons": [{"label": "▶", "method": "skip", "args": [None]},
+                    {"label": "❚❚", "method": "skip", "args": [None]}]}]
     layout["margin"]["b"] = 40
     return fig
 
@@ -398,8 +405,51 @@ _DRAW = """(function () {
     if (!gd || gd.getAttribute("data-drawn")) return;
     gd.setAttribute("data-drawn", "1");
     gd.textContent = "";
+    var tips = fig.tips && document.getElementById(id + "-tips");
     Plotly.newPlot(gd, fig.data, fig.layout, config).then(function () {
-      if (fig.frames) return Plotly.addFrames(gd, fig.frames);
+      if (fig.frames) sweep(gd, tips);
+    });
+    if (tips) Plotly.newPlot(tips, fig.tips.data, fig.tips.layout,
+                             {displaylogo: false, responsive: true, displayModeBar: false});
+  }
+  // A sweep's slider and play button (method "skip": plotly.js only draws them) show a
+  // frame by merging its data into the figure and one Plotly.react. Plotly.animate would
+  // do the work twice: its transition step computes the figure's defaults and data before
+  // the redraw (for a 3D scene, a full one) computes them again.
+  function sweep(gd, tips) {
+    var frames = fig.frames, playing = null;
+    var names = frames.map(function (frame) { return frame.name; });
+    function show(k) {
+      var frame = frames[k];
+      frame.traces.forEach(function (t, i) { Object.assign(gd.data[t], frame.data[i]); });
+      gd.layout.title = frame.layout.title;
+      gd.layout.sliders[0].active = k;
+      gd.layout.datarevision = (gd.layout.datarevision || 0) + 1;
+      // a 2D animation step without redraw moves the tip plot's marker alone (a restyle
+      // would redraw that whole plot, as costly again as the 3D frame)
+      if (tips) Plotly.animate(tips, {data: [fig.tips.shown[k]], traces: [3]},
+        {mode: "immediate", frame: {duration: 0, redraw: false}, transition: {duration: 0}});
+      return Plotly.react(gd, gd.data, gd.layout);
+    }
+    function play() {
+      var token = {}, k = gd.layout.sliders[0].active;
+      playing = token;
+      if (k >= frames.length - 1) k = -1;
+      (function next() {
+        if (playing !== token) return;
+        k += 1;
+        show(k).then(function () {
+          if (k < frames.length - 1) setTimeout(next, 400); else playing = null;
+        });
+      })();
+    }
+    gd.on("plotly_sliderchange", function (event) {
+      playing = null;
+      var k = names.indexOf(event.step.label);
+      if (k >= 0) show(k);
+    });
+    gd.on("plotly_buttonclicked", function (event) {
+      if (event.button.label === "\u25b6") play(); else playing = null;
     });
   }
   if (window.Plotly) { draw(); return; }
@@ -440,9 +490,18 @@ def to_html(fig: dict, *, full_html: bool = True, div_id: str | None = None,
     height = fig.get("layout", {}).get("height", 650)
     script = _DRAW % {"id": json.dumps(div_id), "fig": to_json(fig).replace("</", "<\\/"),
                       "waiting": json.dumps(_WAITING)}
-    body = ((_library() if include_plotlyjs else "") +
-            f'<div id="{html.escape(div_id)}" class="plotly-graph-div" '
-            f'style="height:{int(height)}px; width:100%;"></div>\n'
+    main = (f'<div id="{html.escape(div_id)}" class="plotly-graph-div" '
+            f'style="height:{int(height)}px; width:100%;"></div>')
+    if "tips" in fig:  # a sweep's tip plot over the right of the 3D figure, see figure()
+        margin = fig["layout"]["margin"]
+        inner = int(height) - margin["t"] - margin["b"]
+        top = int(height) - margin["b"] - 0.9 * inner - 30  # its axes at 0.3-0.9 of the height
+        bottom = margin["b"] + 0.3 * inner - 50
+        main = (f'<div style="position:relative; height:{int(height)}px; width:100%;">{main}'
+                f'<div id="{html.escape(div_id)}-tips" class="plotly-graph-div" '
+                f'style="position:absolute; top:{top:.0f}px; bottom:{bottom:.0f}px; '
+                f'left:calc(0.72 * (100% - 20px) - 50px); right:0px;"></div></div>')
+    body = ((_library() if include_plotlyjs else "") + main + "\n" +
             f'<script type="text/javascript">{script}</script>\n')
     if not full_html:
         return f"<div>{body}</div>"
