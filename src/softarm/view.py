@@ -2,9 +2,14 @@
 :meth:`softarm.Equilibrium.show` and the figures of the live app (``softarm app``).
 
 The figures are built here as plain dicts in plotly's figure schema (``data``, ``layout``,
-``frames``) from :mod:`softarm.geometry`, with numpy only; plotly (``pip install
-"softarm[view]"``) is imported only to write them as a self-contained HTML file, which embeds
-plotly.js and opens without a network.
+``frames``; a sweep's tip plot as a second figure under ``"tips"``) from
+:mod:`softarm.geometry`, with numpy only, and written as HTML by :func:`to_html` with a small
+script of ours (a sweep's frames are shown by it, see ``_DRAW``); plotly (``pip install
+"softarm[view]"``) is needed only for the plotly.js it ships, which a page embeds to open
+without a network (a notebook's displays embed it once per kernel session:
+:data:`NOTEBOOK_PLOTLYJS`). Speed matters here: a figure is redrawn on every slider move, in
+browsers that may draw WebGL in software; the notes at ``_SIDES``, ``_cube_anchor`` and
+``_DRAW`` say what each choice saves.
 
 Drawn: the arm as a tube of its real radius (its centreline when the sections are not known),
 the arm and its centreline with hover read-outs (s, position, strains and stresses in the
