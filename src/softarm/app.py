@@ -9,8 +9,10 @@ solver to the unloaded arm.
 
 Endpoints: ``GET /`` the page; ``GET /plotly.min.js``; ``GET /solve?NAME=VALUE&...`` the
 equilibrium for these inputs (names as listed by ``GET /inputs``; absent ones keep their last
-value) as JSON ``{"data": [...traces], "title", "tip": [x, y, z], "solve_ms", "method",
-"residual", "stability"}`` (the verdict in words); ``GET /reset`` the same after returning
+value) as JSON ``{"data": [...traces], "ranges", "title", "tip": [x, y, z], "solve_ms",
+"method", "residual", "stability"}`` (``data``: only what changes of each 3D trace of the
+page's figure, in its order, see :func:`softarm.view.scene_traces`; ``stability``: the
+verdict in words); ``GET /reset`` the same after returning
 to the unloaded arm. A bad request (an
 unknown name, a value that is not a finite number or is out of its slider's range) gets
 HTTP 400 with ``{"error": message}``; a load the solver cannot follow (a fold, a load too large
