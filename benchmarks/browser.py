@@ -1,9 +1,10 @@
 """Browser-side figures of the viewer and the live app, in headless Debian chromium (software
 WebGL: --disable-gpu), printed as a small table:
 
-- the size of the HTML files of `softarm view` (one equilibrium, an 11-step sweep);
+- the size of the HTML files of `softarm view` (one equilibrium, an 11-step sweep) and of
+  the notebook displays (the first of a session embeds plotly.js, later ones do not);
 - sweep slider move -> redrawn frame in the viewer (plotly_sliderchange to two animation
-  frames after plotly_animated);
+  frames after the figure's plotly_afterplot);
 - app slider move -> redrawn arm (the input event to two animation frames after Plotly.react),
   split into the solve on the server, the HTTP round trip and the redraw.
 
@@ -57,9 +58,12 @@ def sweep_redraws(driver, page: Path, moves: int) -> list[float]:
     driver.execute_script("""
         const gd = document.getElementById('softarm-view');
         window.redraws = [];
+        window.t0 = null;
         gd.on('plotly_sliderchange', () => { window.t0 = performance.now(); });
-        gd.on('plotly_animated', () => requestAnimationFrame(() => requestAnimationFrame(
-            () => window.redraws.push(performance.now() - window.t0))));""")
+        gd.on('plotly_afterplot', () => { if (window.t0 === null) return;
+            const t0 = window.t0; window.t0 = null;
+            requestAnimationFrame(() => requestAnimationFrame(
+                () => window.redraws.push(performance.now() - t0))); });""")
     from selenium.webdriver.common.action_chains import ActionChains
     from selenium.webdriver.common.by import By
 
@@ -113,6 +117,14 @@ def main() -> None:
         print(f"HTML size: one equilibrium {single.stat().st_size / 1e6:.2f} MB, "
               f"11-step sweep {sweep.stat().st_size / 1e6:.2f} MB "
               f"(plotly.js {view.plotly_js_path().stat().st_size / 1e6:.2f} MB of it)")
+        view._notebook["embedded"] = False  # a fresh kernel session
+        equilibrium = softarm.solve(demo.arm, demo.loads)
+        first = len(equilibrium._repr_html_().encode())
+        again = len(equilibrium._repr_html_().encode())
+        swept = len(io.load_saved(folder / "sweep.npz").result._repr_html_().encode())
+        print(f"notebook display: first of the session {first / 1e6:.2f} MB (plotly.js "
+              f"embedded), then one equilibrium {again / 1e3:.0f} kB, 11-step sweep "
+              f"{swept / 1e3:.0f} kB")
         driver = _browser.chromium()
         try:
             redraws = sweep_redraws(driver, sweep, args.moves)

@@ -109,6 +109,30 @@ def test_sweep_slider_moves_the_drawn_tip(browser, tmp_path):
         time.sleep(0.05)
     # the drawn tip is that of the last step (τ = 5 N m, from the result file)
     np.testing.assert_allclose(after, saved.result.tip_position[active], atol=1e-6)
+    # the tip plot rings the shown step's tip coordinates
+    shown = browser.execute_script(
+        "const t = document.getElementById('softarm-view-tips')._fullData[3];"
+        "return [Array.from(t.x), Array.from(t.y)];")
+    np.testing.assert_allclose(shown[0], [saved.sweep_values[active]] * 3)
+    np.testing.assert_allclose(shown[1], saved.result.tip_position[active], atol=1e-6)
+    # back to the first step, then play: the frames run to the last one
+    ActionChains(browser).move_to_element_with_offset(rail, -int(0.45 * width), 0).click() \
+        .perform()
+    wait_for(browser, "return document.getElementById('softarm-view')"
+             "._fullLayout.sliders[0].active === 0")
+    browser.execute_script("const gd = document.getElementById('softarm-view');"
+                           "window.seen = []; gd.on('plotly_afterplot', "
+                           "() => window.seen.push(gd._fullLayout.sliders[0].active));")
+    play = browser.find_elements(By.CSS_SELECTOR, ".updatemenu-button")[0]
+    ActionChains(browser).move_to_element(play).click().perform()
+    wait_for(browser, "return document.getElementById('softarm-view')._fullLayout"
+             f".sliders[0].active === {active}", timeout=60)
+    wait_for(browser, f"{tip_js('softarm-view')[:-1].replace('return ', 'const p = ')};"
+             f"return Math.abs(p[0] - {saved.result.tip_position[active][0]}) < 1e-6;")
+    np.testing.assert_allclose(browser.execute_script(tip_js("softarm-view")),
+                               saved.result.tip_position[active], atol=1e-6)
+    seen = browser.execute_script("return window.seen")
+    assert sorted(set(seen)) == list(range(1, active + 1))  # every step on the way, in turn
     assert _browser.severe_console_messages(browser) == []
 
 
@@ -163,3 +187,34 @@ def test_app_slider_resolves_and_redraws(browser, live_server, tmp_path):
     np.testing.assert_allclose(shown, weightless, atol=1e-6)
     errors = _browser.severe_console_messages(browser)
     assert len(errors) == 1 and "oops" in errors[0] and "400" in errors[0]  # the one we sent
+
+
+def test_notebook_outputs_share_one_plotly_js(browser, tmp_path, monkeypatch):
+    # Outputs as a notebook page holds them: only the first display of the kernel session
+    # embeds plotly.js. A view above it on the page (drawn before the library arrives) waits
+    # for it; one below uses it; one without any embedding output on the page says why it
+    # is blank instead of failing.
+    case = softarm.load_case(EXAMPLES / "demo.toml")
+    result = softarm.solve(case.arm, case.loads)
+    monkeypatch.setitem(view._notebook, "embedded", False)
+    first, second, third = (result._repr_html_() for _ in range(3))
+    page = tmp_path / "notebook.html"
+    page.write_text(f"<!DOCTYPE html><html><head><meta charset='utf-8'></head><body>"
+                    f"{second}{first}{third}</body></html>", encoding="utf-8")
+    browser.get(page.as_uri())
+    drawn = ("return Array.from(document.querySelectorAll('.plotly-graph-div'))"
+             ".filter(gd => gd._fullLayout && gd.querySelector('canvas')).length;")
+    assert wait_for(browser, f"{drawn.removesuffix(';')} === 3 ? 3 : 0") == 3
+    ids = browser.execute_script("return Array.from(document.querySelectorAll("
+                                 "'.plotly-graph-div')).map(gd => gd.id)")
+    assert len(set(ids)) == 3
+    for div in ids:  # each draws the equilibrium: its centreline ends at the tip
+        np.testing.assert_allclose(browser.execute_script(tip_js(div)), result.tip_position,
+                                   atol=1e-6)
+    assert _browser.severe_console_messages(browser) == []
+    alone = tmp_path / "alone.html"
+    alone.write_text(f"<!DOCTYPE html><html><body>{third}</body></html>", encoding="utf-8")
+    browser.get(alone.as_uri())
+    text = wait_for(browser, "return document.querySelector('.plotly-graph-div').textContent")
+    assert "waiting for plotly.js" in text and "NOTEBOOK_PLOTLYJS = 'always'" in text
+    assert _browser.severe_console_messages(browser) == []

@@ -66,6 +66,31 @@ def test_tube_mesh_covers_the_surface_with_triangles():
     np.testing.assert_allclose(area, 2 * np.pi * 0.1 * 1.0, rtol=1e-3)
 
 
+def test_tube_rings_bound_the_mesh_and_keep_the_joint_sharp():
+    arm = two_segments()  # joint at s = 0.25 m: 15 mm rod, then 10 mm tube
+    s = np.linspace(0.0, 0.4, 401)  # 1 mm apart: the joint is station 250
+    index, radii = geometry.tube_rings(arm, s, rings=40)
+    # every 10th station (ceil(400 / 40)), the ends, and the joint twice: once with each
+    # segment's radius, so that the drawn step is a flat annulus
+    expected = np.concatenate([np.arange(0, 251, 10), [250], np.arange(260, 401, 10)])
+    np.testing.assert_array_equal(index, expected)
+    np.testing.assert_array_equal(radii, np.where(np.arange(expected.size) <= 25, 0.015, 0.01))
+    # a coarse solution keeps all its stations; a joint between stations gets no extra ring
+    coarse = np.linspace(0.0, 0.4, 9)  # 0.05 m apart: the joint is station 5
+    index, radii = geometry.tube_rings(arm, coarse, rings=40)
+    np.testing.assert_array_equal(index, [0, 1, 2, 3, 4, 5, 5, 6, 7, 8])
+    odd = np.linspace(0.0, 0.4, 12)
+    index, radii = geometry.tube_rings(arm, odd, rings=40)
+    np.testing.assert_array_equal(index, np.arange(12))
+    np.testing.assert_array_equal(radii, np.where(odd < 0.25, 0.015, 0.01))
+    # every 3rd of 102 stations (ceil(101 / 50)), the last one off the stride, and the first
+    # station past the joint (s = 0.25 m lies between stations 63 and 64)
+    index, _ = geometry.tube_rings(arm, np.linspace(0.0, 0.4, 102), rings=50)
+    np.testing.assert_array_equal(index, sorted([*range(0, 102, 3), 64, 101]))
+    stiff = softarm.Arm.from_stiffness(1.0, 1e6, 1e6, 1e6, 1.0, 1.0, 1.0)
+    assert geometry.tube_rings(stiff, [0.0, 1.0]) is None
+
+
 def test_silhouette_of_a_straight_arm_is_a_rectangle():
     points = np.stack([np.linspace(0.0, 2.0, 5), np.zeros(5)], -1)
     outline = geometry.silhouette(points, np.full(5, 0.1))

@@ -25,7 +25,7 @@ def decode(value):
     """A plotly.js typed array {"dtype": "f4", "bdata", "shape"} as numpy (plotly.js's own
     format: little-endian float32 in base64, shape "N, M"), or the value as an array."""
     if isinstance(value, dict):
-        array = np.frombuffer(base64.b64decode(value["bdata"]), dtype="<f4")
+        array = np.frombuffer(base64.b64decode(value["bdata"]), dtype="<" + value["dtype"])
         shape = value.get("shape")
         return array.reshape([int(n) for n in shape.split(",")]) if shape else array
     return np.asarray(value, dtype=float)
@@ -58,17 +58,28 @@ def test_figure_draws_the_equilibrium(demo):
     custom = decode(line["customdata"])
     expected = np.concatenate([result.s[:, None], result.strains, result.stresses], -1)
     np.testing.assert_allclose(custom, expected, rtol=1e-6, atol=1e-9)
-    # the tube: every vertex at the segment's radius (16 mm, then 11 mm) from the axis, with
-    # the read-outs of its station
+    # the tube: rings of 16 vertices at stations spread along the whole arm (at most about
+    # 50 rings, so no more than a 3.2 % of L gap between two); every vertex at the segment's
+    # radius (16 mm, then 11 mm) from the axis, in the plane normal to e1 there, with the
+    # read-outs of its station
     (tube,) = traces(fig, "arm", ("mesh3d",))
-    vertices = np.stack([decode(tube[a]) for a in "xyz"], -1).reshape(p.shape[0], -1, 3)
-    distance = np.linalg.norm(vertices - p[:, None, :], axis=-1)
-    radius = np.where(result.s < 0.25, 0.016, 0.011)  # demo.toml: segment radii
+    vertices = np.stack([decode(tube[a]) for a in "xyz"], -1).reshape(-1, 16, 3)
+    ring_custom = decode(tube["customdata"]).reshape(-1, 16, 13)
+    np.testing.assert_array_equal(ring_custom, ring_custom[:, :1].repeat(16, axis=1))
+    station = np.argmin(np.abs(ring_custom[:, :1, 0] - result.s), axis=1)  # by its s
+    np.testing.assert_allclose(ring_custom[:, 0], expected[station], rtol=1e-6, atol=1e-9)
+    assert station[0] == 0 and station[-1] == result.s.size - 1
+    assert np.max(np.diff(result.s[station])) <= 0.4 / 50 * 1.6 and len(station) <= 60
+    offset = vertices - p[station][:, None, :]
+    distance = np.linalg.norm(offset, axis=-1)
+    radius = np.where(result.s[station] < 0.25, 0.016, 0.011)  # demo.toml: segment radii
     np.testing.assert_allclose(distance, np.broadcast_to(radius[:, None], distance.shape),
                                rtol=1e-5)
-    np.testing.assert_allclose(decode(tube["customdata"])[::vertices.shape[1]], expected,
-                               rtol=1e-6, atol=1e-9)
-    assert np.max(decode(tube["i"])) < vertices.shape[0] * vertices.shape[1]
+    np.testing.assert_allclose(np.einsum("nkx,nx->nk", offset, result.poses[station, :3, 0]),
+                               0.0, atol=1e-7)
+    triangles = np.stack([decode(tube[a]) for a in "ijk"], -1)
+    assert tube["i"]["dtype"] == "u2" and triangles.min() == 0
+    assert triangles.max() == vertices.shape[0] * 16 - 1
     surface = vertices
     # the tip frame: 0.15 L along each column of R(L)
     (e1,) = traces(fig, "tip frame e1 e2 e3")
@@ -107,11 +118,16 @@ def test_sweep_figure_has_frames_slider_and_tip_plot(sweep):
     slider = fig["layout"]["sliders"][0]
     assert [s["args"][0] for s in slider["steps"]] == [[f["name"]] for f in fig["frames"]]
     assert fig["layout"]["updatemenus"][0]["buttons"][0]["label"] == "▶"
-    # the tip against the parameter: pure bending, tip = (sin(τL)/τ, 0, (1 - cos τL)/τ)
-    # for EI = 1 N m², L = 1 m (circular arc of curvature τ/EI, paper Fig. 2)
-    tip_x, tip_z = traces(fig, "tip x")[0], traces(fig, "tip z")[0]
-    np.testing.assert_allclose(decode(tip_x["x"]), values)
+    # the tip against the parameter, a 2D figure of its own: pure bending, tip =
+    # (sin(τL)/τ, 0, (1 - cos τL)/τ) for EI = 1 N m², L = 1 m (circular arc of curvature
+    # τ/EI, paper Fig. 2); its "shown" marker at each step's tip
+    tips = fig["tips"]
+    tip_x, tip_z = traces(tips, "tip x")[0], traces(tips, "tip z")[0]
     tau = values
+    for k, shown in enumerate(tips["shown"]):
+        np.testing.assert_allclose(shown["x"], [tau[k]] * 3)
+        np.testing.assert_allclose(shown["y"], result.tip_position[k], atol=1e-12)
+    np.testing.assert_allclose(decode(tip_x["x"]), values)
     np.testing.assert_allclose(decode(tip_x["y"]), np.sin(tau) / tau, atol=1e-6)
     np.testing.assert_allclose(np.abs(decode(tip_z["y"])), (1 - np.cos(tau)) / tau, atol=1e-6)
     # each frame redraws the centreline of its own step
@@ -150,10 +166,22 @@ def test_cli_view(tmp_path, capsys, sweep):
         assert err.count("\n") == 1 and message in err and "Traceback" not in err
 
 
-def test_notebook_display(demo):
+def test_notebook_display(demo, monkeypatch):
     _, result = demo
-    html = result._repr_html_()
-    assert html.startswith("<div") and "Plotly.newPlot(" in html
+    monkeypatch.setitem(view._notebook, "embedded", False)  # a fresh kernel session
+    first, second = result._repr_html_(), result._repr_html_()
+    library = view.plotly_js_path().stat().st_size
+    # the first display of a session carries plotly.js, the next ones use it from the page
+    assert first.startswith("<div") and "Plotly.newPlot(" in first
+    assert "plotly.js v" in first[:2000] and len(first) > library
+    assert "plotly.js v" not in second and "Plotly.newPlot(" in second
+    assert len(second) < 120_000 and "softarm-plotly-ready" in second
+    monkeypatch.setattr(view, "NOTEBOOK_PLOTLYJS", "always")
+    assert "plotly.js v" in result._repr_html_()[:2000]
+    monkeypatch.setattr(view, "NOTEBOOK_PLOTLYJS", "sometimes")
+    with pytest.raises(ValueError, match="NOTEBOOK_PLOTLYJS must be 'once' or 'always'"):
+        result._repr_html_()
+    monkeypatch.setattr(view, "NOTEBOOK_PLOTLYJS", "once")
     poses = np.broadcast_to(result.poses, (2, 2, *result.poses.shape))
     batch = softarm.Equilibrium(result.s, poses,
                                 np.zeros((2, 2, result.s.size, 6)),
@@ -164,7 +192,8 @@ def test_notebook_display(demo):
 def test_show_writes_the_page(demo, tmp_path):
     _, result = demo
     path = result.show(tmp_path / "shown.html", browser=False)
-    assert path.read_text(encoding="utf-8").count("Plotly.newPlot(") == 1
+    text = path.read_text(encoding="utf-8")
+    assert text.count('class="plotly-graph-div"') == 1 and "plotly.js v" in text[:2000]
 
 
 def test_view_command_does_not_load_the_solver(tmp_path, demo):

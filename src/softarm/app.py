@@ -9,8 +9,10 @@ solver to the unloaded arm.
 
 Endpoints: ``GET /`` the page; ``GET /plotly.min.js``; ``GET /solve?NAME=VALUE&...`` the
 equilibrium for these inputs (names as listed by ``GET /inputs``; absent ones keep their last
-value) as JSON ``{"data": [...traces], "title", "tip": [x, y, z], "solve_ms", "method",
-"residual", "stability"}`` (the verdict in words); ``GET /reset`` the same after returning
+value) as JSON ``{"data": [...traces], "ranges", "title", "tip": [x, y, z], "solve_ms",
+"method", "residual", "stability"}`` (``data``: only what changes of each 3D trace of the
+page's figure, in its order, see :func:`softarm.view.scene_traces`; ``stability``: the
+verdict in words); ``GET /reset`` the same after returning
 to the unloaded arm. A bad request (an
 unknown name, a value that is not a finite number or is out of its slider's range) gets
 HTTP 400 with ``{"error": message}``; a load the solver cannot follow (a fold, a load too large
@@ -205,7 +207,8 @@ class LiveCase:
         self._grow_limits(result)
         centre, half = self.limits
         return {"ranges": [[centre[k] - half, centre[k] + half] for k in range(3)],
-                "data": scene_traces(result, self.scales), "title": _title(self.case, loads),
+                "data": scene_traces(result, self.scales, changing=True),
+                "title": _title(self.case, loads),
                 "tip": np.asarray(result.tip_position).tolist(),
                 "solve_ms": 1e3 * seconds, "method": result.method,
                 "residual": float(np.max(result.residual)),
@@ -326,6 +329,10 @@ function query() {{
   }}).join("&");
 }}
 const layout = FIGURE.layout;
+const cube = FIGURE.data.find(trace => trace.name === "axis cube");  // see view._cube_anchor
+// WebGL at the screen's own resolution, as in softarm.view (see _DRAW there)
+const CONFIG = {{responsive: true, displaylogo: false,
+  plotGlPixelRatio: Math.min(2, Math.max(1, Math.round(window.devicePixelRatio || 1)))}};
 const status = document.getElementById("status");
 const error = document.getElementById("error");
 let busy = false, pending = null;
@@ -339,10 +346,19 @@ async function send(path) {{
     const t1 = performance.now();
     if (!reply.ok) {{ error.textContent = body.error; return; }}
     error.textContent = "";
+    // body.data holds only what changed in each scene trace (coordinates, hover data): merged
+    // into the drawn traces, so that the unchanging parts (the tube's triangles, colours,
+    // hover templates) are neither sent nor parsed again. Plotly.react with a new
+    // datarevision redraws the figure once with the new title and axis ranges too (for a 3D
+    // scene plotly.js recomputes every trace on any data change, so restyling only the
+    // changed traces would cost as much, in two calls).
+    body.data.forEach((trace, i) => Object.assign(FIGURE.data[i], trace));
     layout.title.text = body.title;
     ["xaxis", "yaxis", "zaxis"].forEach((axis, k) => {{
-      layout.scene[axis].range = body.ranges[k]; }});
-    await Plotly.react("plot", body.data, layout);
+      layout.scene[axis].range = body.ranges[k];
+      cube["xyz"[k]] = body.ranges[k]; }});
+    layout.datarevision = (layout.datarevision || 0) + 1;
+    await Plotly.react("plot", FIGURE.data, layout, CONFIG);
     await new Promise(done => requestAnimationFrame(() => requestAnimationFrame(done)));
     const t2 = performance.now();
     const tip = body.tip.map(v => v.toPrecision(4)).join(", ");
@@ -362,7 +378,7 @@ async function send(path) {{
 }}
 function request() {{ send("/solve?" + query()); }}
 document.getElementById("reset").addEventListener("click", () => send("/reset?" + query()));
-Plotly.newPlot("plot", FIGURE.data, layout, {{responsive: true, displaylogo: false}})
+Plotly.newPlot("plot", FIGURE.data, layout, CONFIG)
   .then(request);
 </script></body></html>
 """
@@ -382,6 +398,7 @@ def _page(live: LiveCase) -> bytes:
 
 class _Handler(BaseHTTPRequestHandler):
     server_version = "softarm-app"
+    protocol_version = "HTTP/1.1"  # keep-alive: a slider's requests reuse one connection
     live: LiveCase
     lock: threading.Lock
     plotly_js: bytes

@@ -268,17 +268,18 @@ class Equilibrium:
         return path
 
     def _repr_html_(self) -> str | None:
-        """Jupyter's rich display: the interactive 3D view with plotly.js embedded (about
-        5 MB per displayed result); None (the plain repr) without plotly or for a batch with
-        more than one axis."""
+        """Jupyter's rich display: the interactive 3D view (:func:`softarm.view.notebook_html`:
+        the first display of a kernel session embeds plotly.js, about 4.8 MB, later ones use
+        it from the page; see :data:`softarm.view.NOTEBOOK_PLOTLYJS`); None (the plain repr)
+        without plotly or for a batch with more than one axis."""
         try:
-            from .view import figure, to_html
+            from .view import notebook_html
         except ImportError:  # pragma: no cover - plotly missing
             return None
         if len(self.batch_shape) > 1:
             return None
         try:
-            return to_html(figure(self), full_html=False)
+            return notebook_html(self)
         except ImportError:
             return None
 

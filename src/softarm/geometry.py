@@ -20,6 +20,7 @@ __all__ = [
     "sweep_axis",
     "tip_frame",
     "tube_mesh",
+    "tube_rings",
     "tube_surface",
 ]
 
@@ -34,6 +35,38 @@ def station_radii(arm, s) -> np.ndarray | None:
     bounds = np.asarray(arm.boundaries[1:-1], dtype=float)
     index = np.searchsorted(bounds, np.asarray(s, dtype=float), side="right")
     return np.asarray(radii, dtype=float)[index]
+
+
+def tube_rings(arm, s, rings: int = 48) -> tuple[np.ndarray, np.ndarray] | None:
+    """The stations and radii of the rings of a drawn tube: (index (M,), radii (M,) in m), or
+    None if a segment's cross-section is not known.
+
+    At most about ``rings`` rings spread evenly over the stations ``s`` (every k-th station,
+    always the first and last), so that a fine solution does not make a heavy drawing; a
+    joint between segments of different radii gets two rings at its station, one of each
+    radius, so that the step is drawn flat and sharp (an annulus) whatever the spacing.
+    The rings in order, ``poses[index]`` and ``radii`` give :func:`tube_mesh` its input.
+    """
+    s = np.asarray(s, dtype=float)
+    per = [segment.radius for segment in arm.segments]
+    if any(r is None for r in per):
+        return None
+    n = s.size
+    stride = max(1, -(-(n - 1) // max(int(rings), 1)))  # ceil((n - 1) / rings)
+    keep = np.zeros(n, dtype=bool)
+    keep[::stride] = True
+    keep[-1] = True
+    bounds = np.asarray(arm.boundaries[1:-1], dtype=float)
+    joints = np.searchsorted(s, bounds)  # the station at (or just after) each joint
+    keep[joints[joints < n]] = True
+    index = np.flatnonzero(keep)
+    radii = np.asarray(per, dtype=float)[np.searchsorted(bounds, s[index], side="right")]
+    # at a joint station, a first ring of the base-side radius
+    base_side = np.asarray(per, dtype=float)[np.searchsorted(bounds, s[index], side="left")]
+    step = np.flatnonzero((base_side != radii) & (index > 0))
+    index = np.insert(index, step, index[step])
+    radii = np.insert(radii, step, base_side[step])
+    return index, radii
 
 
 def tube_surface(poses, radii, sides: int = 24) -> np.ndarray:

@@ -2,9 +2,14 @@
 :meth:`softarm.Equilibrium.show` and the figures of the live app (``softarm app``).
 
 The figures are built here as plain dicts in plotly's figure schema (``data``, ``layout``,
-``frames``) from :mod:`softarm.geometry`, with numpy only; plotly (``pip install
-"softarm[view]"``) is imported only to write them as a self-contained HTML file, which embeds
-plotly.js and opens without a network.
+``frames``; a sweep's tip plot as a second figure under ``"tips"``) from
+:mod:`softarm.geometry`, with numpy only, and written as HTML by :func:`to_html` with a small
+script of ours (a sweep's frames are shown by it, see ``_DRAW``); plotly (``pip install
+"softarm[view]"``) is needed only for the plotly.js it ships, which a page embeds to open
+without a network (a notebook's displays embed it once per kernel session:
+:data:`NOTEBOOK_PLOTLYJS`). Speed matters here: a figure is redrawn on every slider move, in
+browsers that may draw WebGL in software; the notes at ``_SIDES``, ``_cube_anchor`` and
+``_DRAW`` say what each choice saves.
 
 Drawn: the arm as a tube of its real radius (its centreline when the sections are not known),
 the arm and its centreline with hover read-outs (s, position, strains and stresses in the
@@ -31,11 +36,12 @@ from .geometry import (
     sweep_axis,
     tip_frame,
     tube_mesh,
+    tube_rings,
     tube_surface,
 )
 
-__all__ = ["PLOTLY_MISSING", "figure", "plotly_js_path", "scene_traces", "to_html", "to_json",
-           "view_result_file", "write_html"]
+__all__ = ["NOTEBOOK_PLOTLYJS", "PLOTLY_MISSING", "figure", "notebook_html", "plotly_js_path",
+           "scene_traces", "to_html", "to_json", "view_result_file", "write_html"]
 
 #: The message when plotly is not installed.
 PLOTLY_MISSING = "the browser views need plotly: pip install 'softarm[view]'"
@@ -45,7 +51,11 @@ _LINE = "rgb(214,39,40)"
 _AXES = ("rgb(220,40,40)", "rgb(40,160,40)", "rgb(40,80,220)")
 _FORCE = "rgb(60,60,60)"
 _MOMENT = "rgb(148,103,189)"
-_SIDES = 16  # tube facets: enough for a smooth look, few enough for a small file
+# The tube's mesh: software WebGL (headless or GPU-less browsers) spends its time per vertex,
+# so the tube has at most about _RINGS rings of _SIDES vertices whatever the number of
+# stations (1616 vertices at 101 stations before; the look is the same, see tube_rings).
+_SIDES = 16
+_RINGS = 50
 
 
 def _plotly():
@@ -131,23 +141,27 @@ def _arrow_scales(arrows_per_frame, length: float) -> dict[str, float]:
             for key, value in largest.items() if value > 0}
 
 
-def _scene_traces(result, arrows, scales, radii) -> list[dict]:
-    """The traces of one (unbatched) equilibrium, always the same number and order."""
+def _scene_traces(result, arrows, scales, rings) -> list[dict]:
+    """The traces of one (unbatched) equilibrium, always the same number and order (``rings``:
+    :func:`softarm.geometry.tube_rings` of the arm, or None to draw no tube)."""
     poses = np.asarray(result.poses)
     p = poses[:, :3, 3]
     length = float(result.arm.length)
     traces = []
     custom = np.concatenate([np.asarray(result.s)[:, None], result.strains, result.stresses],
                             axis=-1)
-    if radii is not None:
-        vertices, triangles = tube_mesh(poses, radii, sides=_SIDES)
+    if rings is not None:
+        index, radii = rings
+        vertices, triangles = tube_mesh(poses[index], radii, sides=_SIDES)
         traces.append({"type": "mesh3d", "x": vertices[:, 0], "y": vertices[:, 1],
                        "z": vertices[:, 2], "i": triangles[:, 0], "j": triangles[:, 1],
                        "k": triangles[:, 2], "color": _TUBE, "opacity": 1.0,
-                       "customdata": np.repeat(custom, _SIDES, axis=0),
+                       "customdata": np.repeat(custom[index], _SIDES, axis=0),
                        "hovertemplate": _HOVER.replace("centreline", "arm"), "name": "arm",
                        "showlegend": True})
-    traces.append({"type": "scatter3d", "mode": "lines+markers", "x": p[:, 0], "y": p[:, 1],
+    # inside the opaque tube the stations' markers cannot be seen: drawn without a tube only
+    traces.append({"type": "scatter3d", "mode": "lines" if rings is not None else
+                   "lines+markers", "x": p[:, 0], "y": p[:, 1],
                    "z": p[:, 2], "customdata": custom, "hovertemplate": _HOVER,
                    "line": {"color": _LINE, "width": 4}, "marker": {"size": 2, "color": _LINE},
                    "name": "centreline"})
@@ -175,10 +189,13 @@ def _scene_traces(result, arrows, scales, radii) -> list[dict]:
     return traces
 
 
-def scene_traces(result, scales) -> list[dict]:
-    """The 3D traces of one (unbatched) equilibrium, as in :func:`figure` with ``scales``."""
+def scene_traces(result, scales, *, changing: bool = False) -> list[dict]:
+    """The 3D traces of one (unbatched) equilibrium, as in :func:`figure` with ``scales``;
+    ``changing``: only what changes with the equilibrium (coordinates, hover data), the
+    same for each trace as a sweep's frame holds, to update a drawn figure with."""
     arrows = load_arrows(result.loads, result.poses, result.s, result.arm)
-    return _scene_traces(result, arrows, scales, station_radii(result.arm, result.s))
+    traces = _scene_traces(result, arrows, scales, tube_rings(result.arm, result.s, _RINGS))
+    return [_changing(trace) for trace in traces] if changing else traces
 
 
 def _extent(result, radii, arrows, scales) -> np.ndarray:
@@ -243,7 +260,7 @@ def figure(result, *, name: str | None = None, values=None, label: str | None = 
     scales = _arrow_scales(arrows, length) if scales is None else scales
     centre, half = cube_limits(_extent(result, radii, arrows, scales)) if limits is None \
         else limits
-    scene = {"aspectmode": "cube", "domain": {"x": [0.0, 0.64 if batch else 1.0],
+    scene = {"aspectmode": "cube", "domain": {"x": [0.0, 0.66 if batch else 1.0],
                                               "y": [0.0, 1.0]},
              "camera": {"eye": {"x": 1.1, "y": -1.6, "z": 0.75}}}
     for k, axis in enumerate("xyz"):
@@ -253,7 +270,8 @@ def figure(result, *, name: str | None = None, values=None, label: str | None = 
     layout = {"scene": scene, "height": height, "margin": {"l": 10, "r": 10, "t": 60, "b": 10},
               "legend": {"x": 0.0, "y": 1.0}, "hovermode": "closest",
               "uirevision": "keep the camera"}
-    data = _scene_traces(cases[0], arrows[0], scales, radii)
+    rings = tube_rings(result.arm, result.s, _RINGS)
+    data = _scene_traces(cases[0], arrows[0], scales, rings)
 
     def caption(case) -> str:
         tip = np.asarray(case.tip_position)
@@ -263,50 +281,74 @@ def figure(result, *, name: str | None = None, values=None, label: str | None = 
     layout["title"] = {"text": caption(cases[0]), "x": 0.02, "font": {"size": 14}}
     fig = {"data": data, "layout": layout}
     if not batch:
+        data.append(_cube_anchor(centre, half))
         return fig
 
     steps = batch[0]
     values, label = sweep_axis(steps, sweep, values, label)
     tips = np.asarray(result.tip_position)
     n_scene = len(data)
+    data.append(_cube_anchor(centre, half))
+    # The tip against the parameter is a figure of its own (fig["tips"]), drawn in a second
+    # <div> laid over the right-hand part of the 3D figure's (where its own axes used to be):
+    # a 3D figure redraws all of itself on every frame, 2D axes included, so a separate 2D
+    # plot saves a third of the redraw; the page moves its "shown" marker on each frame.
+    tip_data = []
     for k, axis in enumerate("xyz"):
-        data.append({"type": "scatter", "mode": "lines+markers", "x": values, "y": tips[:, k],
-                     "xaxis": "x", "yaxis": "y", "name": f"tip {axis}",
-                     "line": {"color": _AXES[k]}, "marker": {"size": 5},
-                     "hovertemplate": f"{label} = %{{x:.4g}}<br>tip {axis} = %{{y:.4g}} m"
-                     "<extra></extra>"})
-    data.append({"type": "scatter", "mode": "markers", "x": [values[0]] * 3,
-                 "y": tips[0].tolist(), "xaxis": "x", "yaxis": "y", "name": "shown",
-                 "marker": {"size": 12, "color": "rgba(0,0,0,0)",
-                            "line": {"color": "black", "width": 2}},
-                 "hoverinfo": "skip", "showlegend": False})
-    layout["xaxis"] = {"domain": [0.72, 1.0], "anchor": "y", "title": {"text": label}}
-    layout["yaxis"] = {"domain": [0.3, 0.9], "anchor": "x", "title": {"text": "tip (m)"}}
+        tip_data.append({"type": "scatter", "mode": "lines+markers", "x": values,
+                         "y": tips[:, k], "name": f"tip {axis}",
+                         "line": {"color": _AXES[k]}, "marker": {"size": 5},
+                         "hovertemplate": f"{label} = %{{x:.4g}}<br>tip {axis} = %{{y:.4g}} m"
+                         "<extra></extra>"})
+    tip_data.append({"type": "scatter", "mode": "markers", "x": [values[0]] * 3,
+                     "y": tips[0].tolist(), "name": "shown",
+                     "marker": {"size": 12, "color": "rgba(0,0,0,0)",
+                                "line": {"color": "black", "width": 2}},
+                     "hoverinfo": "skip", "showlegend": False})
+    fig["tips"] = {"data": tip_data, "layout": {
+        "xaxis": {"title": {"text": label}}, "yaxis": {"title": {"text": "tip (m)"}},
+        "margin": {"l": 60, "r": 10, "t": 30, "b": 50},
+        "legend": {"orientation": "h", "x": 0.0, "y": 1.0, "yanchor": "bottom"},
+        "paper_bgcolor": "rgba(0,0,0,0)", "plot_bgcolor": "rgba(0,0,0,0)",
+        "hovermode": "closest"},
+        # the "shown" marker at each frame (plain lists for the page's script)
+        "shown": [{"x": [float(v)] * 3, "y": tip.tolist()} for v, tip in zip(values, tips,
+                                                                              strict=True)]}
     names = [f"{v:.6g}" for v in values]
     frames = []
     for k, case in enumerate(cases):
-        traces = [_changing(trace) for trace in _scene_traces(case, arrows[k], scales, radii)]
-        traces.append({"x": [values[k]] * 3, "y": tips[k].tolist()})
-        frames.append({"name": names[k], "data": traces,
-                       "traces": [*range(n_scene), len(data) - 1],
+        traces = [_changing(trace) for trace in _scene_traces(case, arrows[k], scales, rings)]
+        frames.append({"name": names[k], "data": traces, "traces": list(range(n_scene)),
                        "layout": {"title": {"text": caption(case), "x": 0.02,
                                             "font": {"size": 14}}}})
+    # The frames are shown by the page's script (to_html; "skip": plotly.js only draws the
+    # slider and the buttons): one Plotly.react per frame, see _DRAW.
     fig["frames"] = frames
-    now = {"mode": "immediate", "frame": {"duration": 0, "redraw": True},
-           "transition": {"duration": 0}}
     layout["sliders"] = [{
         "active": 0, "x": 0.05, "len": 0.9, "y": 0.0, "pad": {"t": 10},
         "currentvalue": {"prefix": f"{label} = ", "font": {"size": 13}},
-        "steps": [{"label": n, "method": "animate", "args": [[n], now]} for n in names]}]
-    play = {"mode": "immediate", "fromcurrent": True, "frame": {"duration": 400, "redraw": True},
-            "transition": {"duration": 0}}
+        "steps": [{"label": n, "method": "skip", "args": [[n]]} for n in names]}]
     layout["updatemenus"] = [{
         "type": "buttons", "direction": "left", "x": 0.05, "y": 0.08, "xanchor": "right",
         "showactive": False,
-        "buttons": [{"label": "▶", "method": "animate", "args": [None, play]},
-                    {"label": "❚❚", "method": "animate", "args": [[None], now]}]}]
+        "buttons": [{"label": "▶", "method": "skip", "args": [None]},
+                    {"label": "❚❚", "method": "skip", "args": [None]}]}]
     layout["margin"]["b"] = 40
     return fig
+
+
+def _cube_anchor(centre, half) -> dict:
+    """An undrawn trace (mode "none") at two corners of the axis cube.
+
+    plotly.js scales a 3D scene's data by the extent of the data, not of the axes: when the
+    arm moves (a sweep's frame, an app's slider), that scale changes, and with it the axes'
+    tick positions, and the scene rebuilds its grid lines and compiles their shader again on
+    every redraw, which costs software WebGL tens of milliseconds. These two points make the
+    data's extent that of the fixed axis cube, so the scale stays put."""
+    corners = np.array([centre - half, centre + half])
+    return {"type": "scatter3d", "mode": "none", "x": corners[:, 0], "y": corners[:, 1],
+            "z": corners[:, 2], "hoverinfo": "skip", "showlegend": False,
+            "name": "axis cube"}
 
 
 _CHANGING = ("x", "y", "z", "u", "v", "w", "customdata", "text")
@@ -335,13 +377,17 @@ def to_json(fig: dict) -> str:
 def _compact(value):
     """``value`` with numeric arrays as plotly.js typed arrays (``{"dtype": "f4", "bdata":
     base64, "shape": "N, M"}``): float32 keeps 7 significant digits, more than a drawing or
-    its read-outs show, in a fifth of the characters of decimal text."""
+    its read-outs show, in a fifth of the characters of decimal text (fewer digits would
+    not help: plotly.js takes no smaller float type)."""
     if isinstance(value, dict):
         return {k: _compact(v) for k, v in value.items()}
     if isinstance(value, list):
         return [_compact(v) for v in value]
     if isinstance(value, np.ndarray) and value.dtype.kind in "fiu" and value.size:
-        dtype = "<f4" if value.dtype.kind == "f" else "<i4"
+        if value.dtype.kind == "f":
+            dtype = "<f4"
+        else:  # indices (a mesh's triangles): two bytes each while they fit
+            dtype = "<u2" if value.min() >= 0 and value.max() < 2**16 else "<i4"
         data = np.ascontiguousarray(value, dtype=dtype)
         typed = {"dtype": dtype[1:], "bdata": base64.b64encode(data.tobytes()).decode("ascii")}
         if data.ndim > 1:
@@ -350,14 +396,157 @@ def _compact(value):
     return value
 
 
-def to_html(fig: dict, *, full_html: bool = True, div_id: str | None = None) -> str:
-    """A self-contained HTML page (or ``<div>``) of ``fig`` with plotly.js embedded.
+# The page's script for one figure. WebGL draws at the screen's own resolution: plotly.js's
+# default (plotGlPixelRatio 2) draws a 3D scene at twice the resolution on every screen, four
+# times the pixels, which software WebGL (a browser without a GPU, a headless one) pays on
+# every redraw; on a high-density screen (devicePixelRatio 2) nothing changes. Without
+# window.Plotly (a notebook output that relies on an earlier output to have loaded it), the
+# figure waits for the "softarm-plotly-ready" event that an embedding output sends.
+_DRAW = """(function () {
+  var id = %(id)s, fig = %(fig)s, config = {displaylogo: false, responsive: true,
+    plotGlPixelRatio: Math.min(2, Math.max(1, Math.round(window.devicePixelRatio || 1)))};
+  function draw() {
+    var gd = document.getElementById(id);
+    if (!gd || gd.getAttribute("data-drawn")) return;
+    gd.setAttribute("data-drawn", "1");
+    gd.textContent = "";
+    var tips = fig.tips && document.getElementById(id + "-tips");
+    Plotly.newPlot(gd, fig.data, fig.layout, config).then(function () {
+      if (fig.frames) sweep(gd, tips);
+    });
+    if (tips) Plotly.newPlot(tips, fig.tips.data, fig.tips.layout,
+                             {displaylogo: false, responsive: true, displayModeBar: false});
+  }
+  // A sweep's slider and play button (method "skip": plotly.js only draws them) show a
+  // frame by merging its data into the figure and one Plotly.react. Plotly.animate would
+  // do the work twice: its transition step computes the figure's defaults and data before
+  // the redraw (for a 3D scene, a full one) computes them again.
+  function sweep(gd, tips) {
+    var frames = fig.frames, playing = null;
+    var names = frames.map(function (frame) { return frame.name; });
+    function show(k) {
+      var frame = frames[k];
+      frame.traces.forEach(function (t, i) { Object.assign(gd.data[t], frame.data[i]); });
+      gd.layout.title = frame.layout.title;
+      gd.layout.sliders[0].active = k;
+      gd.layout.datarevision = (gd.layout.datarevision || 0) + 1;
+      // a 2D animation step without redraw moves the tip plot's marker alone (a restyle
+      // would redraw that whole plot, as costly again as the 3D frame)
+      if (tips) Plotly.animate(tips, {data: [fig.tips.shown[k]], traces: [3]},
+        {mode: "immediate", frame: {duration: 0, redraw: false}, transition: {duration: 0}});
+      return Plotly.react(gd, gd.data, gd.layout);
+    }
+    function play() {
+      var token = {}, k = gd.layout.sliders[0].active;
+      playing = token;
+      if (k >= frames.length - 1) k = -1;
+      (function next() {
+        if (playing !== token) return;
+        k += 1;
+        show(k).then(function () {
+          if (k < frames.length - 1) setTimeout(next, 400); else playing = null;
+        });
+      })();
+    }
+    gd.on("plotly_sliderchange", function (event) {
+      playing = null;
+      var k = names.indexOf(event.step.label);
+      if (k >= 0) show(k);
+    });
+    gd.on("plotly_buttonclicked", function (event) {
+      if (event.button.label === "\u25b6") play(); else playing = null;
+    });
+  }
+  if (window.Plotly) { draw(); return; }
+  document.getElementById(id).textContent = %(waiting)s;
+  window.addEventListener("softarm-plotly-ready", draw);
+})();"""
 
-    ``div_id``: the id of the figure's ``<div>`` (default: a fresh unique one)."""
-    pio = _plotly()
-    return pio.to_html(_compact(fig), include_plotlyjs=True, full_html=full_html, auto_play=False,
-                       div_id=div_id, validate=False,
-                       config={"displaylogo": False, "responsive": True})
+_WAITING = ("softarm: waiting for plotly.js, which the first softarm view shown in this "
+            "notebook's kernel session carries; it is not on this page (its output was "
+            "cleared, or the page reloaded). Run softarm.view.NOTEBOOK_PLOTLYJS = 'always' "
+            "and this cell again, or restart the kernel and run the notebook from the top.")
+
+
+def _library() -> str:
+    """plotly.js as an inline script that announces itself ("softarm-plotly-ready")."""
+    code = plotly_js_path().read_text(encoding="utf-8")
+    if "</script" in code.lower():  # pragma: no cover - would end the script element early
+        raise ValueError("plotly.min.js contains '</script'; cannot inline it")
+    return ('<script type="text/javascript">window.PlotlyConfig = {MathJaxConfig: "local"};'
+            '</script>\n<script type="text/javascript">' + code +
+            '\nwindow.dispatchEvent(new Event("softarm-plotly-ready"));</script>\n')
+
+
+def to_html(fig: dict, *, full_html: bool = True, div_id: str | None = None,
+            include_plotlyjs: bool = True) -> str:
+    """An HTML page (or, ``full_html=False``, a ``<div>`` with its scripts) drawing ``fig``.
+
+    ``include_plotlyjs``: embed plotly.js (about 4.8 MB; the page opens offline on its own),
+    or not (the figure uses the ``window.Plotly`` of the page it is put in, waiting for it
+    if an embedding figure comes later on the page). ``div_id``: the id of the figure's
+    ``<div>`` (default: a fresh unique one)."""
+    import html
+    import uuid
+
+    if include_plotlyjs:
+        _plotly()
+    div_id = div_id or f"softarm-{uuid.uuid4().hex[:12]}"
+    height = fig.get("layout", {}).get("height", 650)
+    script = _DRAW % {"id": json.dumps(div_id), "fig": to_json(fig).replace("</", "<\\/"),
+                      "waiting": json.dumps(_WAITING)}
+    main = (f'<div id="{html.escape(div_id)}" class="plotly-graph-div" '
+            f'style="height:{int(height)}px; width:100%;"></div>')
+    if "tips" in fig:  # a sweep's tip plot over the right of the 3D figure, see figure()
+        margin = fig["layout"]["margin"]
+        inner = int(height) - margin["t"] - margin["b"]
+        top = int(height) - margin["b"] - 0.9 * inner - 30  # its axes at 0.3-0.9 of the height
+        bottom = margin["b"] + 0.3 * inner - 50
+        main = (f'<div style="position:relative; height:{int(height)}px; width:100%;">{main}'
+                f'<div id="{html.escape(div_id)}-tips" class="plotly-graph-div" '
+                f'style="position:absolute; top:{top:.0f}px; bottom:{bottom:.0f}px; '
+                f'left:calc(0.72 * (100% - 20px) - 50px); right:0px;"></div></div>')
+    body = ((_library() if include_plotlyjs else "") + main + "\n" +
+            f'<script type="text/javascript">{script}</script>\n')
+    if not full_html:
+        return f"<div>{body}</div>"
+    title = html.escape(_plain_title(fig))
+    return (f'<!DOCTYPE html>\n<html lang="en">\n<head><meta charset="utf-8">'
+            f'<title>{title}</title></head>\n<body style="margin:0">\n{body}</body>\n</html>\n')
+
+
+def _plain_title(fig: dict) -> str:
+    text = fig.get("layout", {}).get("title", {}).get("text", "softarm")
+    import re
+
+    return re.sub(r"<[^>]+>", " ", text.split("<br>")[0]).strip() or "softarm"
+
+
+#: How a notebook's rich display of an :class:`~softarm.Equilibrium` carries plotly.js:
+#: ``"once"`` (default): the first display of the kernel session embeds it (about 4.8 MB)
+#: and later ones use it from the page (tens of kB each); a reopened notebook works offline
+#: as long as that first output is still in it (its script loads plotly.js for the views
+#: below, and a view drawn before it waits for it). ``"always"``: every display embeds it
+#: (each output stands alone: for a notebook whose outputs are cleared or moved around, or a
+#: front end that isolates outputs, which Google Colab does and is detected).
+NOTEBOOK_PLOTLYJS = "once"
+_notebook = {"embedded": False}
+
+
+def notebook_html(result, **options) -> str:
+    """The notebook display of ``result`` (:func:`figure`, ``options`` as there), carrying
+    plotly.js as :data:`NOTEBOOK_PLOTLYJS` says."""
+    import sys
+
+    if NOTEBOOK_PLOTLYJS not in ("once", "always"):
+        raise ValueError(f"softarm.view.NOTEBOOK_PLOTLYJS must be 'once' or 'always', got "
+                         f"{NOTEBOOK_PLOTLYJS!r}")
+    fig = figure(result, **options)
+    embed = (NOTEBOOK_PLOTLYJS == "always" or not _notebook["embedded"]
+             or "google.colab" in sys.modules)
+    text = to_html(fig, full_html=False, include_plotlyjs=embed)
+    _notebook["embedded"] = _notebook["embedded"] or embed
+    return text
 
 
 def write_html(result, path: str | os.PathLike, **options) -> Path:
