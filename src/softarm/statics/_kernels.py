@@ -135,7 +135,7 @@ _DLAM_CROSS = 1e-3
 _REFINE_MAX = 0.05
 
 
-@_jit
+@_inline
 def _strain(C, f0, j, diag, s0, s1, s2, s3, s4, s5):
     """The constitutive step of piece j: strains (v; u) = f⁰ + C σ from the stress σ in
     material components. With ``f0`` zero rows it is the linear map of the tangents
@@ -424,24 +424,20 @@ def _deriv(work, twork, nt, stage, s, arm, j, now, rate, law):
         return
     # δσ = (Rᵀδn + σ_n × δθ; Rᵀδm + σ_m × δθ), then δ(v; u) = dstrain δσ (+ the actuators'
     # own change with λ), all columns at once: one factorisation of H when actuated
+    # (a passive arm's δ(v; u) are computed in the loop below, in registers: one loop, no
+    # round trip through memory; an actuated one's need one solve with H for all columns)
     M = law[0]
-    for d in range(nt):
+    for d in range(nt if actuated else 0):
         t = twork[Y, d]
         th0, th1, th2 = t[_TT], t[_TT + 1], t[_TT + 2]
         dn0, dn1, dn2 = t[_TN], t[_TN + 1], t[_TN + 2]
         dm0, dm1, dm2 = t[_TM], t[_TM + 1], t[_TM + 2]
-        d0 = R00 * dn0 + R10 * dn1 + R20 * dn2 + s1 * th2 - s2 * th1
-        d1 = R01 * dn0 + R11 * dn1 + R21 * dn2 + s2 * th0 - s0 * th2
-        d2 = R02 * dn0 + R12 * dn1 + R22 * dn2 + s0 * th1 - s1 * th0
-        d3 = R00 * dm0 + R10 * dm1 + R20 * dm2 + s4 * th2 - s5 * th1
-        d4 = R01 * dm0 + R11 * dm1 + R21 * dm2 + s5 * th0 - s3 * th2
-        d5 = R02 * dm0 + R12 * dm1 + R22 * dm2 + s3 * th1 - s4 * th0
-        if actuated:
-            M[0, 6 + d], M[1, 6 + d], M[2, 6 + d] = d0, d1, d2
-            M[3, 6 + d], M[4, 6 + d], M[5, 6 + d] = d3, d4, d5
-        else:
-            (M[0, 6 + d], M[1, 6 + d], M[2, 6 + d], M[3, 6 + d], M[4, 6 + d],
-             M[5, 6 + d]) = _strain(C, zero, j, diag, d0, d1, d2, d3, d4, d5)
+        M[0, 6 + d] = R00 * dn0 + R10 * dn1 + R20 * dn2 + s1 * th2 - s2 * th1
+        M[1, 6 + d] = R01 * dn0 + R11 * dn1 + R21 * dn2 + s2 * th0 - s0 * th2
+        M[2, 6 + d] = R02 * dn0 + R12 * dn1 + R22 * dn2 + s0 * th1 - s1 * th0
+        M[3, 6 + d] = R00 * dm0 + R10 * dm1 + R20 * dm2 + s4 * th2 - s5 * th1
+        M[4, 6 + d] = R01 * dm0 + R11 * dm1 + R21 * dm2 + s5 * th0 - s3 * th2
+        M[5, 6 + d] = R02 * dm0 + R12 * dm1 + R22 * dm2 + s3 * th1 - s4 * th0
     if actuated:
         for d in range(LAM, nt):
             _actuator_rates(arm, j, rate[d - LAM], law, law[2][4])
@@ -456,8 +452,19 @@ def _deriv(work, twork, nt, stage, s, arm, j, now, rate, law):
         t = twork[Y, d]
         th0, th1, th2 = t[_TT], t[_TT + 1], t[_TT + 2]
         dn0, dn1, dn2 = t[_TN], t[_TN + 1], t[_TN + 2]
-        c0, c1, c2 = M[0, 6 + d], M[1, 6 + d], M[2, 6 + d]
-        c3, c4, c5 = M[3, 6 + d], M[4, 6 + d], M[5, 6 + d]
+        if actuated:
+            c0, c1, c2 = M[0, 6 + d], M[1, 6 + d], M[2, 6 + d]
+            c3, c4, c5 = M[3, 6 + d], M[4, 6 + d], M[5, 6 + d]
+        else:  # δσ = (Rᵀδn + σ_n × δθ; Rᵀδm + σ_m × δθ), then the constitutive step
+            dm0, dm1, dm2 = t[_TM], t[_TM + 1], t[_TM + 2]
+            c0, c1, c2, c3, c4, c5 = _strain(
+                C, zero, j, diag,
+                R00 * dn0 + R10 * dn1 + R20 * dn2 + s1 * th2 - s2 * th1,
+                R01 * dn0 + R11 * dn1 + R21 * dn2 + s2 * th0 - s0 * th2,
+                R02 * dn0 + R12 * dn1 + R22 * dn2 + s0 * th1 - s1 * th0,
+                R00 * dm0 + R10 * dm1 + R20 * dm2 + s4 * th2 - s5 * th1,
+                R01 * dm0 + R11 * dm1 + R21 * dm2 + s5 * th0 - s3 * th2,
+                R02 * dm0 + R12 * dm1 + R22 * dm2 + s3 * th1 - s4 * th0)
         # δp' = R (δθ × v + δv)
         a0 = th1 * v2 - th2 * v1 + c0
         a1 = th2 * v0 - th0 * v2 + c1
