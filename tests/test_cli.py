@@ -243,3 +243,21 @@ def test_python_dash_m(tmp_path):
     done = subprocess.run([sys.executable, "-m", "softarm", "--version"], capture_output=True,
                           text=True, timeout=120)
     assert done.returncode == 0 and softarm.__version__ in done.stdout
+
+
+def test_summary_names_the_base_wrench_for_what_it_is(capsys):
+    """A passive arm's base line is the clamp reaction, which for a tip load alone equals
+    that load (global balance); a tendon robot's is the total of clamp and actuators."""
+    code, stdout, stderr = run(capsys, "solve", FIG2, "--method", "numeric")
+    assert code == 0, stderr
+    line = next(row for row in stdout.splitlines() if row.startswith("base"))
+    assert "clamp reaction" in line and "actuators" not in line
+    moment = np.asarray(load_case(FIG2).loads[0].moment, dtype=float)
+    printed = line.split("moment")[1]
+    numbers = [float(v) for v in printed.replace("(", " ").replace(")", " ").replace(",", " ")
+               .split() if v not in ("N", "m")]
+    np.testing.assert_allclose(numbers, moment, atol=1e-6 * np.abs(moment).max())
+    code, stdout, stderr = run(capsys, "solve", EXAMPLES / "tendon_robot.toml")
+    assert code == 0, stderr
+    line = next(row for row in stdout.splitlines() if row.startswith("base"))
+    assert "clamp and actuators" in line

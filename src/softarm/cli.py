@@ -755,7 +755,10 @@ def _summary(case: Case, result, seconds: float) -> str:
         if result.tendon_tensions is not None:
             lines.append("tendons   " + "\n          ".join(_tendon_lines(result)))
         if result.base_wrench is not None:
-            lines.append(f"base      total wrench (clamp and actuators) force "
+            # with tendons or chambers the clamp and the actuators share the base wrench
+            actuated = any(load.acts_through_base for load in result.loads)
+            what = "total wrench (clamp and actuators)" if actuated else "clamp reaction"
+            lines.append(f"base      {what} force "
                          f"{_vector(result.base_wrench[:3])} N, moment "
                          f"{_vector(result.base_wrench[3:])} N m")
         if result.stability is not None:

@@ -185,6 +185,9 @@ class Load(abc.ABC):
     #: True for a load whose magnitude is an unknown of the solve (a tendon under
     #: displacement control, :class:`Tendon`).
     displacement_controlled: ClassVar[bool] = False
+    #: True for an actuator that runs through the sections and ends at the base plate (a
+    #: tendon, a chamber): the base wrench is then shared by the clamp and the actuator.
+    acts_through_base: ClassVar[bool] = False
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
@@ -649,6 +652,7 @@ class Tendon(Load):
     """
 
     kind: ClassVar[str] = "tendon"
+    acts_through_base: ClassVar[bool] = True
     schema: ClassVar = (Key("tension", "magnitude", "N"), Key("displacement", "magnitude", "m"),
                         Key("routing", "routing", required=True), Key("end", "number", "m"))
 
@@ -752,6 +756,7 @@ class Chamber(Load):
     """
 
     kind: ClassVar[str] = "chamber"
+    acts_through_base: ClassVar[bool] = True
     inputs: ClassVar = ("pressure",)
     schema: ClassVar = (Key("pressure", "magnitude", "Pa", required=True),
                         Key("area", "number", "m²", required=True),
