@@ -261,3 +261,20 @@ def test_summary_names_the_base_wrench_for_what_it_is(capsys):
     assert code == 0, stderr
     line = next(row for row in stdout.splitlines() if row.startswith("base"))
     assert "clamp and actuators" in line
+
+
+def test_a_swallowed_ctrl_c_is_raised_again_at_the_next_progress_report():
+    """A SIGINT whose KeyboardInterrupt something swallowed (numba's ctypes cache callback
+    prints and drops it) is remembered by the command's handler and raised again by the
+    next progress report, so the command still ends with exit status 130."""
+    stream = _stdio.StringIO()
+    progress = cli._Progress(stream, delay=0.0)
+    cli._Interrupt.seen = False
+    progress(1, 4)  # nothing pending: no interrupt
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            cli._Interrupt.handler(2, None)  # raised, and remembered
+        with pytest.raises(KeyboardInterrupt):
+            progress(2, 4)  # ... so raised again here
+    finally:
+        cli._Interrupt.seen = False

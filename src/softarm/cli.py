@@ -70,6 +70,7 @@ class _Progress:
         self.last = 0.0
 
     def __call__(self, done: int, total: int, failed: int = 0) -> None:
+        _Interrupt.check()  # a Ctrl-C that something below swallowed
         now = time.perf_counter()
         if self.first is None:
             self.first = (now, done)
@@ -283,13 +284,42 @@ def _parser() -> argparse.ArgumentParser:
     return parser
 
 
+class _Interrupt:
+    """SIGINT while the command runs: raise KeyboardInterrupt, as Python does, and remember it.
+
+    A KeyboardInterrupt raised while numba is inside a ctypes callback (writing its cache
+    during a compile) is printed and swallowed there ("Exception ignored on calling ctypes
+    callback function"), and the command would go on for minutes. Remembered, it is raised
+    again at the next progress report (:meth:`check`)."""
+
+    seen = False
+
+    @classmethod
+    def handler(cls, signum, frame):
+        cls.seen = True
+        raise KeyboardInterrupt
+
+    @classmethod
+    def check(cls) -> None:
+        if cls.seen:
+            raise KeyboardInterrupt
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the ``softarm`` command with ``argv`` (default ``sys.argv[1:]``); return the exit
     code (see the module docstring and docs/cli.md)."""
+    _Interrupt.seen = False
+    previous = None
+    with contextlib.suppress(ValueError, OSError):  # ValueError: not the main thread
+        previous = signal.signal(signal.SIGINT, _Interrupt.handler)
     try:
         return _main(argv)
     except KeyboardInterrupt:
         return interrupted()
+    finally:
+        if previous is not None and signal.getsignal(signal.SIGINT) == _Interrupt.handler:
+            with contextlib.suppress(ValueError, OSError):
+                signal.signal(signal.SIGINT, previous)
 
 
 def _main(argv: Sequence[str] | None) -> int:
