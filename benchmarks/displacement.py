@@ -16,8 +16,7 @@ Run::
 from __future__ import annotations
 
 import argparse
-import statistics
-import time
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -26,17 +25,10 @@ import softarm
 from softarm.case import load_case
 from softarm.statics import Solver
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from run import timed  # benchmarks/ is not a package
+
 CASE = Path(__file__).resolve().parents[1] / "examples" / "tendon_robot.toml"
-
-
-def _timed(solve, repeats):
-    wall, cpu = [], []
-    for _ in range(repeats):
-        w, c = time.perf_counter(), time.process_time()
-        result = solve()
-        wall.append(time.perf_counter() - w)
-        cpu.append(time.process_time() - c)
-    return result, statistics.median(wall), statistics.median(cpu)
 
 
 def main(argv=None):
@@ -60,14 +52,14 @@ def main(argv=None):
           f"displacements {np.round(1e3 * by_tension.tendon_length_changes, 6).tolist()} mm")
     print(f"{'':44} {'wall (ms)':>10} {'CPU (ms)':>10} {'ratio':>7}")
     for jacobians in (False, True):
-        base, w0, c0 = _timed(lambda j=jacobians: softarm.solve(
+        base, w0, c0 = timed(lambda j=jacobians: softarm.solve(
             arm, loads, method="numeric", jacobians=j), args.repeats)
         Solver.solve_from_unloaded = counted
         try:
             calls.clear()
             softarm.solve(arm, displaced, jacobians=jacobians)
             solves = len(calls) - 1  # the outer call itself
-            result, w1, c1 = _timed(lambda j=jacobians: softarm.solve(
+            result, w1, c1 = timed(lambda j=jacobians: softarm.solve(
                 arm, displaced, jacobians=j), args.repeats)
         finally:
             Solver.solve_from_unloaded = inner
