@@ -53,7 +53,9 @@ class InverseResult:
         The remaining task error: the distance to the target / L, or with an orientation the
         larger of that and the rotation angle to the target orientation in rad.
     iterations : int or ndarray (B...)
-        Forward solves with Jacobians used (after the first).
+        Forward solves with Jacobians used after the first (the full route), or
+        integrations with the input columns (the fast route from a prepared solver's last
+        equilibrium; docs/control.md).
     at_bound : ndarray of bool, shape (B..., n)
         Which inputs sit at a bound (a slack tendon: tension 0).
     condition : float or ndarray (B...)
