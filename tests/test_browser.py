@@ -54,7 +54,7 @@ def tip_js(div: str) -> str:
 
 
 def orange_pixels(png: bytes) -> int:
-    """Pixels of the tube's orange (255, 127, 14) seen through its 45 % opacity and shading:
+    """Pixels of the tube's orange (255, 127, 14) under its shading (the tube is opaque):
     clearly red-orange, neither grey nor white."""
     rgb = _browser.png_pixels(png).astype(int)
     r, g, b = rgb[..., 0], rgb[..., 1], rgb[..., 2]
