@@ -115,7 +115,7 @@ def run(cases: Sequence[str] | None = None, *, data_dir=_AUTO,
     if progress is not None:
         where = _where(tables.directory) if tables.directory is not None else "none (skipping)"
         progress.write(f"reproduce: {len(selected)} cases; reference tables: {where}; the first "
-                       "numerical solve compiles the solver (~20 s on a cold cache)\n")
+                       "numerical solve compiles the solver (about 1 min on a cold cache)\n")
     start = time.perf_counter()
     for i, case in enumerate(selected):
         _progress(progress, i, len(selected), f"{case.name} ...")
