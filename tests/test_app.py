@@ -175,3 +175,18 @@ def test_without_plotly_one_line(monkeypatch, capsys):
     code = cli.main(["app", str(EXAMPLES / "mattiasson_cantilever.toml"), "--no-browser"])
     _, err = capsys.readouterr()
     assert code == 2 and err.count("\n") == 1 and "pip install 'softarm[view]'" in err
+
+
+def test_load_headings_follow_the_sliders(server):
+    """Each load's heading on the page is redescribed with the current values (it used to keep
+    the case file's): here the tip force set by the request, the other components the case's."""
+    url, live = server
+    status, body = get(f"{url}/solve?l1.force.z=-2.5")
+    assert status == 200, body
+    heading = json.loads(body)["headings"]["l1.on"]
+    v = live.values  # (earlier tests in this module moved other sliders)
+    expected = live.case.loads[0].replace(
+        force=np.array([v["l1.force.x"], v["l1.force.y"], -2.5]),
+        moment=np.array([v["l1.moment.x"], v["l1.moment.y"], v["l1.moment.z"]]))
+    assert heading == "1: " + expected.describe()
+    assert "-2.5" in heading

@@ -166,6 +166,10 @@ def test_app_slider_resolves_and_redraws(browser, live_server, tmp_path):
     np.testing.assert_allclose(shown, expected, atol=1e-6)
     drawn = browser.execute_script(tip_js("plot"))
     np.testing.assert_allclose(drawn, expected, atol=1e-6)
+    # the load's heading says its values now, not the case file's
+    heading = browser.execute_script(
+        "return document.getElementById('l2.on').parentElement.textContent")
+    assert heading.strip() == "2: " + loads[1].describe()
     png = browser.get_screenshot_as_png()
     (tmp_path / "app.png").write_bytes(png)
     assert orange_pixels(png) > 1000, "no tube in the screenshot"

@@ -188,13 +188,19 @@ class LiveCase:
 
     def loads(self) -> tuple:
         """The case's loads with the current input values (switched-off loads left out)."""
-        out = []
-        for i, load in enumerate(self.case.loads):
-            if not self.values[f"l{i + 1}.on"]:
-                continue
-            fields = _fields(load, i, self.values, 1.0)
-            out.append(load.replace(**fields) if fields else load)
-        return tuple(out)
+        return tuple(self.current(i) for i in range(len(self.case.loads))
+                     if self.values[f"l{i + 1}.on"])
+
+    def current(self, i: int):
+        """Load i of the case with the current input values (whether on or off)."""
+        load = self.case.loads[i]
+        fields = _fields(load, i, self.values, 1.0)
+        return load.replace(**fields) if fields else load
+
+    def headings(self) -> dict:
+        """Each load's heading on the page, with its current values (the switches' labels)."""
+        return {f"l{i + 1}.on": f"{i + 1}: {self.current(i).describe()}"
+                for i in range(len(self.case.loads))}
 
     def solve(self) -> dict:
         """Solve for the current inputs from the previous equilibrium; the reply's body."""
@@ -210,6 +216,7 @@ class LiveCase:
                 "data": scene_traces(result, self.scales, changing=True),
                 "title": _title(self.case, loads),
                 "tip": np.asarray(result.tip_position).tolist(),
+                "headings": self.headings(),
                 "solve_ms": 1e3 * seconds, "method": result.method,
                 "residual": float(np.max(result.residual)),
                 "stability": None if result.stability is None else
@@ -354,6 +361,10 @@ async function send(path) {{
     // changed traces would cost as much, in two calls).
     body.data.forEach((trace, i) => Object.assign(FIGURE.data[i], trace));
     layout.title.text = body.title;
+    for (const [name, text] of Object.entries(body.headings)) {{  // each load's values now
+      const check = document.getElementById(name);
+      if (check) check.parentElement.lastChild.textContent = " " + text;
+    }}
     ["xaxis", "yaxis", "zaxis"].forEach((axis, k) => {{
       layout.scene[axis].range = body.ranges[k];
       cube["xyz"[k]] = body.ranges[k]; }});
