@@ -614,13 +614,14 @@ class Solver:
         x = np.asarray(x, dtype=np.float64)
         if x.shape != (6,) or not np.all(np.isfinite(x)):
             raise ValueError(f"x must be 6 finite numbers (n(0); m(0)), got {x!r}")
+        # steps per piece as the kernel's _fill_steps spreads them: factor × the nominal n
+        # in proportion to length, at least one
         if isinstance(steps, tuple) and len(steps) == 2 and steps[0] == "solution":
-            N = count(steps[1], "steps", 1)
-            counts = 2 * np.maximum(1, np.floor(N * pieces[1] / self.length + 0.5))
+            n, factor = count(steps[1], "steps", 1), 2  # a solution's fine grid, 2N
         else:
-            n = 200 if steps is None else count(steps, "steps", 1)
-            counts = np.maximum(1, np.floor(n * pieces[1] / self.length + 0.5))
-        counts = counts.astype(np.int64)
+            n, factor = 200 if steps is None else count(steps, "steps", 1), 1
+        counts = factor * np.maximum(1, np.floor(n * pieces[1] / self.length + 0.5)).astype(
+            np.int64)
         lam = float(load_factor)
         piece, tip = channels.piece[0], channels.tip_loads[0]
         if inputs:  # at λ·loads; the columns after x along each input's channels
