@@ -578,9 +578,9 @@ def _check_on_arm(obj, arm, *names) -> None:
                              f"[0, {arm.length!r}] m, got {value!r}")
 
 
-#: Paths already checked on an arm: (id(routing), id(arm), span) -> (routing, arm), the
-#: objects held so that their ids stay theirs. A control loop re-solves the same tendons
-#: with new tensions thousands of times; the check depends on the path alone.
+#: Paths already checked on an arm: (routing, id(arm), span) -> arm, held so that its id
+#: stays its own. Routings are frozen dataclasses, equal by value: a control loop that builds
+#: new tendons on the same paths with new tensions thousands of times checks each path once.
 _CHECKED_PATHS: dict = {}
 
 
@@ -588,13 +588,13 @@ def _check_tangent(obj, arm) -> None:
     """ValueError if the path's tangent w = e1 + κ⁰ × r + r' vanishes on the unloaded arm
     (a tendon folded back along itself has no direction to pull in)."""
     start, end = obj.path_span(arm.length)
-    key = (id(obj.routing), id(arm), start, end)
+    key = (obj.routing, id(arm), start, end)
     if key in _CHECKED_PATHS:
         return
     _check_path(obj, arm, start, end)
     if len(_CHECKED_PATHS) >= 256:
         _CHECKED_PATHS.pop(next(iter(_CHECKED_PATHS)))
-    _CHECKED_PATHS[key] = (obj.routing, arm)
+    _CHECKED_PATHS[key] = arm
 
 
 def _check_path(obj, arm, start, end) -> None:
