@@ -212,3 +212,42 @@ def test_tracking_takes_the_shooting_route_and_agrees_with_forward_solves():
     assert result.reached.all()
     again = forward(arm, result.inputs).tip_position
     assert np.max(np.linalg.norm(again - targets[1:], axis=-1)) / L <= 1e-6
+
+
+def test_a_prepared_shooter_equals_shooting_the_rebuilt_loads():
+    """``Solver.shooter`` recombines channels prepared once (they are affine in the inputs);
+    against ``Solver.shoot`` of the loads rebuilt with the same new inputs (each load's own
+    channels, prepared again), for a tendon, a chamber and a magnetic field (6 inputs), and
+    its ``solve_near`` against the Solver's."""
+    material = softarm.Material(5.0e6, poisson_ratio=0.45, density=1100.0)
+    arm = softarm.Arm(0.2, softarm.Circle(0.004), material, magnetization=(2.0, 0.0, 0.5))
+
+    def loads(q):
+        return [GRAVITY, softarm.Tendon(q[0], Straight(0.0, 0.002)),
+                softarm.Chamber(q[1], 2e-6, Straight(0.002, 0.0), start=0.05),
+                softarm.MagneticField(q[2:5]), softarm.Tendon(q[5], Straight(-0.002, 0.0))]
+
+    q0 = np.array([0.3, 2.0e4, 0.001, -0.002, 0.0005, 0.1])
+    q1 = np.array([0.5, 1.0e4, -0.001, 0.001, 0.002, 0.0])
+    solver = softarm.statics.Solver(arm, tol=1e-8)
+    solver.solve(loads(q0))
+    x, N = solver.last_solution()
+    shooter = solver.shooter(loads(q0))
+    assert np.array_equal(shooter.inputs, q0)
+    for load_factor in (1.0, 0.6):
+        prepared = shooter(x, q1, load_factor=load_factor, steps=("solution", N))
+        direct = solver.shoot(loads(q1), x, load_factor, steps=("solution", N), inputs=True)
+        for name in ("residual", "jacobian_x", "tip_pose", "tip_motion_x", "jacobian_inputs",
+                     "tip_motion_inputs"):
+            a, b = getattr(prepared, name), getattr(direct, name)
+            assert np.allclose(a, b, rtol=0, atol=1e-12 * max(np.abs(b).max(), 1.0)), name
+    other = softarm.statics.Solver(arm, tol=1e-8)
+    other.solve(loads(q1))
+    x1, N1 = other.last_solution()
+    near = shooter.solve_near(loads(q1), x1, 2 * N1, q1)
+    again = softarm.statics.Solver(arm, tol=1e-8).solve_near(loads(q1), x1, 2 * N1)
+    assert np.allclose(near.poses, again.poses, rtol=0, atol=1e-13)
+    assert int(near.stability.index) == int(again.stability.index) == 0
+    assert bool(near.stability.stable) and bool(again.stability.stable)
+    with pytest.raises(ValueError, match="inputs must have shape"):
+        shooter(x, q1[:3])

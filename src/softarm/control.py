@@ -121,6 +121,8 @@ class InverseSolver:
         solver_tol = 0.1 * self.tol if solver_tol is None else solver_tol
         # displacement-controlled tendons are solved in their tensions (self._actuators)
         self._actuators, self._displaced = self._in_tensions(arm, s, solver_tol)
+        self._shooter = None  # the fast route's prepared shooting (Solver.shooter)
+        self._warm = None  # the fast route's last answer: q, x, tip pose, A, J_x⁻¹ [r | J_q]
         self._slots = []  # (actuator index, field, component, is tension)
         values = []
         for i, load in enumerate(self._actuators):
@@ -247,31 +249,42 @@ class InverseSolver:
     def _step(self, J, b, q, mu):
         """The bounded Gauss–Newton step δq for the weighted task Jacobian J and right-hand
         side b: in scaled inputs u = q/s, min |J δu - b|² + μ σ² |δu|² + ε σ² |u + δu|²
-        within the bounds; ε (1e-12) picks the least effort along the task's null space and
-        moves the task solution by ~1e-12 relative."""
+        (σ = |J|_F) within the bounds; ε (1e-12) picks the least effort along the task's
+        null space and moves the task solution by ~1e-12 relative."""
         J = J * self.scales
-        sigma = max(np.linalg.norm(J, 2), 1e-300)
+        sigma = max(float(np.sqrt(np.sum(J * J))), 1e-300)  # |J|_F: within √n of |J|₂
         u = q / self.scales
-        eps = 1e-12
-        rows = np.vstack([J, np.sqrt(mu) * sigma * np.eye(self.n_inputs),
-                          np.sqrt(eps) * sigma * np.eye(self.n_inputs)])
-        rhs = np.concatenate([b, np.zeros(self.n_inputs), -np.sqrt(eps) * sigma * u])
+        n, m = self.n_inputs, J.shape[0]
+        root_eps = 1e-6  # √ε
+        rows = np.zeros((m + 2 * n, n))
+        rows[:m] = J
+        diagonal = np.arange(n)
+        rows[m + diagonal, diagonal] = np.sqrt(mu) * sigma
+        rows[m + n + diagonal, diagonal] = root_eps * sigma
+        rhs = np.zeros(m + 2 * n)
+        rhs[:m] = b
+        rhs[m + n:] = -root_eps * sigma * u
         return _box_least_squares(rows, rhs, self.lower / self.scales - u,
                                   self.upper / self.scales - u) * self.scales
 
     def _shooting_newton(self, q, target, orientation):
         """The fast route: Newton on the base reaction x and the inputs q together, one
-        integration per iteration (``Solver.shoot`` with the input columns, on the grid of
-        the last solution), from the Solver's last equilibrium; then one solve at the answer
-        (``solve_near``: refined to tol, with its stability verdict) that must confirm the
-        task error. None (the caller takes the full-solve route) when there is no last
-        equilibrium, displacement-controlled tendons are among the actuators, or the
-        iteration does not converge or the confirmation fails.
+        integration per iteration (``Solver.shooter``: the shooting primitive with the input
+        columns, prepared once, on the grid of the last solution), from the Solver's last
+        equilibrium; then one solve at the answer (``solve_near``: refined to tol, with its
+        stability verdict) that must confirm the task error. None (the caller takes the
+        full-solve route) when there is no last equilibrium, displacement-controlled
+        tendons are among the actuators, or the iteration does not converge or the
+        confirmation fails.
 
         Linearised, r + J_x δx + J_q δq = 0 gives δx = -J_x⁻¹ (r + J_q δq), and the task
         error e = w (target - p(L)) changes by -w (E_x δx + E_q δq): the step solves
         (w A) δq ≈ e + w E_x J_x⁻¹ r with A = E_q - E_x J_x⁻¹ J_q, the actuation Jacobian
         (exact when r = 0), under the same bounds and effort term as the full route.
+
+        Tracking: when the last answer came from this route, the first step needs no
+        integration. The last equilibrium has r = 0 and a known tip, and A and J_x⁻¹ J_q
+        from the last integration before it (one small step away) give the step.
         """
         last = self.solver.last_solution()
         if last is None or self._displaced:  # (displacement answers need the full route's
@@ -279,7 +292,17 @@ class InverseSolver:
         x, N = last
         scale = self.solver._data.scale
         first = sum(_input_count(load) for load in self.loads)
+        if self._shooter is None:  # prepared once; each iteration sets the inputs only
+            try:
+                self._shooter = self.solver.shooter([*self.loads, *self._actuators_at(q)])
+            except ValueError:
+                return None
+        shooter = self._shooter
+        every = shooter.inputs.copy()  # every input of the loads, the actuators' at slots
         task = slice(0, 3 if orientation is None else 6)
+        warm, self._warm = self._warm, None
+        if warm is not None and not (np.array_equal(warm[0], q) and np.array_equal(warm[1], x)):
+            warm = None  # the Solver or the inputs moved since
         redundant = None
         merit = np.inf
         iterations = 0
@@ -287,42 +310,53 @@ class InverseSolver:
             iterations += 1
             if iterations > self.max_iterations:
                 return None
-            loads = [*self.loads, *self._actuators_at(q)]
-            try:
-                shot = self.solver.shoot(loads, x, steps=("solution", N), inputs=True)
-            except ValueError:
-                return None
-            Jq = shot.jacobian_inputs[:, first:first + self.n_inputs]
-            Eq = shot.tip_motion_inputs[:, first:first + self.n_inputs]
-            try:
-                G = np.linalg.solve(shot.jacobian_x, np.column_stack([shot.residual, Jq]))
-            except np.linalg.LinAlgError:
-                return None
-            A = Eq - shot.tip_motion_x @ G[:, 1:]
-            e, w = self._pose_task(shot.tip_pose, target, orientation)
+            if warm is not None:  # at the last answer: r = 0, its tip, the last A and G
+                _, _, tip, A, G = warm
+                warm, shot = None, None
+                e, w = self._pose_task(tip, target, orientation)
+                rhs = e
+            else:
+                every[first:first + self.n_inputs] = q
+                shot = shooter(x, every, steps=("solution", N))
+                Jq = shot.jacobian_inputs[:, first:first + self.n_inputs]
+                Eq = shot.tip_motion_inputs[:, first:first + self.n_inputs]
+                try:
+                    G = np.linalg.solve(shot.jacobian_x, np.column_stack([shot.residual, Jq]))
+                except np.linalg.LinAlgError:
+                    return None
+                A = Eq - shot.tip_motion_x @ G[:, 1:]
+                e, w = self._pose_task(shot.tip_pose, target, orientation)
+                rhs = e + w * (shot.tip_motion_x @ G[:, 0])[task]  # e at the equilibrium
             J = w[:, None] * A[task]
             if redundant is None:
                 redundant = self._redundant(J)
+            step = self._step(J, rhs, q, 0.0)
+            trial = np.clip(q + step, self.lower, self.upper)
+            if shot is None:  # the warm step: r = 0
+                x = x - G[:, 1:] @ (trial - q)
+                q = trial
+                continue
             size = _size(e)
             residual = float(np.max(np.abs(shot.residual) / scale))
             if not np.isfinite(size + residual) or size + residual > 2.0 * merit:
                 return None  # diverging: the full-solve route, damped, from q
             merit = size + residual
-            step = self._step(J, e + w * (shot.tip_motion_x @ G[:, 0])[task], q, 0.0)
-            trial = np.clip(q + step, self.lower, self.upper)
             x = x - G[:, 0] - G[:, 1:] @ (trial - q)
             small = np.max(np.abs(trial - q) / self.scales) <= 1e-7 * (
                 1.0 + np.max(np.abs(q) / self.scales))
             q = trial
-            # stop at an integration that shows the task within tol and the equilibrium
-            # residual small (the step taken from there only improves them; the solve at
-            # the answer checks). Not earlier: along the inputs' weak direction (equal
-            # tensions compress the arm) the second-order terms are large, and a step from a
-            # task error of 1e-4 was measured to leave 2e-7, not 1e-8
-            if size <= 0.5 * self.tol and residual <= 1e-8 and (small or not redundant):
+            # stop at an integration that shows the task within tol, also as linearised to
+            # the equilibrium (``rhs``), with the equilibrium residual small enough for that
+            # linearisation (the step taken from there only improves them; the solve at the
+            # answer checks). Not earlier: along the inputs' weak direction (equal tensions
+            # compress the arm) the second-order terms are large, and a step from a task
+            # error of 1e-4 was measured to leave 2e-7, not 1e-8
+            if (size <= 0.5 * self.tol and _size(rhs) <= 0.5 * self.tol and residual <= 1e-6
+                    and (small or not redundant)):
                 break
         try:
-            eq = self.solver.solve_near([*self.loads, *self._actuators_at(q)], x, 2 * N)
+            every[first:first + self.n_inputs] = q
+            eq = shooter.solve_near([*self.loads, *self._actuators_at(q)], x, 2 * N, every)
         except ConvergenceError:
             self.solver.reset()
             return None
@@ -331,6 +365,9 @@ class InverseSolver:
         if size > self.tol:
             return None
         self.q = q
+        last = self.solver.last_solution()
+        if last is not None:
+            self._warm = (q.copy(), last[0], eq.tip, A, G)
         singular = np.linalg.svd(J * self.scales, compute_uv=False)
         condition = float(singular[0] / singular[-1]) if singular[-1] > 0 else np.inf
         at_bound = (q <= self.lower) | (q >= self.upper)

@@ -290,12 +290,13 @@ def _law(arm, j, s, now, law, s0, s1, s2, s3, s4, s5):
                 ci = c * g[i]
                 for k in range(6):
                     H[i, k] -= ci * g[k]
-        for i in range(6):
-            for k in range(6):
-                M[i, k] = H[i, k]
-            M[i, 6] = -F[i]
-        if _eliminate_columns(M, np.int64(1)) == 0.0:
-            return np.nan, np.nan, np.nan, np.nan, np.nan, np.nan
+        if not _cholesky_correction(H, F, M):  # τ < 0 somewhere: not definite
+            for i in range(6):
+                for k in range(6):
+                    M[i, k] = H[i, k]
+                M[i, 6] = -F[i]
+            if _eliminate_columns(M, np.int64(1)) == 0.0:
+                return np.nan, np.nan, np.nan, np.nan, np.nan, np.nan
         size = 0.0
         for i in range(6):
             eps[i] += M[i, 6]
@@ -310,6 +311,38 @@ def _law(arm, j, s, now, law, s0, s1, s2, s3, s4, s5):
                     M[i, k] = H[i, k]
             return eps[0], eps[1], eps[2], eps[3], eps[4], eps[5]
     return np.nan, np.nan, np.nan, np.nan, np.nan, np.nan
+
+
+@_inline
+def _cholesky_correction(H, F, M):
+    """The Newton correction M[:, 6] = -H⁻¹F by Cholesky (H = L Lᵀ, L in M[:, :6]): H is
+    symmetric, and positive definite when every tension is >= 0 (K plus Σ τ/|w| Jᵀ (I - t tᵀ)
+    J, each term semi-definite). No pivoting, about a third of the work of the general
+    elimination. False (M garbage) if H is not positive definite."""
+    for c in range(6):
+        d = H[c, c]
+        for k in range(c):
+            d -= M[c, k] * M[c, k]
+        if not d > 0.0:
+            return False
+        d = math.sqrt(d)
+        M[c, c] = d
+        for i in range(c + 1, 6):
+            acc = H[i, c]
+            for k in range(c):
+                acc -= M[i, k] * M[c, k]
+            M[i, c] = acc / d
+    for i in range(6):  # L z = -F
+        acc = -F[i]
+        for k in range(i):
+            acc -= M[i, k] * M[k, 6]
+        M[i, 6] = acc / M[i, i]
+    for i in range(5, -1, -1):  # Lᵀ δ = z
+        acc = M[i, 6]
+        for k in range(i + 1, 6):
+            acc -= M[k, i] * M[k, 6]
+        M[i, 6] = acc / M[i, i]
+    return True
 
 
 @_jit

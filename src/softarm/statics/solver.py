@@ -8,6 +8,8 @@ the numerical work, for the whole batch at once, is :func:`softarm.statics._kern
 
 from __future__ import annotations
 
+import copy
+import dataclasses
 import functools
 import math
 from dataclasses import dataclass
@@ -20,7 +22,7 @@ from ..errors import ConvergenceError
 from ..loads import as_loads, batch_shape
 from ..model import Arm, SegmentedArm
 
-__all__ = ["METHOD", "ShootResult", "Solver", "check_base", "check_tol", "solve_numeric"]
+__all__ = ["METHOD", "ShootResult", "Shooter", "Solver", "check_base", "check_tol", "solve_numeric"]
 
 #: Equilibrium.method of every result of this solver.
 METHOD = "numeric.shooting"
@@ -262,6 +264,15 @@ class _Channels:
             active[:, a] = rows
         return (*pieces[:8], pieces[8], routes, kinds, active, pieces[9], pieces[10])
 
+    def single(self, piece, tip) -> _Channels:
+        """A copy of these channels (the same pieces and actuators) holding the single case
+        ``piece`` (P, PIECE_LOADS + A), ``tip`` (TIP_LOADS,)."""
+        out = copy.copy(self)
+        out.shape, out.count = (), 1
+        out.piece, out.tip_loads = piece[None], tip[None]
+        out._piece, out._tip = piece, tip
+        return out
+
     def signature(self) -> tuple:
         """What identifies the actuators (kinds, paths, where they act): a chained solve
         continues from the last case only if this is unchanged."""
@@ -294,6 +305,87 @@ class ShootResult:
     #: actuation inputs in load order (as ``Equilibrium.actuation_jacobian``)
     jacobian_inputs: np.ndarray | None = None
     tip_motion_inputs: np.ndarray | None = None
+
+
+class Shooter:
+    """:meth:`Solver.shoot` with the input columns, prepared for one load set
+    (:meth:`Solver.shooter`). The load channels are affine in the actuation inputs q (a
+    tension, a pressure, a field component), piece(q) = piece(q₀) + Σᵢ (qᵢ - q₀ᵢ) unitᵢ, so a
+    call with new inputs only recombines the prepared arrays.
+
+    Attributes
+    ----------
+    inputs : ndarray, shape (n,)
+        q₀: the loads' own input values, in load order (``Equilibrium.actuation_jacobian``'s
+        columns).
+    """
+
+    def __init__(self, solver, prepared, arm, inputs, unit_piece, unit_tip):
+        self._solver, self._prepared, self._arm = solver, prepared, arm
+        _, _, _, pieces, channels = prepared
+        self._piece_lengths, self._actuators = pieces[1], len(channels.actuators)
+        piece, tip = channels.piece[0], channels.tip_loads[0]
+        self.inputs = inputs
+        self._unit_piece, self._unit_tip = unit_piece, unit_tip
+        self._unit_flat = unit_piece.reshape(inputs.size, -1)
+        # the channels at q = 0
+        self._piece0 = piece - (inputs @ self._unit_flat).reshape(piece.shape)
+        self._tip0 = tip - inputs @ unit_tip
+        self._counts = {}  # step counts per `steps` argument
+
+    def __call__(self, x, inputs=None, *, load_factor=1.0, steps=None) -> ShootResult:
+        """One integration from the base reaction ``x`` (N, N m, spatial) with the inputs
+        ``inputs`` (default :attr:`inputs`) at load factor λ (every load, inputs included,
+        scaled by λ); ``steps`` as in :meth:`Solver.shoot`. Inputs are not validated (a
+        negative tension is integrated as given): the caller keeps them in their bounds."""
+        q = self.inputs if inputs is None else np.asarray(inputs, dtype=np.float64)
+        if q.shape != self.inputs.shape:
+            raise ValueError(f"inputs must have shape {self.inputs.shape} (every actuation "
+                             f"input of the loads, in load order), got {q.shape}")
+        lam = float(load_factor)
+        piece = self._piece0 + (q @ self._unit_flat).reshape(self._piece0.shape)
+        tip = self._tip0 + q @ self._unit_tip
+        k = _kernels()
+        case = (lam * piece, lam * self._unit_piece, lam * tip, lam * self._unit_tip)
+        key = steps if steps is None or isinstance(steps, (int, tuple)) else None
+        counts = self._counts.get(key) if key is not None else None
+        if counts is None:
+            counts = self._solver._step_counts(self._piece_lengths, steps)
+            if key is not None and len(self._counts) < 64:
+                self._counts[key] = counts
+        return _shoot(k, x, 0.0, counts, self._solver._base_kernel, self._arm, case,
+                      self._actuators)
+
+    def solve_near(self, loads, x, steps: int, inputs) -> Equilibrium:
+        """:meth:`Solver.solve_near` for ``loads``, the prepared loads with ``inputs``
+        (given for the result's ``loads``; not validated again), without preparing them."""
+        q = np.asarray(inputs, dtype=np.float64)
+        _, shape, count, pieces, channels = self._prepared
+        piece = self._piece0 + (q @ self._unit_flat).reshape(self._piece0.shape)
+        prepared = (as_loads(loads), shape, count, pieces,
+                    channels.single(piece, self._tip0 + q @ self._unit_tip))
+        return self._solver._solve_near(loads, x, steps, prepared)
+
+
+def _shoot(k, x, lam, counts, base, arm, case, actuators) -> ShootResult:
+    """One call of the kernel's ``shoot``: the tangent columns after x are those of
+    ``case``'s rate rows (inputs, or the load factor), returned as ``jacobian_inputs`` and
+    ``tip_motion_inputs``."""
+    x = np.asarray(x, dtype=np.float64)
+    if x.shape != (6,) or not np.all(np.isfinite(x)):
+        raise ValueError(f"x must be 6 finite numbers (n(0); m(0)), got {x!r}")
+    ncols = 6 + case[1].shape[0]
+    r, J = np.empty(6), np.empty((6, ncols))
+    y, T = np.empty(18 + actuators), np.empty((ncols, 12 + actuators))  # with the lengths
+    k.shoot(x.copy(), lam, counts, base, arm, case, r, J, y, T)
+    R = y[3:12].reshape(3, 3)
+    pose = np.eye(4)
+    pose[:3, :3], pose[:3, 3] = R, y[:3]
+    motion = np.empty((6, ncols))
+    motion[:3] = T[:, :3].T
+    motion[3:] = R @ T[:, 3:6].T
+    return ShootResult(r, J[:, :6].copy(), None, pose, motion[:, :6].copy(), J[:, 6:].copy(),
+                       motion[:, 6:].copy())
 
 
 class Solver:
@@ -467,7 +559,11 @@ class Solver:
         and of this Solver's state (what :func:`softarm.solve` returns)."""
         return self._solve(loads, chained=False, jacobians=jacobians)
 
-    def _solve(self, loads, *, chained: bool, jacobians: bool) -> Equilibrium:
+    def _solve(self, loads, *, chained: bool, jacobians: bool, near: bool = False,
+               prepared=None) -> Equilibrium:
+        """``near``: a single case whose path starts at its own loads, from the memory
+        :meth:`solve_near` wrote (λ = 0 and λ = 1 the same loads); ``prepared``: what
+        :meth:`_prepare` returns for these loads (a :class:`Shooter`'s)."""
         if not isinstance(jacobians, (bool, np.bool_)):
             raise TypeError(f"jacobians must be True or False, got {jacobians!r}")
         loads = as_loads(loads)
@@ -482,15 +578,22 @@ class Solver:
             return solve_displaced(self, loads, jacobians=jacobians)
         k = _kernels()
         last = self._last if chained else None
-        loads, shape, count, pieces, channels = self._prepare(
+        loads, shape, count, pieces, channels = prepared or self._prepare(
             loads, () if last is None else tuple(last[0]))
-        if last is not None and last[3] != channels.signature():
+        if near:
+            if shape != ():
+                raise ValueError(f"Solver.solve_near takes a single load case, got batch "
+                                 f"shape {shape}")
+            last = (pieces[0], channels.piece[0], channels.tip_loads[0])
+        elif last is not None and last[3] != channels.signature():
             # other actuators than the last case's: no continuous path from it
             self.reset()
             last = None
         if last is None:  # from the unloaded arm
             first_piece, first_tip = np.zeros((pieces[0].size, channels.piece.shape[2])), \
                 np.zeros(k.TIP_LOADS)
+        elif near:
+            first_piece, first_tip = channels.piece[0].copy(), channels.tip_loads[0].copy()
         else:
             first_piece, first_tip = _recut(last[0], last[1], pieces[0]), last[2]
         if self._memory is None or not chained:
@@ -581,20 +684,17 @@ class Solver:
         ``x`` (N, N m, spatial), a solution on ``steps`` RK4 steps over the arm (from
         continuation), refined to tol like any solve: the branch x is on, not the one
         connected to the unloaded arm. Leaves this Solver at that equilibrium."""
+        return self._solve_near(loads, x, steps, None)
+
+    def _solve_near(self, loads, x, steps, prepared) -> Equilibrium:
         k = _kernels()
         self.reset()
-        _, shape, _, pieces, channels = self._prepare(loads)
-        if shape != ():
-            raise ValueError(f"Solver.solve_near takes a single load case, got batch shape "
-                             f"{shape}")
-        self._last = (pieces[0], channels.piece[0].copy(), channels.tip_loads[0].copy(),
-                      channels.signature())
         memory = np.zeros(k.MEMORY)
         memory[0:6] = memory[6:12] = np.asarray(x, dtype=np.float64)
         memory[12] = max(1, int(steps) // 2)
         memory[13] = 1.0
         self._memory = memory
-        return self.solve(loads)
+        return self._solve(loads, chained=True, jacobians=False, near=True, prepared=prepared)
 
     def shoot(self, loads, x, load_factor=1.0, *, steps=None, inputs=False) -> ShootResult:
         """One integration from the base reaction ``x`` = (n(0); m(0)) (N, N m, spatial) at
@@ -605,48 +705,47 @@ class Solver:
         (default: a fixed 200, spread over the pieces in proportion to their length), or
         ``("solution", N)``: the grid of a solve whose coarse step count is N (2N steps, as
         :meth:`last_solution` reports it). ``inputs=True`` adds the columns of every
-        actuation input (``jacobian_inputs``, ``tip_motion_inputs``).
+        actuation input (``jacobian_inputs``, ``tip_motion_inputs``); :meth:`shooter`
+        prepares that once for many integrations.
         """
+        if inputs:
+            return self.shooter(loads)(x, load_factor=load_factor, steps=steps)
         k = _kernels()
         loads, shape, _, pieces, channels = self._prepare(loads)
         if shape != ():
             raise ValueError(f"Solver.shoot takes a single load case, got batch shape {shape}")
-        x = np.asarray(x, dtype=np.float64)
-        if x.shape != (6,) or not np.all(np.isfinite(x)):
-            raise ValueError(f"x must be 6 finite numbers (n(0); m(0)), got {x!r}")
-        # steps per piece as the kernel's _fill_steps spreads them: factor × the nominal n
-        # in proportion to length, at least one
+        piece, tip = channels.piece[0], channels.tip_loads[0]
+        case = (np.zeros_like(piece), piece[None].copy(), np.zeros(k.TIP_LOADS),
+                tip[None].copy())
+        result = _shoot(k, x, float(load_factor), self._step_counts(pieces[1], steps),
+                        self._base_kernel, channels.arm_tuple(), case, len(channels.actuators))
+        return dataclasses.replace(result, jacobian_load=result.jacobian_inputs[:, 0],
+                                   jacobian_inputs=None, tip_motion_inputs=None)
+
+    def shooter(self, loads) -> Shooter:
+        """:meth:`shoot` with the input columns, prepared once for the single case ``loads``
+        (validation, the cut, the channels per unit input): a :class:`Shooter`, called with
+        new input values, integrates without any of that work. Inverse statics iterates on
+        it. Valid while ``loads``' structure (kinds, routings, segments) stays the same."""
+        loads, shape, _, pieces, channels = self._prepare(loads)
+        if shape != ():
+            raise ValueError(f"Solver.shooter takes a single load case, got batch shape "
+                             f"{shape}")
+        unit_piece, unit_tip = self._input_channels(loads, pieces, channels.piece.shape[2])
+        values = np.array([v for load in loads for name in load.inputs
+                           for v in np.ravel(np.asarray(getattr(load, name), dtype=float))])
+        return Shooter(self, (loads, shape, 1, pieces, channels), channels.arm_tuple(), values,
+                       unit_piece, unit_tip)
+
+    def _step_counts(self, piece_lengths, steps) -> np.ndarray:
+        """RK4 steps per piece as the kernel's ``_fill_steps`` spreads them: factor × the
+        nominal n in proportion to length, at least one (``steps`` as in :meth:`shoot`)."""
         if isinstance(steps, tuple) and len(steps) == 2 and steps[0] == "solution":
             n, factor = count(steps[1], "steps", 1), 2  # a solution's fine grid, 2N
         else:
             n, factor = 200 if steps is None else count(steps, "steps", 1), 1
-        counts = factor * np.maximum(1, np.floor(n * pieces[1] / self.length + 0.5)).astype(
+        return factor * np.maximum(1, np.floor(n * piece_lengths / self.length + 0.5)).astype(
             np.int64)
-        lam = float(load_factor)
-        piece, tip = channels.piece[0], channels.tip_loads[0]
-        if inputs:  # at λ·loads; the columns after x along each input's channels
-            unit_piece, unit_tip = self._input_channels(loads, pieces, piece.shape[1])
-            case = (lam * piece, lam * unit_piece, lam * tip, lam * unit_tip)
-            lam = 0.0
-        else:
-            case = (np.zeros_like(piece), piece[None].copy(), np.zeros(k.TIP_LOADS),
-                    tip[None].copy())
-        ncols = 6 + case[1].shape[0]
-        r, J = np.empty(6), np.empty((6, ncols))
-        A = len(channels.actuators)  # the tangent rows carry the A tendon lengths
-        y, T = np.empty(18 + A), np.empty((ncols, 12 + A))
-        k.shoot(x.copy(), lam, counts, self._base_kernel, channels.arm_tuple(), case, r, J, y,
-                T)
-        R = y[3:12].reshape(3, 3)
-        pose = np.eye(4)
-        pose[:3, :3], pose[:3, 3] = R, y[:3]
-        motion = np.empty((6, ncols))
-        motion[:3] = T[:, :3].T
-        motion[3:] = R @ T[:, 3:6].T
-        if inputs:
-            return ShootResult(r, J[:, :6].copy(), None, pose, motion[:, :6].copy(),
-                               J[:, 6:].copy(), motion[:, 6:].copy())
-        return ShootResult(r, J[:, :6].copy(), J[:, 6].copy(), pose, motion[:, :6].copy())
 
     def last_solution(self):
         """(x, N) of the last case a chained :meth:`solve` reached: its base reaction (N, N m,
