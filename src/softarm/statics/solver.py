@@ -251,7 +251,11 @@ class _Channels:
             self._piece[..., :, k.FG:k.FG + 9] += G[..., None, :]
 
     def arm_tuple(self) -> tuple:
-        """The kernel's arm tuple: the pieces and the actuators' paths (see _kernels)."""
+        """The kernel's arm tuple: the pieces and the actuators' paths (see _kernels);
+        built once (the solve and its stability verdict both pass it)."""
+        built = self.__dict__.get("_arm_tuple")
+        if built is not None and built[0] == len(self.actuators):
+            return built[1]
         pieces = self.pieces
         degree = max([1] + [routing.degree for _, routing, _, _ in self.actuators])
         A = len(self.actuators)
@@ -262,7 +266,9 @@ class _Channels:
             routes[a] = routing.kernel_row(degree, self.length)
             kinds[a] = kind
             active[:, a] = rows
-        return (*pieces[:8], pieces[8], routes, kinds, active, pieces[9], pieces[10])
+        out = (*pieces[:8], pieces[8], routes, kinds, active, pieces[9], pieces[10])
+        self._arm_tuple = (A, out)
+        return out
 
     def single(self, piece, tip) -> _Channels:
         """A copy of these channels (the same pieces and actuators) holding the single case
@@ -847,14 +853,14 @@ def _compliances(jac, motion, shape, tendons):
     lengths = jac[:, 6 + tendons, :]
     jac = jac[:, :6]
     inverse = np.linalg.inv(jac[:, :, :6])
-    station = np.einsum("bsij,bjk->bsik", motion[..., :6], inverse)
+    station = motion[..., :6] @ inverse[:, None]
     tip = station[:, -1].copy()
     S = motion.shape[1]
     n = jac.shape[2] - 6
     out = [tip.reshape(*shape, 6, 6), station.reshape(*shape, S, 6, 6)]
     if n:
         through_x = np.einsum("bij,bjk->bik", inverse, jac[:, :, 6:])
-        inputs = motion[..., 6:] - np.einsum("bsij,bjk->bsik", motion[..., :6], through_x)
+        inputs = motion[..., 6:] - motion[..., :6] @ through_x[:, None]
         out += [inputs[:, -1].copy().reshape(*shape, 6, n), inputs.reshape(*shape, S, 6, n)]
         if tendons.size:
             out.append((lengths[..., 6:] - np.einsum("bij,bjk->bik", lengths[..., :6],
