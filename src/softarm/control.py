@@ -19,6 +19,7 @@ An unreachable target gives the closest reachable point with ``reached=False``.
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -235,11 +236,13 @@ class InverseSolver:
 
     def _pose_task(self, tip, target, orientation):
         """The weighted task error e and its weights w at the tip pose ``tip`` (4 × 4)."""
-        e = (np.asarray(target) - tip[:3, 3]) / self.length
+        e = (target - tip[:3, 3]) / self.length
+        weights = np.full(3 if orientation is None else 6, 1.0 / self.length)
         if orientation is None:
-            return e, np.r_[np.full(3, 1.0 / self.length)]
+            return e, weights
+        weights[3:] = 1.0
         rotation = so3.log(orientation @ tip[:3, :3].T)  # spatial δθ to the target
-        return np.r_[e, rotation], np.r_[np.full(3, 1.0 / self.length), np.ones(3)]
+        return np.concatenate([e, rotation]), weights
 
     def _redundant(self, J) -> bool:
         """More inputs than the rank of the weighted task Jacobian J (task × inputs)."""
@@ -331,7 +334,7 @@ class InverseSolver:
             if redundant is None:
                 redundant = self._redundant(J)
             step = self._step(J, rhs, q, 0.0)
-            trial = np.clip(q + step, self.lower, self.upper)
+            trial = np.minimum(np.maximum(q + step, self.lower), self.upper)
             if shot is None:  # the warm step: r = 0
                 x = x - G[:, 1:] @ (trial - q)
                 q = trial
@@ -467,7 +470,7 @@ class InverseSolver:
 
 def _size(e) -> float:
     """The task error: |δp|/L, or with an orientation the larger of that and |δθ| (rad)."""
-    return float(max(np.linalg.norm(e[:3]), np.linalg.norm(e[3:]) if e.size > 3 else 0.0))
+    return math.sqrt(max(float(e[:3] @ e[:3]), float(e[3:] @ e[3:]) if e.size > 3 else 0.0))
 
 
 def _input_count(load) -> int:
