@@ -262,6 +262,23 @@ def run_cases(all_cases, refs, repeats: int, peer_repeats: int, quick: bool) -> 
         print(f"  {name}: softarm numeric tol={tol:g} {wall0 * 1e3:.3f} ms err {err:.1e}",
               flush=True)
 
+        # the same solve with the tip as the only output (s=2: base and tip), in alternation
+        # with the 101 stations: each station costs one RK4 sub-step of the output pass
+        tip = softarm.solve(arm, loads, method="numeric", tol=tol, s=2).tip_position
+        tip_err = float(np.linalg.norm(tip - ref)) / L
+        (t_wall, t_cpu), (s_wall, s_cpu) = timed_pair(
+            lambda arm=arm, loads=loads, tol=tol: softarm.solve(
+                arm, loads, method="numeric", tol=tol, s=2),
+            lambda arm=arm, loads=loads, tol=tol: softarm.solve(
+                arm, loads, method="numeric", tol=tol), repeats)
+        rows.append(Row(name, "softarm numeric, tip only", f"tol={tol:g}, s=2 (base, tip)",
+                        t_wall * 1e3, t_cpu * 1e3, tip_err, tip_err <= ACCURACY,
+                        t_wall / wall0,
+                        f"101 stations in alternation: {s_wall * 1e3:.3f} ms wall, "
+                        f"{s_cpu * 1e3:.3f} ms CPU", s_wall * 1e3, s_cpu * 1e3))
+        print(f"  {name}: tip only {t_wall * 1e3:.3f} ms (101 stations {s_wall * 1e3:.3f} ms)",
+              flush=True)
+
         # the exact tip compliance (issue 13): solve + compliance against the solve alone,
         # timed in alternation at the same tolerance
         (wall, cpu), (p_wall, p_cpu) = timed_pair(
@@ -451,6 +468,8 @@ def verdicts(rows, closed, closed_serial, batch) -> list[str]:
               None)
     bvp = next((x for x in rows if x.case == "mattiasson_k5" and x.tool == "scipy solve_bvp"),
                None)
+    tip = next((x for x in rows if x.case == "mattiasson_k5"
+                and x.tool == "softarm numeric, tip only"), None)
     if sa and bvp:
         ok = sa.wall_ms <= 0.5 and sa.matched and bvp.ratio >= 20.0 and bvp.matched
         out.append(
@@ -458,6 +477,13 @@ def verdicts(rows, closed, closed_serial, batch) -> list[str]:
             f"{'met' if ok else 'NOT met'}: softarm {sa.wall_ms:.3f} ms wall, {sa.cpu_ms:.3f} ms "
             f"CPU (target ≤ 0.5 ms, error {sa.error:.1e} L), solve_bvp {bvp.wall_ms:.1f} ms = "
             f"{bvp.ratio:.1f}× (target ≥ 20×)"
+        )
+    if tip:
+        out.append(
+            f"the same with the tip as the only output (s=2): "
+            f"{'met' if tip.wall_ms <= 0.5 and tip.matched else 'NOT met'}: "
+            f"{tip.wall_ms:.3f} ms wall, {tip.cpu_ms:.3f} ms CPU, against "
+            f"{tip.numeric_wall_ms:.3f} ms with 101 stations in alternation"
         )
     comps = [x for x in rows if x.tool == "softarm numeric + compliance"]
     if comps:
@@ -622,8 +648,15 @@ def main(argv=None) -> int:
     for n in (max(1, n_cases // 10), n_cases):
         batch.append(throughput.batch_solver(n))
         print(f"  {json.dumps(batch[-1])}", flush=True)
+    tip_batch = throughput.batch_solver(n_cases, n_stations=2)  # the tip as the only output
+    print(f"  {json.dumps(tip_batch)}", flush=True)
 
     verdict = verdicts(rows, closed, closed_serial, batch)
+    t_ok = tip_batch["wall_s"] <= 5.0 * tip_batch["n_cases"] / 1e4
+    verdict.append(
+        f"the same batch with the tip as the only output (s=2): "
+        f"{'met' if t_ok else 'NOT met'}: {tip_batch['n_cases']} load cases took "
+        f"{tip_batch['wall_s']:.2f} s (CPU {tip_batch['cpu_s']:.2f} s)")
     if comp["cold_first_call_s"] is not None:
         cold = comp["cold_first_call_s"]
         verdict.append(f"cold numba compile not slower than 0.1's (about 15 s): "

@@ -44,7 +44,7 @@ def test_quick_run_writes_report(quick_report):
     for heading in ("## Machine", "## Compilation", "## Against peers", "## Throughput",
                     "## Verdicts"):
         assert heading in text
-    assert stdout.count("VERDICT") == 6
+    assert stdout.count("VERDICT") == 8
 
 
 def test_table_parses_and_covers_every_case_and_tool(quick_report):

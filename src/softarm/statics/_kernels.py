@@ -637,15 +637,19 @@ def _dipole(y, T, which, m0, m1, m2, now, rate, out):
 
 
 @_inline
-def _rk4(y, T, nt, h, s, arm, j, now, rate, work, twork, law):
+def _rk4(y, T, nt, h, s, arm, j, now, rate, work, twork, law, known):
     """One RK4 step of length h from arc length s on piece j in place (the state and the
     first nt tangent columns of T), then R ← R (3I - RᵀR)/2: one Björck step towards the
-    nearest rotation.
+    nearest rotation. ``known``: the first stage's derivatives (``work[0]``, ``twork[0]``)
+    are already those at (y, T, s), left by a step from the same point (the output pass's
+    station sub-steps and the grid step they share a start with): not evaluated again.
 
     Loops are written out (no slice assignment, no array expression): numba compiles those
     with shape checks whose error messages pull in its string machinery.
     """
     for stage in range(4):  # work rows 0-3: the stage derivatives; row 4: the stage state
+        if stage == 0 and known:
+            continue
         a = 0.0 if stage == 0 else (h if stage == 3 else 0.5 * h)
         prev = max(stage - 1, 0)
         for i in range(y.size):
@@ -686,7 +690,9 @@ def _rk4(y, T, nt, h, s, arm, j, now, rate, work, twork, law):
 @_jit
 def _steps(y, T, nt, h, s, n, arm, j, now, rate, work, twork, law):
     """``n`` RK4 steps of length h (negative: towards the base) from arc length s on piece j,
-    in place.
+    in place. ``n`` = -1: one step whose first stage derivatives are already in ``work[0]``
+    and ``twork[0]`` (``_rk4``'s ``known``; an encoding, not another argument, so that every
+    caller shares one compiled version).
 
     Design note: this is the one function the inlined step (:func:`_rk4` with :func:`_deriv`)
     is compiled into. Every integration (the shooting pass, the output pass, the stability
@@ -694,8 +700,9 @@ def _steps(y, T, nt, h, s, n, arm, j, now, rate, work, twork, law):
     side once instead of once per caller (cold compile 110 s -> see statics/README.md), and a
     call costs once per run of steps, not once per stage.
     """
-    for i in range(n):
-        _rk4(y, T, nt, h, s + i * h, arm, j, now, rate, work, twork, law)
+    known = n < 0
+    for i in range(abs(n)):
+        _rk4(y, T, nt, h, s + i * h, arm, j, now, rate, work, twork, law, known and i == 0)
 
 
 @_jit
@@ -1221,7 +1228,10 @@ def _record(x, nt, steps, base, arm, case, lam, scratch, s_out, out, b, r, J):
             last = j == npieces - 1 and i == steps[j] - 1
             t1 = piece_start[j] + (i + 1) * h if i < steps[j] - 1 else (
                 piece_start[j + 1] if j < npieces - 1 else np.inf)
-            while k < ns and s_out[k] < t1:  # stations inside this step: own steps
+            # stations inside this step: own steps from its start, which all share its first
+            # stage (evaluated once, by the first of them; the step itself reuses it too)
+            first = one
+            while k < ns and s_out[k] < t1:
                 if last and s_out[k] >= arm[6]:
                     break  # the tip station: the tip state itself, below
                 for a in range(y.size):
@@ -1229,12 +1239,13 @@ def _record(x, nt, steps, base, arm, case, lam, scratch, s_out, out, b, r, J):
                 for d in range(nt):
                     for a in range(T.shape[1]):
                         Ts[d, a] = T[d, a]
-                _steps(ys, Ts, nt, s_out[k] - t0, t0, one, arm, j, now, rate, work, twork,
+                _steps(ys, Ts, nt, s_out[k] - t0, t0, first, arm, j, now, rate, work, twork,
                        law)
+                first = -one
                 _write(ys, Ts, nt, j, s_out[k], arm, now, law, poses[k], strains[k],
                        stresses[k], E[k])
                 k += 1
-            _steps(y, T, nt, h, t0, one, arm, j, now, rate, work, twork, law)
+            _steps(y, T, nt, h, t0, first, arm, j, now, rate, work, twork, law)
             i += 1
     for i in range(k, ns):
         _write(y, T, nt, npieces - 1, arm[6], arm, now, law, poses[i], strains[i],
