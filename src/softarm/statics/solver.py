@@ -792,18 +792,18 @@ def _unloaded_length(pieces, actuator) -> float:
     """A tendon's length in the unloaded arm, ∫ |e1 + κ⁰ × r + r'| ds over the pieces it
     runs through (Gauss–Legendre, 24 nodes per piece and per quarter turn of a helix)."""
     _, routing, active, _ = actuator
-    on = np.flatnonzero(active)
-    return _unloaded_length_cached(routing, pieces[0][on].tobytes(), pieces[1][on].tobytes(),
-                                   pieces[3][on].tobytes())
+    return _unloaded_length_cached(routing, active.tobytes(), pieces[0].tobytes(),
+                                   pieces[1].tobytes(), pieces[3].tobytes())
 
 
 _NODES, _WEIGHTS = np.polynomial.legendre.leggauss(24)
 
 
 @functools.lru_cache(maxsize=256)
-def _unloaded_length_cached(routing, starts, lengths, f0) -> float:
-    starts, lengths = np.frombuffer(starts), np.frombuffer(lengths)
-    f0 = np.frombuffer(f0).reshape(-1, 6)
+def _unloaded_length_cached(routing, active, starts, lengths, f0) -> float:
+    on = np.flatnonzero(np.frombuffer(active))
+    starts, lengths = np.frombuffer(starts)[on], np.frombuffer(lengths)[on]
+    f0 = np.frombuffer(f0).reshape(-1, 6)[on]
     total = 0.0
     for j in range(starts.size):
         parts = max(1, int(np.ceil(4 * abs(routing.helix[1]) * lengths[j])))
