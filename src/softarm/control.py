@@ -390,11 +390,12 @@ class InverseSolver:
                 raise ValueError("orientation must be a 3 × 3 rotation matrix")
         q = np.clip(self.q, self.lower, self.upper)
         if self.solver.last_solution() is None and not self._displaced:
-            # cold: one plain solve at the current inputs puts the fast route in reach
-            # (measured: a cold inverse 2-3× faster than the full route's solves with
-            # Jacobians); a ConvergenceError there leaves the full route to try
+            # cold: one solve at the current inputs (its memory only: tip station, no
+            # verdict) puts the fast route in reach (a cold inverse of the nitinol robot:
+            # 13 ms median by the full route's solves with Jacobians, 7 ms so); a
+            # ConvergenceError there leaves the full route to try
             try:
-                self.solver.solve([*self.loads, *self._actuators_at(q)])
+                self.solver._settle([*self.loads, *self._actuators_at(q)])
             except ConvergenceError:
                 self.solver.reset()
         fast = self._shooting_newton(q, target, orientation)

@@ -560,16 +560,23 @@ class Solver:
         """
         return self._solve(loads, chained=True, jacobians=jacobians)
 
+    def _settle(self, loads) -> None:
+        """:meth:`solve` for the quasi-static memory only (the solution's base reaction and
+        step count, :meth:`last_solution`): the tip is its one station and there is no
+        verdict. Inverse statics' first target starts its fast route from it."""
+        self._solve(loads, chained=True, jacobians=False, outputs=False)
+
     def solve_from_unloaded(self, loads, *, jacobians: bool = False) -> Equilibrium:
         """Every case of ``loads`` solved from the unloaded arm, independently of the others
         and of this Solver's state (what :func:`softarm.solve` returns)."""
         return self._solve(loads, chained=False, jacobians=jacobians)
 
     def _solve(self, loads, *, chained: bool, jacobians: bool, near: bool = False,
-               prepared=None) -> Equilibrium:
+               prepared=None, outputs: bool = True) -> Equilibrium | None:
         """``near``: a single case whose path starts at its own loads, from the memory
         :meth:`solve_near` wrote (λ = 0 and λ = 1 the same loads); ``prepared``: what
-        :meth:`_prepare` returns for these loads (a :class:`Shooter`'s)."""
+        :meth:`_prepare` returns for these loads (a :class:`Shooter`'s); ``outputs=False``:
+        only the memory of a chained solve (the tip its one station, no verdict), None."""
         if not isinstance(jacobians, (bool, np.bool_)):
             raise TypeError(f"jacobians must be True or False, got {jacobians!r}")
         loads = as_loads(loads)
@@ -608,7 +615,8 @@ class Solver:
                 self._memory = memory
         else:
             memory = self._memory
-        S = self.s.size
+        s_kernel = self._s_kernel if outputs else np.array([self.length])
+        S = s_kernel.size
         poses = np.empty((count, S, 4, 4))
         strains = np.empty((count, S, 6))
         stresses = np.empty((count, S, 6))
@@ -626,10 +634,10 @@ class Solver:
         lengths = np.empty((count, len(channels.actuators)))
         k.solve_cases(self._base_kernel, channels.arm_tuple(),
                       (channels.piece, channels.tip_loads), (first_piece, first_tip),
-                      self._options(chained, jacobians), self._s_kernel, memory, inputs,
+                      self._options(chained, jacobians), s_kernel, memory, inputs,
                       (poses, strains, stresses, info, status, jac, motion, base_wrench,
                        lengths))
-        actuation = _actuation(channels, base_wrench, lengths, shape)
+        actuation = _actuation(channels, base_wrench, lengths, shape) if outputs else None
         failed = np.flatnonzero(status != k.OK)
         if failed.size:
             if chained:
@@ -638,6 +646,8 @@ class Solver:
         if chained and count:
             self._last = (pieces[0], channels.piece[-1].copy(), channels.tip_loads[-1].copy(),
                           channels.signature())
+        if not outputs:
+            return None
         tip_compliance = compliance = None
         if jacobians:
             tip_compliance, compliance, tip_inputs, station_inputs, lengths_inputs = \
