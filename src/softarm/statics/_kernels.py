@@ -637,12 +637,12 @@ def _dipole(y, T, which, m0, m1, m2, now, rate, out):
 
 
 @_inline
-def _rk4(y, T, nt, h, s, arm, j, now, rate, work, twork, law, known):
+def _rk4(y, T, nt, h, s, arm, j, now, rate, work, twork, law, known, first_only):
     """One RK4 step of length h from arc length s on piece j in place (the state and the
     first nt tangent columns of T), then R ← R (3I - RᵀR)/2: one Björck step towards the
     nearest rotation. ``known``: the first stage's derivatives (``work[0]``, ``twork[0]``)
-    are already those at (y, T, s), left by a step from the same point (the output pass's
-    station sub-steps and the grid step they share a start with): not evaluated again.
+    are already those at (y, T, s), left by the output pass: not evaluated again.
+    ``first_only``: only those derivatives, y and T unchanged.
 
     Loops are written out (no slice assignment, no array expression): numba compiles those
     with shape checks whose error messages pull in its string machinery.
@@ -662,6 +662,8 @@ def _rk4(y, T, nt, h, s, arm, j, now, rate, work, twork, law, known):
                 for i in range(NT, T.shape[1]):
                     twork[4, d, i] = T[d, i] + a * twork[prev, d, i] if stage else T[d, i]
         _deriv(work, twork, nt, stage, s + a, arm, j, now, rate, law)
+        if first_only:
+            return
     w = h / 6.0
     for i in range(y.size):
         y[i] += w * (work[0, i] + 2.0 * work[1, i] + 2.0 * work[2, i] + work[3, i])
@@ -674,6 +676,80 @@ def _rk4(y, T, nt, h, s, arm, j, now, rate, work, twork, law, known):
             for i in range(NT, T.shape[1]):
                 T[d, i] += w * (twork[0, d, i] + 2.0 * twork[1, d, i] + 2.0 * twork[2, d, i]
                                 + twork[3, d, i])
+    _bjorck(y)
+
+
+@_inline
+def _station_rotation(y0, f0, y1, f1, u, h, out):
+    """The rotation of a station at u ∈ [0, 1] of a step of length h, from the states y0, y1
+    and derivatives f0, f1 at its ends: R = R0 exp(θ~), θ(u) the cubic Hermite polynomial of
+    the rotation vector from R0 (θ(0) = 0, θ(1) = log(R0ᵀ R1), θ' = h u0 and h J_r⁻¹(θ1) u1,
+    u the curvature R' = R u~). The rotation vector is what varies slowly (exactly linearly
+    on an arc), so this interpolates R to the accuracy of the positions' Hermite polynomial,
+    where interpolating R's entries was 10× worse; exactly a rotation. Writes out[3:12]."""
+    # u0 = vee(R0ᵀ R0'), u1 = vee(R1ᵀ R1') (the antisymmetric part's axial vector)
+    c = np.empty((2, 3))
+    for e in range(2):
+        y, f = (y0, f0) if e == 0 else (y1, f1)
+        for a in range(3):  # (RᵀR')[a, b] = Σ_i R[i, a] R'[i, b]
+            b, d = (a + 1) % 3, (a + 2) % 3
+            m_db = (y[_R + d] * f[_R + b] + y[_R + 3 + d] * f[_R + 3 + b]
+                    + y[_R + 6 + d] * f[_R + 6 + b])
+            m_bd = (y[_R + b] * f[_R + d] + y[_R + 3 + b] * f[_R + 3 + d]
+                    + y[_R + 6 + b] * f[_R + 6 + d])
+            c[e, a] = 0.5 * (m_db - m_bd)  # û[d, b] = u_a
+    # Q = R0ᵀ R1 and its rotation vector
+    q = np.empty((3, 3))
+    for a in range(3):
+        for b in range(3):
+            q[a, b] = (y0[_R + a] * y1[_R + b] + y0[_R + 3 + a] * y1[_R + 3 + b]
+                       + y0[_R + 6 + a] * y1[_R + 6 + b])
+    w0, w1, w2 = q[2, 1] - q[1, 2], q[0, 2] - q[2, 0], q[1, 0] - q[0, 1]
+    sine = 0.5 * math.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
+    cosine = 0.5 * (q[0, 0] + q[1, 1] + q[2, 2] - 1.0)
+    angle = math.atan2(sine, cosine)
+    scale = 0.5 + angle * angle / 12.0 if angle < 1e-4 else 0.5 * angle / math.sin(angle)
+    t0, t1, t2 = scale * w0, scale * w1, scale * w2  # θ1
+    # θ1' = J_r⁻¹(θ1) u1 = u1 + ½ θ1 × u1 + β θ1 × (θ1 × u1)
+    beta = (1.0 / 12.0 + angle * angle / 720.0 if angle < 1e-3 else
+            1.0 / (angle * angle) - (1.0 + math.cos(angle)) / (2.0 * angle * math.sin(angle)))
+    v0, v1, v2 = c[1, 0], c[1, 1], c[1, 2]
+    x0, x1, x2 = t1 * v2 - t2 * v1, t2 * v0 - t0 * v2, t0 * v1 - t1 * v0  # θ1 × u1
+    z0, z1, z2 = t1 * x2 - t2 * x1, t2 * x0 - t0 * x2, t0 * x1 - t1 * x0
+    d0, d1, d2 = v0 + 0.5 * x0 + beta * z0, v1 + 0.5 * x1 + beta * z1, v2 + 0.5 * x2 + beta * z2
+    # the Hermite polynomial at u (θ(0) = 0)
+    c1 = u * (1.0 - u) * (1.0 - u) * h
+    c2 = u * u * (3.0 - 2.0 * u)
+    c3 = -u * u * (1.0 - u) * h
+    a0 = c1 * c[0, 0] + c2 * t0 + c3 * d0
+    a1 = c1 * c[0, 1] + c2 * t1 + c3 * d1
+    a2 = c1 * c[0, 2] + c2 * t2 + c3 * d2
+    # exp(θ~) by Rodrigues, then R0 exp(θ~)
+    angle = math.sqrt(a0 * a0 + a1 * a1 + a2 * a2)
+    if angle < 1e-4:
+        sa, ca = 1.0 - angle * angle / 6.0, 0.5 - angle * angle / 24.0
+    else:
+        sa, ca = math.sin(angle) / angle, (1.0 - math.cos(angle)) / (angle * angle)
+    e = np.empty((3, 3))
+    e[0, 0] = 1.0 - ca * (a1 * a1 + a2 * a2)
+    e[1, 1] = 1.0 - ca * (a0 * a0 + a2 * a2)
+    e[2, 2] = 1.0 - ca * (a0 * a0 + a1 * a1)
+    e[0, 1] = -sa * a2 + ca * a0 * a1
+    e[1, 0] = sa * a2 + ca * a0 * a1
+    e[0, 2] = sa * a1 + ca * a0 * a2
+    e[2, 0] = -sa * a1 + ca * a0 * a2
+    e[1, 2] = -sa * a0 + ca * a1 * a2
+    e[2, 1] = sa * a0 + ca * a1 * a2
+    for a in range(3):
+        for b in range(3):
+            out[_R + 3 * a + b] = (y0[_R + 3 * a] * e[0, b] + y0[_R + 3 * a + 1] * e[1, b]
+                                   + y0[_R + 3 * a + 2] * e[2, b])
+
+
+@_inline
+def _bjorck(y):
+    """R ← R (3I - RᵀR)/2 on the state's rotation: one Björck step towards the nearest
+    rotation (quadratic: an error ε of RᵀR = I becomes about ε²)."""
     g00 = 1.5 - 0.5 * (y[3] * y[3] + y[6] * y[6] + y[9] * y[9])
     g11 = 1.5 - 0.5 * (y[4] * y[4] + y[7] * y[7] + y[10] * y[10])
     g22 = 1.5 - 0.5 * (y[5] * y[5] + y[8] * y[8] + y[11] * y[11])
@@ -690,9 +766,10 @@ def _rk4(y, T, nt, h, s, arm, j, now, rate, work, twork, law, known):
 @_jit
 def _steps(y, T, nt, h, s, n, arm, j, now, rate, work, twork, law):
     """``n`` RK4 steps of length h (negative: towards the base) from arc length s on piece j,
-    in place. ``n`` = -1: one step whose first stage derivatives are already in ``work[0]``
-    and ``twork[0]`` (``_rk4``'s ``known``; an encoding, not another argument, so that every
-    caller shares one compiled version).
+    in place. ``n`` < 0: |n| steps, the first one's first stage derivatives already in
+    ``work[0]`` and ``twork[0]`` (``_rk4``'s ``known``); ``n`` = 0: those derivatives at
+    (y, T, s) only, y and T unchanged (encodings, not more arguments, so that every caller
+    shares one compiled version, with one inlined copy of the step).
 
     Design note: this is the one function the inlined step (:func:`_rk4` with :func:`_deriv`)
     is compiled into. Every integration (the shooting pass, the output pass, the stability
@@ -700,9 +777,9 @@ def _steps(y, T, nt, h, s, n, arm, j, now, rate, work, twork, law):
     side once instead of once per caller (cold compile 110 s -> see statics/README.md), and a
     call costs once per run of steps, not once per stage.
     """
-    known = n < 0
-    for i in range(abs(n)):
-        _rk4(y, T, nt, h, s + i * h, arm, j, now, rate, work, twork, law, known and i == 0)
+    for i in range(max(abs(n), 1)):
+        _rk4(y, T, nt, h, s + i * h, arm, j, now, rate, work, twork, law, n < 0 and i == 0,
+             n == 0)
 
 
 @_jit
@@ -1193,10 +1270,14 @@ def _record(x, nt, steps, base, arm, case, lam, scratch, s_out, out, b, r, J):
     and, with nt >= 6, the Jacobian J and the station tangents (columns 6.. along the
     case's rate rows: the inputs); and the case's base reaction and tendon lengths.
 
-    A station inside a step is reached by its own RK4 step from the start of that step, so
-    the stations never change the steps of the solution. A station at a piece start gets the
-    state after the point wrench there (the tip side). The station s = L (and any station
-    past the last step's start) is written from the tip state itself.
+    A station inside a step is interpolated: the cubic Hermite polynomial of the state and
+    tangents on the step, from their values and derivatives at both ends (the derivative at
+    the end is the next step's first stage, so it costs nothing inside a piece), then one
+    Björck step on R. Its error is of the order of the step's own discretisation error
+    (statics/README.md: measured against tight solves); the stations never change the
+    steps of the solution. A station at a piece start gets the state after the point wrench
+    there (the tip side). The station s = L (and any station past the last step's start) is
+    written from the tip state itself.
     """
     y, T, work, twork, now, tip_now, ys, Ts, law = scratch
     poses, strains, stresses = out[0][b], out[1][b], out[2][b]
@@ -1209,10 +1290,12 @@ def _record(x, nt, steps, base, arm, case, lam, scratch, s_out, out, b, r, J):
     ns = s_out.size
     npieces = piece_len.size
     one = np.int64(1)  # not a literal 1: _steps is compiled once for every caller
+    zero = one - one
     for j in range(npieces):
         _jump(y, T, nt, now, rate, j, arm, law)
         h = piece_len[j] / steps[j]
         i = 0
+        known = False  # work[0], twork[0] hold the derivatives at (y, T, this step's start)
         while i < steps[j]:
             # the steps surely before the next station's step, as one run (one step of
             # margin against rounding: the step-by-step branch below decides exactly)
@@ -1220,32 +1303,57 @@ def _record(x, nt, steps, base, arm, case, lam, scratch, s_out, out, b, r, J):
             if k < ns:
                 run = min(run, max(int((s_out[k] - piece_start[j]) / h) - 1 - i, 0))
             if run > 0:
-                _steps(y, T, nt, h, piece_start[j] + i * h, run, arm, j, now, rate, work,
-                       twork, law)
+                _steps(y, T, nt, h, piece_start[j] + i * h, -run if known else run, arm, j,
+                       now, rate, work, twork, law)
+                known = False
                 i += run
                 continue
             t0 = piece_start[j] + i * h
             last = j == npieces - 1 and i == steps[j] - 1
             t1 = piece_start[j] + (i + 1) * h if i < steps[j] - 1 else (
                 piece_start[j + 1] if j < npieces - 1 else np.inf)
-            # stations inside this step: own steps from its start, which all share its first
-            # stage (evaluated once, by the first of them; the step itself reuses it too)
-            first = one
+            inside = k < ns and s_out[k] < t1 and not (last and s_out[k] >= arm[6])
+            if not inside:  # (the tip station is the tip state itself, below)
+                _steps(y, T, nt, h, t0, -one if known else one, arm, j, now, rate, work,
+                       twork, law)
+                known = False
+                i += 1
+                continue
+            # stations inside this step: the step from its start (kept with its derivative,
+            # the step's first stage), the derivative at its end (the next step's first
+            # stage on this piece), then each station by Hermite interpolation
+            _copy(y, work[5])
+            for d in range(nt):
+                for a in range(T.shape[1]):
+                    twork[5, d, a] = T[d, a]
+            _steps(y, T, nt, h, t0, -one if known else one, arm, j, now, rate, work, twork,
+                   law)
+            _copy(work[0], work[6])
+            for d in range(nt):
+                for a in range(T.shape[1]):
+                    twork[6, d, a] = twork[0, d, a]
+            # (at the next step's own start, to the bit: its first stage is this one)
+            _steps(y, T, nt, h, piece_start[j] + (i + 1) * h, zero, arm, j, now, rate, work,
+                   twork, law)
+            known = i + 1 < steps[j]
             while k < ns and s_out[k] < t1:
                 if last and s_out[k] >= arm[6]:
-                    break  # the tip station: the tip state itself, below
+                    break
+                u = (s_out[k] - t0) / h
+                c0 = (1.0 + 2.0 * u) * (1.0 - u) * (1.0 - u)  # cubic Hermite basis
+                c1 = u * (1.0 - u) * (1.0 - u) * h
+                c2 = u * u * (3.0 - 2.0 * u)
+                c3 = -u * u * (1.0 - u) * h
                 for a in range(y.size):
-                    ys[a] = y[a]
+                    ys[a] = c0 * work[5, a] + c1 * work[6, a] + c2 * y[a] + c3 * work[0, a]
                 for d in range(nt):
                     for a in range(T.shape[1]):
-                        Ts[d, a] = T[d, a]
-                _steps(ys, Ts, nt, s_out[k] - t0, t0, first, arm, j, now, rate, work, twork,
-                       law)
-                first = -one
+                        Ts[d, a] = (c0 * twork[5, d, a] + c1 * twork[6, d, a] + c2 * T[d, a]
+                                    + c3 * twork[0, d, a])
+                _station_rotation(work[5], work[6], y, work[0], u, h, ys)
                 _write(ys, Ts, nt, j, s_out[k], arm, now, law, poses[k], strains[k],
                        stresses[k], E[k])
                 k += 1
-            _steps(y, T, nt, h, t0, first, arm, j, now, rate, work, twork, law)
             i += 1
     for i in range(k, ns):
         _write(y, T, nt, npieces - 1, arm[6], arm, now, law, poses[i], strains[i],
@@ -1396,14 +1504,16 @@ def _chord(x, J_c, steps, base, arm, case, scratch, scale, threshold, max_iterat
 @_jit
 def _scratch(npieces, nact, ncols):
     """Work arrays of one integration (state with the nact tendon lengths, ncols tangent
-    columns, RK4 stages, loads at λ, a station's own state and tangents, and the
+    columns, RK4 stages (rows 0-3 the stage derivatives, 4 the stage state, 5-6 the output
+    pass's step start: state and derivative), loads at λ, a station's own state and
+    tangents, and the
     constitutive law's: the 6 × (6 + ncols) elimination matrix, per actuator (t, |w|, y, z,
     y', z'), small vectors)."""
     width = 18 + nact
     law = (np.empty((6, 6 + ncols)), np.zeros((max(nact, 1), 8)), np.zeros((6, 6)),
            np.zeros((6, 6)))
-    return (np.empty(width), np.empty((ncols, NT + nact)), np.empty((6, width)),
-            np.empty((5, ncols, NT + nact)), np.empty((npieces, PIECE_LOADS + nact)),
+    return (np.empty(width), np.empty((ncols, NT + nact)), np.empty((7, width)),
+            np.empty((7, ncols, NT + nact)), np.empty((npieces, PIECE_LOADS + nact)),
             np.empty(TIP_LOADS), np.empty(width), np.empty((ncols, NT + nact)), law)
 
 
