@@ -123,7 +123,11 @@ def closed_form_verdict(solver, loads, eq) -> Stability | None:
     _, shape, count, _, channels = solver._prepare(loads)
     if channels.actuators:
         return None
-    xs = np.concatenate([eq.forces_spatial[..., 0, :], eq.moments_spatial[..., 0, :]], -1)
+    # the base reaction: the internal wrench at s = 0 in spatial components, R(0) (n; m)
+    R0, base = eq.poses[..., 0, :3, :3], eq.stresses[..., 0, :]
+    xs = np.empty((*np.broadcast_shapes(R0.shape[:-2], base.shape[:-1]), 6))
+    xs[..., :3] = (R0 @ base[..., :3, None])[..., 0]
+    xs[..., 3:] = (R0 @ base[..., 3:, None])[..., 0]
     xs = np.ascontiguousarray(np.broadcast_to(xs, (*shape, 6)).reshape(count, 6))
     tips = None
     if eq.s[-1] == solver.length:
