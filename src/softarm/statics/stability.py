@@ -6,6 +6,8 @@ The numerical work is in :mod:`softarm.statics._kernels` (``stability_cases``,
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..equilibrium import Stability
@@ -69,13 +71,20 @@ def _closed_form_steps(channels, data) -> np.ndarray:
     scales 1/√(F/EI) and EI/(F L), EI/M; 8 + 2 (kL + F L²/EI + M L/EI) steps keep h k and
     the turning per step below about 1/2, in [12, 256]."""
     k = _k()
+    EI = min(data.K[:, 4, 4].min(), data.K[:, 5, 5].min())
+    L = data.length
+    if channels.count == 1:  # one case: scalar arithmetic (numpy's per-call cost dominates)
+        t = channels.tip_loads[0].tolist()
+        force = math.sqrt(sum((abs(t[k.TD + i]) + abs(t[k.TF + i])) ** 2 for i in range(3)))
+        moment = math.sqrt(sum((abs(t[k.TD + 3 + i]) + abs(t[k.TF + 3 + i])) ** 2
+                               for i in range(3)))
+        n = 8 + 2 * (math.sqrt(force * L * L / EI) + force * L * L / EI + moment * L / EI)
+        return np.array([min(max(math.ceil(n), 12.0), 256.0)])
     tip = np.abs(channels.tip_loads)
     force = tip[:, k.TD:k.TD + 3] + tip[:, k.TF:k.TF + 3]
     moment = tip[:, k.TD + 3:k.TD + 6] + tip[:, k.TF + 3:k.TF + 6]
     force = np.sqrt((force * force).sum(-1))  # (not np.linalg.norm: 4× its cost here)
     moment = np.sqrt((moment * moment).sum(-1))
-    EI = min(data.K[:, 4, 4].min(), data.K[:, 5, 5].min())
-    L = data.length
     n = 8 + 2 * (np.sqrt(force * L * L / EI) + force * L * L / EI + moment * L / EI)
     return np.minimum(np.maximum(np.ceil(n), 12.0), 256.0)  # (np.clip: 3× the cost)
 
@@ -125,10 +134,13 @@ def closed_form_verdict(solver, loads, eq) -> Stability | None:
         return None
     # the base reaction: the internal wrench at s = 0 in spatial components, R(0) (n; m)
     R0, base = eq.poses[..., 0, :3, :3], eq.stresses[..., 0, :]
-    xs = np.empty((*np.broadcast_shapes(R0.shape[:-2], base.shape[:-1]), 6))
-    xs[..., :3] = (R0 @ base[..., :3, None])[..., 0]
-    xs[..., 3:] = (R0 @ base[..., 3:, None])[..., 0]
-    xs = np.ascontiguousarray(np.broadcast_to(xs, (*shape, 6)).reshape(count, 6))
+    if R0.ndim == 2 and base.ndim == 1:  # one case
+        xs = np.concatenate([R0 @ base[:3], R0 @ base[3:]])[None]
+    else:
+        xs = np.empty((*np.broadcast_shapes(R0.shape[:-2], base.shape[:-1]), 6))
+        xs[..., :3] = (R0 @ base[..., :3, None])[..., 0]
+        xs[..., 3:] = (R0 @ base[..., 3:, None])[..., 0]
+        xs = np.ascontiguousarray(np.broadcast_to(xs, (*shape, 6)).reshape(count, 6))
     tips = None
     if eq.s[-1] == solver.length:
         tips = np.broadcast_to(eq.poses[..., -1, :, :], (*shape, 4, 4)).reshape(count, 4, 4)
