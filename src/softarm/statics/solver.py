@@ -684,16 +684,25 @@ class Solver:
         )
 
     def _input_channels(self, loads, pieces, width):
-        """:func:`_input_channels`, remembered for the last few load structures (the channels
-        per unit input depend on the cut and on each load's fixed fields, not on the input
-        values: a control loop re-solves with the same structure)."""
-        key = (pieces[0].tobytes(), tuple(_structure(load) for load in loads))
-        cache = self.__dict__.setdefault("_inputs_cache", {})
-        if key not in cache:
-            if len(cache) >= 8:
-                cache.pop(next(iter(cache)))
-            cache[key] = _input_channels(loads, pieces, self._data, width)
-        return cache[key]
+        """:func:`_input_channels`, remembered per arm for the last few load structures (the
+        channels per unit input depend on the cut and on each load's fixed fields, not on
+        the input values: a control loop re-solves with the same structure, and
+        ``softarm.solve``, a new Solver each call, shares the arm's memory)."""
+        if not any(load.inputs for load in loads):  # no actuation input: nothing to build
+            k = _kernels()
+            return (np.zeros((0, pieces[0].size, width)), np.zeros((0, k.TIP_LOADS)))
+        key = (pieces[0].tobytes(), width, tuple(_structure(load) for load in loads))
+        cache = self._data.__dict__.setdefault("_inputs_cache", {})
+        found = cache.get(key)
+        if found is None:  # (Solvers in other threads may share the arm's cache: no
+            found = _input_channels(loads, pieces, self._data, width)  # read-then-pop)
+            while len(cache) >= 8:
+                try:
+                    cache.pop(next(iter(cache)), None)
+                except (StopIteration, RuntimeError):
+                    break
+            cache[key] = found
+        return found
 
     def solve_near(self, loads, x, steps: int) -> Equilibrium:
         """The equilibrium of the single case ``loads`` continued from the base reaction
