@@ -349,8 +349,7 @@ class Shooter:
             raise ValueError(f"inputs must have shape {self.inputs.shape} (every actuation "
                              f"input of the loads, in load order), got {q.shape}")
         lam = float(load_factor)
-        piece = self._piece0 + (q @ self._unit_flat).reshape(self._piece0.shape)
-        tip = self._tip0 + q @ self._unit_tip
+        piece, tip = self._at(q)
         k = _kernels()
         case = (lam * piece, lam * self._unit_piece, lam * tip, lam * self._unit_tip)
         key = steps if steps is None or isinstance(steps, (int, tuple)) else None
@@ -365,12 +364,15 @@ class Shooter:
     def solve_near(self, loads, x, steps: int, inputs) -> Equilibrium:
         """:meth:`Solver.solve_near` for ``loads``, the prepared loads with ``inputs``
         (given for the result's ``loads``; not validated again), without preparing them."""
-        q = np.asarray(inputs, dtype=np.float64)
         _, shape, count, pieces, channels = self._prepared
-        piece = self._piece0 + (q @ self._unit_flat).reshape(self._piece0.shape)
         prepared = (as_loads(loads), shape, count, pieces,
-                    channels.single(piece, self._tip0 + q @ self._unit_tip))
+                    channels.single(*self._at(np.asarray(inputs, dtype=np.float64))))
         return self._solver._solve_near(loads, x, steps, prepared)
+
+    def _at(self, q):
+        """The piece and tip channels (one case) at inputs q."""
+        return (self._piece0 + (q @ self._unit_flat).reshape(self._piece0.shape),
+                self._tip0 + q @ self._unit_tip)
 
 
 def _shoot(k, x, lam, counts, base, arm, case, actuators) -> ShootResult:
@@ -688,9 +690,8 @@ class Solver:
         channels per unit input depend on the cut and on each load's fixed fields, not on
         the input values: a control loop re-solves with the same structure, and
         ``softarm.solve``, a new Solver each call, shares the arm's memory)."""
-        if not any(load.inputs for load in loads):  # no actuation input: nothing to build
-            k = _kernels()
-            return (np.zeros((0, pieces[0].size, width)), np.zeros((0, k.TIP_LOADS)))
+        if not any(load.inputs for load in loads):  # nothing to build, nothing to remember
+            return _input_channels(loads, pieces, self._data, width)
         key = (pieces[0].tobytes(), width, tuple(_structure(load) for load in loads))
         cache = self._data.__dict__.setdefault("_inputs_cache", {})
         found = cache.get(key)
@@ -908,6 +909,8 @@ def _input_channels(loads, pieces, data, width) -> tuple[np.ndarray, np.ndarray]
     The channels are linear in the inputs, so each is the channels of all loads zeroed but
     that one component at 1 (all loads applied, so that the actuator columns line up)."""
     k = _kernels()
+    if not any(load.inputs for load in loads):
+        return np.zeros((0, pieces[0].size, width)), np.zeros((0, k.TIP_LOADS))
     zeroed = [load.take((0,) * len(load.batch_shape)).scaled(0.0) for load in loads]
     piece, tip = [], []
     for i, load in enumerate(loads):
@@ -923,8 +926,6 @@ def _input_channels(loads, pieces, data, width) -> tuple[np.ndarray, np.ndarray]
                     item.apply(channels)
                 piece.append(channels.piece[0])
                 tip.append(channels.tip_loads[0])
-    if not piece:
-        return np.zeros((0, pieces[0].size, width)), np.zeros((0, k.TIP_LOADS))
     return np.ascontiguousarray(piece), np.ascontiguousarray(tip)
 
 

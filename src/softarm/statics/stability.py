@@ -78,15 +78,20 @@ def _closed_form_steps(channels, data) -> np.ndarray:
         force = math.sqrt(sum((abs(t[k.TD + i]) + abs(t[k.TF + i])) ** 2 for i in range(3)))
         moment = math.sqrt(sum((abs(t[k.TD + 3 + i]) + abs(t[k.TF + 3 + i])) ** 2
                                for i in range(3)))
-        n = 8 + 2 * (math.sqrt(force * L * L / EI) + force * L * L / EI + moment * L / EI)
-        return np.array([min(max(math.ceil(n), 12.0), 256.0)])
+        return np.array([min(max(math.ceil(_sweep_steps(force, moment, L, EI)), 12.0),
+                                 256.0)])
     tip = np.abs(channels.tip_loads)
     force = tip[:, k.TD:k.TD + 3] + tip[:, k.TF:k.TF + 3]
     moment = tip[:, k.TD + 3:k.TD + 6] + tip[:, k.TF + 3:k.TF + 6]
     force = np.sqrt((force * force).sum(-1))  # (not np.linalg.norm: 4× its cost here)
     moment = np.sqrt((moment * moment).sum(-1))
-    n = 8 + 2 * (np.sqrt(force * L * L / EI) + force * L * L / EI + moment * L / EI)
+    n = _sweep_steps(force, moment, L, EI)
     return np.minimum(np.maximum(np.ceil(n), 12.0), 256.0)  # (np.clip: 3× the cost)
+
+
+def _sweep_steps(force, moment, L, EI):
+    """8 + 2 (kL + F L²/EI + M L/EI), k = √(F/EI): floats or arrays alike."""
+    return 8 + 2 * ((force * L * L / EI) ** 0.5 + force * L * L / EI + moment * L / EI)
 
 
 def _axial_index(eq, data, loads):
