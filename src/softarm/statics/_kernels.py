@@ -389,8 +389,8 @@ def _deriv(work, twork, nt, stage, s, arm, j, now, rate, law):
     ``work[stage]`` and the tangent derivatives into ``twork[stage]``. Scalars throughout
     where it matters: no array views in the passive arm's path, no allocation.
 
-    Design note: this function and :func:`_rk4` are inlined into their callers by numba
-    (``inline="always"``). Left to LLVM, they stay out of line once the actuated path is in
+    Design note: this function is inlined into :func:`_steps` by numba
+    (``inline="always"``). Left to LLVM, it stays out of line once the actuated path is in
     the body, and every RK4 step and output station then pays calls that pass the arm's
     arrays by value: a passive solve measured 1.5-2× slower than 0.1's kernel that way,
     and at parity inlined. The actuated path's own work is in :func:`_law`.
@@ -637,49 +637,6 @@ def _dipole(y, T, which, m0, m1, m2, now, rate, out):
 
 
 @_inline
-def _rk4(y, T, nt, h, s, arm, j, now, rate, work, twork, law, known, first_only):
-    """One RK4 step of length h from arc length s on piece j in place (the state and the
-    first nt tangent columns of T), then R ← R (3I - RᵀR)/2: one Björck step towards the
-    nearest rotation. ``known``: the first stage's derivatives (``work[0]``, ``twork[0]``)
-    are already those at (y, T, s), left by the output pass: not evaluated again.
-    ``first_only``: only those derivatives, y and T unchanged.
-
-    Loops are written out (no slice assignment, no array expression): numba compiles those
-    with shape checks whose error messages pull in its string machinery.
-    """
-    for stage in range(4):  # work rows 0-3: the stage derivatives; row 4: the stage state
-        if stage == 0 and known:
-            continue
-        a = 0.0 if stage == 0 else (h if stage == 3 else 0.5 * h)
-        prev = max(stage - 1, 0)
-        for i in range(y.size):
-            work[4, i] = y[i] + a * work[prev, i] if stage else y[i]
-        for d in range(nt):
-            for i in range(NT):
-                twork[4, d, i] = T[d, i] + a * twork[prev, d, i] if stage else T[d, i]
-        if T.shape[1] > NT:  # the tendons' lengths' tangents (actuated arms only)
-            for d in range(nt):
-                for i in range(NT, T.shape[1]):
-                    twork[4, d, i] = T[d, i] + a * twork[prev, d, i] if stage else T[d, i]
-        _deriv(work, twork, nt, stage, s + a, arm, j, now, rate, law)
-        if first_only:
-            return
-    w = h / 6.0
-    for i in range(y.size):
-        y[i] += w * (work[0, i] + 2.0 * work[1, i] + 2.0 * work[2, i] + work[3, i])
-    for d in range(nt):
-        for i in range(NT):
-            T[d, i] += w * (twork[0, d, i] + 2.0 * twork[1, d, i] + 2.0 * twork[2, d, i]
-                            + twork[3, d, i])
-    if T.shape[1] > NT:
-        for d in range(nt):
-            for i in range(NT, T.shape[1]):
-                T[d, i] += w * (twork[0, d, i] + 2.0 * twork[1, d, i] + 2.0 * twork[2, d, i]
-                                + twork[3, d, i])
-    _bjorck(y)
-
-
-@_inline
 def _station_rotation(y0, f0, y1, f1, u, h, out):
     """The rotation of a station at u ∈ [0, 1] of a step of length h, from the states y0, y1
     and derivatives f0, f1 at its ends: R = R0 exp(θ~), θ(u) the cubic Hermite polynomial of
@@ -766,20 +723,57 @@ def _bjorck(y):
 @_jit
 def _steps(y, T, nt, h, s, n, arm, j, now, rate, work, twork, law):
     """``n`` RK4 steps of length h (negative: towards the base) from arc length s on piece j,
-    in place. ``n`` < 0: |n| steps, the first one's first stage derivatives already in
-    ``work[0]`` and ``twork[0]`` (``_rk4``'s ``known``); ``n`` = 0: those derivatives at
-    (y, T, s) only, y and T unchanged (encodings, not more arguments, so that every caller
-    shares one compiled version, with one inlined copy of the step).
+    in place (the state and the first nt tangent columns of T), each followed by
+    R ← R (3I - RᵀR)/2: one Björck step towards the nearest rotation. ``n`` < 0: |n| steps,
+    the first one's first-stage derivatives already in ``work[0]`` and ``twork[0]`` (left
+    there by the output pass: not evaluated again); ``n`` = 0: those derivatives at (y, T, s)
+    only, y and T unchanged (encodings, not more arguments, so that every caller shares one
+    compiled version, with one inlined copy of the right-hand side).
 
-    Design note: this is the one function the inlined step (:func:`_rk4` with :func:`_deriv`)
-    is compiled into. Every integration (the shooting pass, the output pass, the stability
-    sweep) calls it for a run of steps, so numba and LLVM build and optimise the right-hand
-    side once instead of once per caller (cold compile 110 s -> see statics/README.md), and a
-    call costs once per run of steps, not once per stage.
+    Design note: this is the one function the right-hand side (:func:`_deriv`) is compiled
+    into. Every integration (the shooting pass, the output pass, the stability sweep) calls
+    it for a run of steps, so numba and LLVM build and optimise the right-hand side once
+    instead of once per caller (cold compile: see statics/README.md), and a call costs once
+    per run of steps, not once per stage. The RK4 step is written here, not in a function of
+    its own: each level of numba inlining deep-copies the inlined IR twice, and the step's
+    own level cost about 5 s of cold compile.
+
+    Loops are written out (no slice assignment, no array expression): numba compiles those
+    with shape checks whose error messages pull in its string machinery.
     """
-    for i in range(max(abs(n), 1)):
-        _rk4(y, T, nt, h, s + i * h, arm, j, now, rate, work, twork, law, n < 0 and i == 0,
-             n == 0)
+    lengths = T.shape[1] > NT  # the tendons' lengths' tangents (actuated arms only)
+    for step in range(max(abs(n), 1)):
+        at = s + step * h
+        for stage in range(4):  # work rows 0-3: the stage derivatives; row 4: the stage state
+            if stage == 0 and n < 0 and step == 0:
+                continue
+            a = 0.0 if stage == 0 else (h if stage == 3 else 0.5 * h)
+            prev = max(stage - 1, 0)
+            for i in range(y.size):
+                work[4, i] = y[i] + a * work[prev, i] if stage else y[i]
+            for d in range(nt):
+                for i in range(NT):
+                    twork[4, d, i] = T[d, i] + a * twork[prev, d, i] if stage else T[d, i]
+            if lengths:
+                for d in range(nt):
+                    for i in range(NT, T.shape[1]):
+                        twork[4, d, i] = T[d, i] + a * twork[prev, d, i] if stage else T[d, i]
+            _deriv(work, twork, nt, stage, at + a, arm, j, now, rate, law)
+            if n == 0:
+                return
+        w = h / 6.0
+        for i in range(y.size):
+            y[i] += w * (work[0, i] + 2.0 * work[1, i] + 2.0 * work[2, i] + work[3, i])
+        for d in range(nt):
+            for i in range(NT):
+                T[d, i] += w * (twork[0, d, i] + 2.0 * twork[1, d, i] + 2.0 * twork[2, d, i]
+                                + twork[3, d, i])
+        if lengths:
+            for d in range(nt):
+                for i in range(NT, T.shape[1]):
+                    T[d, i] += w * (twork[0, d, i] + 2.0 * twork[1, d, i]
+                                    + 2.0 * twork[2, d, i] + twork[3, d, i])
+        _bjorck(y)
 
 
 @_jit
@@ -1911,7 +1905,7 @@ def _orthonormalise(T, nt, weights, A):
                 A[i, d] /= norm
 
 
-@_jit
+@_inline
 def _sweep(x, lam, steps, base, arm, case, scratch, nt, r, J, states, fields, theta0, tip):
     """The backward sweep of one equilibrium (base reaction x at load factor λ, ``steps``
     RK4 steps per piece, the solution's own grid): the state integrated forward to the tip
