@@ -160,6 +160,8 @@ def real(value, name: str, unit: str = "") -> float:
     ...
     TypeError: max_step must be a real number, got a bool (True)
     """
+    if type(value) is float and math.isfinite(value):  # the common case, first
+        return value
     in_unit = f" in {unit}" if unit else ""
     if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "fiu":
         value = value[()]
@@ -207,6 +209,8 @@ def length(value, name: str) -> float:
 
 def count(value, name: str, minimum: int = 0) -> int:
     """An integer >= ``minimum`` (Python or numpy integer; not a bool or a float), as int."""
+    if type(value) is int and value >= minimum:  # the common case, first
+        return value
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, (Integral, np.integer)):
         raise TypeError(f"{name} must be an integer, got {_kind(value)} ({_short(value, 40)})")
     if value < minimum:

@@ -511,12 +511,13 @@ class Solver:
         """ValueError naming the load whose size is not representable against the arm."""
         k = self.length
         fs, ms = self._data.scale[0], self._data.scale[3]
+        # a cheap bound first: every channel at its largest, summed (finite loads: no
+        # overflow here)
+        largest = float(max(np.max(np.abs(channels.piece), initial=0.0),
+                            np.max(np.abs(channels.tip_loads), initial=0.0)))
+        if largest * 12.0 * max(k, 1.0) / min(fs, ms) <= _LOAD_LIMIT:
+            return
         with np.errstate(over="ignore", invalid="ignore"):
-            # a cheap bound first: every channel at its largest, summed
-            largest = max(np.max(np.abs(channels.piece), initial=0.0),
-                          np.max(np.abs(channels.tip_loads), initial=0.0))
-            if largest * 12.0 * max(k, 1.0) / min(fs, ms) <= _LOAD_LIMIT:
-                return
             piece = np.abs(channels.piece)
             tip = np.abs(channels.tip_loads)
             sizes = np.concatenate([
