@@ -23,7 +23,9 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import root
 
 import softarm
+from softarm._threads import available_threads
 from softarm.routing import Straight
+from softarm.statics.solver import CASES_PER_THREAD
 
 L = 0.25
 RADIUS = 0.0006
@@ -171,6 +173,12 @@ def main(argv=None):
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     print(f"the same batch, tip only (s=2): {wall:.2f} s wall, {cpu:.2f} s CPU "
           f"({1e3 * wall / args.cases:.3f} ms a case)")
+    t0, c0 = time.perf_counter(), time.process_time()
+    softarm.solve(arm, batch, tol=1e-6, threads=1)
+    wall1, cpu1 = time.perf_counter() - t0, time.process_time() - c0
+    print(f"the same batch, 101 stations, on one thread (threads=1): {wall1:.2f} s wall, "
+          f"{cpu1:.2f} s CPU; the batches above ran on "
+          f"{min(available_threads(), max(1, args.cases // CASES_PER_THREAD))} thread(s)")
 
 
 if __name__ == "__main__":

@@ -435,7 +435,7 @@ def verdicts(rows, closed, closed_serial, batch) -> list[str]:
         f"({closed_serial['n_arms']:.0e} arms) {closed_serial['ratio_poses']:.1f}× and "
         f"{closed_serial['ratio_all']:.1f}×"
     )
-    small, big = batch
+    small, big, serial = batch
     overhead = [b["rss_peak_bytes"] - b["rss_before_bytes"] - b["output_bytes"]
                 for b in (small, big)]
     mem_ok = overhead[1] <= max(1.5 * overhead[0], overhead[0] + 32 * 2**20)
@@ -443,8 +443,9 @@ def verdicts(rows, closed, closed_serial, batch) -> list[str]:
     out.append(
         f"exact solver batch, every case on its own path from the unloaded arm: "
         f"{'met' if t_ok else 'NOT met'}: {big['n_cases']} load cases in one call took "
-        f"{big['wall_s']:.2f} s (CPU {big['cpu_s']:.2f} s; target ≤ 5 s for 10^4"
-        f"{', scaled to this size' if big['n_cases'] != 10**4 else ''})"
+        f"{big['wall_s']:.2f} s on {big['threads']} thread(s) (CPU {big['cpu_s']:.2f} s; "
+        f"target ≤ 5 s for 10^4{', scaled to this size' if big['n_cases'] != 10**4 else ''}); "
+        f"on one thread {serial['wall_s']:.2f} s (CPU {serial['cpu_s']:.2f} s)"
     )
     out.append(
         f"exact solver memory: {'met' if mem_ok else 'NOT met'}: peak-RSS growth beyond the "
@@ -500,7 +501,7 @@ def verdicts(rows, closed, closed_serial, batch) -> list[str]:
 def report(env, comp, rows, ref_notes, pyel_note, closed_runs, batch, verdict,
            quick: bool, elapsed: float) -> str:
     cold = comp["cold_first_call_s"]
-    big = batch[-1]
+    big = batch[1]  # (batch: the small one, the full one, the full one on one thread)
     lines = [
         "# Performance",
         "",
@@ -579,18 +580,20 @@ def report(env, comp, rows, ref_notes, pyel_note, closed_runs, batch, verdict,
         "",
         "The 3D soft arm (gravity + oblique dead tip force), a `(B, 3)` tip-force array in "
         f"one `softarm.solve(..., method='numeric', tol={big['tol']:g}, s={big['n_stations']})`"
-        " call (the kernel warm-starts each case from the previous one); forces in random "
-        "order (`throughput.soft_arm_loads`). Each size in a fresh process (peak RSS is a "
-        "high-water mark).",
+        " call: every case on its own path from the unloaded arm, the batch cut into chunks "
+        "solved in threads over the available cores (at most `$SOFTARM_NUM_THREADS`; the "
+        "same answer to the bit); the last row is the same batch with "
+        "`SOFTARM_NUM_THREADS=1`. Forces in random order (`throughput.soft_arm_loads`). Each "
+        "size in a fresh process (peak RSS is a high-water mark).",
         "",
-        "| cases | wall s | CPU s | per case ms | peak RSS growth MiB | outputs MiB "
+        "| cases | threads | wall s | CPU s | per case ms | peak RSS growth MiB | outputs MiB "
         "| growth − outputs MiB | max error estimate / L | max gap to tol=1e-11 / L |",
-        "|---|---|---|---|---|---|---|---|---|",
+        "|---|---|---|---|---|---|---|---|---|---|",
     ]
     for b in batch:
         growth = b["rss_peak_bytes"] - b["rss_before_bytes"]
         lines.append(
-            f"| {b['n_cases']} | {b['wall_s']:.2f} | {b['cpu_s']:.2f} "
+            f"| {b['n_cases']} | {b['threads']} | {b['wall_s']:.2f} | {b['cpu_s']:.2f} "
             f"| {b['wall_s'] / b['n_cases'] * 1e3:.3f} | {growth / 2**20:.1f} "
             f"| {b['output_bytes'] / 2**20:.1f} | {(growth - b['output_bytes']) / 2**20:.1f} "
             f"| {b['max_error_estimate_over_L']:.1e} | {b['max_gap_to_tight_over_L']:.1e} |"
@@ -650,6 +653,9 @@ def main(argv=None) -> int:
         print(f"  {json.dumps(batch[-1])}", flush=True)
     tip_batch = throughput.batch_solver(n_cases, n_stations=2)  # the tip as the only output
     print(f"  {json.dumps(tip_batch)}", flush=True)
+    serial_batch = throughput.batch_solver(n_cases, threads=1)  # the same work on one thread
+    print(f"  {json.dumps(serial_batch)}", flush=True)
+    batch.append(serial_batch)
 
     verdict = verdicts(rows, closed, closed_serial, batch)
     t_ok = tip_batch["wall_s"] <= 5.0 * tip_batch["n_cases"] / 1e4

@@ -84,6 +84,8 @@ def _reset_peak_rss() -> bool:
 def _batch_child(n_cases: int, tol: float, n_stations: int) -> dict:
     """One warm batched solve in this process: time, CPU time, peak RSS and accuracy."""
     import softarm
+    from softarm._threads import available_threads
+    from softarm.statics.solver import CASES_PER_THREAD
 
     arm = soft_arm()
     loads, forces = soft_arm_loads(n_cases)
@@ -121,11 +123,14 @@ def _batch_child(n_cases: int, tol: float, n_stations: int) -> dict:
         "output_bytes": output_bytes,
         "max_error_estimate_over_L": float(np.max(eq.error_estimate)) / _L,
         "max_gap_to_tight_over_L": max(gaps),
+        "threads": min(available_threads(), max(1, n_cases // CASES_PER_THREAD)),
     }
 
 
-def batch_solver(n_cases: int, tol: float = 1e-6, n_stations: int = 101) -> dict:
-    """Run :func:`_batch_child` in a fresh Python process and return its measurements."""
+def batch_solver(n_cases: int, tol: float = 1e-6, n_stations: int = 101,
+                 threads: int | None = None) -> dict:
+    """Run :func:`_batch_child` in a fresh Python process and return its measurements;
+    ``threads``: its ``$SOFTARM_NUM_THREADS`` (None: as it is here)."""
     cmd = [
         sys.executable,
         str(_HERE),
@@ -136,7 +141,10 @@ def batch_solver(n_cases: int, tol: float = 1e-6, n_stations: int = 101) -> dict
         "--stations",
         str(n_stations),
     ]
-    done = subprocess.run(cmd, capture_output=True, text=True, check=False)
+    env = dict(os.environ)
+    if threads is not None:
+        env["SOFTARM_NUM_THREADS"] = str(threads)
+    done = subprocess.run(cmd, capture_output=True, text=True, check=False, env=env)
     if done.returncode != 0:
         raise RuntimeError(f"batch child failed:\n{done.stdout}\n{done.stderr}")
     return json.loads(done.stdout.strip().splitlines()[-1])

@@ -92,7 +92,9 @@ def solve(arm, loads, *, method="auto", s=None, tol=1e-8, base=None, jacobians=F
         one of two mirror branches (default: the mode's own sign).
     **options
         Passed to :class:`softarm.statics.Solver` (``max_iterations``, ``max_load_step``,
-        ``steps``, ``max_steps``, ``max_shootings``, ``stability``); checked on every route.
+        ``steps``, ``max_steps``, ``max_shootings``, ``stability``, ``threads``: a batch's
+        cases are solved in threads, by default over every core, at most
+        ``$SOFTARM_NUM_THREADS``, the same answer to the bit); checked on every route.
 
     Returns
     -------

@@ -11,11 +11,10 @@ H(s) = exp_SE3(s (u; ω)) · exp_SE3(s (0; τ e1)) (docs/closed-forms.md, C4; eq
 from __future__ import annotations
 
 import math
-import os
-from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
+from .._threads import THREADS_VARIABLE, available_threads, in_threads, thread_setting
 from .._validate import as_vectors, stations
 from ..equilibrium import Equilibrium
 from ..model import Arm, SegmentedArm
@@ -135,10 +134,6 @@ _BLOCK = 8192
 #: 1.3-1.7× faster on two threads).
 _PER_THREAD = 4 * _BLOCK
 
-#: Environment variable capping the threads of :func:`screw_poses` (default: the CPUs this
-#: process may run on).
-THREADS_VARIABLE = "SOFTARM_NUM_THREADS"
-
 _EYE3 = np.eye(3)
 #: Component orders of the cross product: (a × u)_i = a_{i+1} u_{i+2} - a_{i+2} u_{i+1}.
 _NEXT, _LAST = np.array([1, 2, 0]), np.array([2, 0, 1])
@@ -147,49 +142,10 @@ _NEXT, _LAST = np.array([1, 2, 0]), np.array([2, 0, 1])
 def thread_count(elements: int) -> int:
     """Threads for a kernel writing ``elements`` (arm, station) pairs: 1 for small work.
 
-    At most ``$SOFTARM_NUM_THREADS`` (a positive integer) or, unset, the CPUs available to the
-    process; at least ``_PER_THREAD`` elements per thread.
+    At most :func:`softarm._threads.available_threads` (``$SOFTARM_NUM_THREADS`` or the CPUs
+    available to the process); at least ``_PER_THREAD`` elements per thread.
     """
-    limit = thread_setting()
-    if limit is None:
-        limit = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else \
-            (os.cpu_count() or 1)
-    return max(1, min(limit, elements // _PER_THREAD))
-
-
-def thread_setting() -> int | None:
-    """``$SOFTARM_NUM_THREADS`` as a positive integer, None if unset, else ValueError (checked
-    on every closed form that takes it, one load or a batch alike)."""
-    setting = os.environ.get(THREADS_VARIABLE, "").strip()
-    if not setting:
-        return None
-    try:
-        limit = int(setting)
-    except ValueError:
-        limit = 0
-    if limit < 1:
-        raise ValueError(
-            f"environment variable {THREADS_VARIABLE} must be a positive integer (the "
-            f"most threads the closed forms may use), got {setting!r}"
-        )
-    return limit
-
-
-def _in_threads(work, size: int, threads: int) -> None:
-    """``work(first, last)`` over ``range(size)`` split into ``threads`` contiguous ranges.
-
-    The ranges run concurrently (numpy releases the GIL in its loops); each element is
-    computed the same way whatever the split, so the result does not depend on ``threads``.
-    """
-    if threads == 1:
-        work(0, size)
-        return
-    edges = [size * i // threads for i in range(threads + 1)]
-    with ThreadPoolExecutor(threads - 1) as pool:
-        others = [pool.submit(work, edges[i], edges[i + 1]) for i in range(1, threads)]
-        work(edges[0], edges[1])
-        for other in others:
-            other.result()
+    return max(1, min(available_threads(), elements // _PER_THREAD))
 
 
 def _broadcast(array: np.ndarray, shape: tuple) -> np.ndarray:
@@ -332,7 +288,7 @@ def screw_poses(u, omega, s, twist=None, fields=None):
                 np.multiply(b[:, 2:4, None], b[:, None, 4:6], out=b[:, 6:10].reshape(m, 2, 2, n))
             np.matmul(b.transpose(0, 2, 1), K[:m], out=flat[start:stop])
 
-    _in_threads(fill, size, thread_count(size * n))
+    in_threads(fill, size, thread_count(size * n))
     buffer.setflags(write=False)
     poses = buffer[..., :16].reshape(*batch, n, 4, 4)
     return poses, (None if fields is None else buffer[..., 16:])

@@ -65,6 +65,9 @@ _jit = partial(jit, what="the shooting solver's kernels")
 #: 17 % faster but the cold compile 12 s longer). Measured cold compile of a first solve with
 #: its stability verdict (benchmarks/run.py's figure): 110 s -> 62 s on this 2-core machine.
 _inline = partial(jit, what="the shooting solver's kernels", inline="always")
+#: The batch entry points: they release the GIL, so that a batch runs in threads (chunks of
+#: independent cases: Solver's ``threads``)
+_batch = partial(jit, what="the shooting solver's kernels", nogil=True)
 
 
 # Status codes returned per load case.
@@ -1533,7 +1536,7 @@ def _output(x, nt, steps, base, arm, case, piece_loads, tip_loads, inputs, scrat
             J_out)
 
 
-@_jit
+@_batch
 def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
     """Solve every load case of a flattened batch.
 
@@ -2041,7 +2044,7 @@ def _conservative(piece, tip):
     return True
 
 
-@_jit
+@_batch
 def stability_cases(base, arm, loads, xs, Ns, tips, factor, index, theta0, conservative):
     """The Morse index of every solved case of a batch (loads at λ = 1 from zero, the
     solution x, as :func:`solve_cases` returns them), swept on ``factor`` × Ns[b] steps

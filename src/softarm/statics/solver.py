@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._threads import available_threads, in_threads
 from .._validate import check_allocation, count, real, rigid_transform, stations
 from ..equilibrium import Equilibrium
 from ..errors import ConvergenceError
@@ -33,6 +34,8 @@ _IDENTITY.setflags(write=False)
 #: The largest load accepted, in units of the bending scale (EI/L², EI/L): beyond it the rod
 #: is a string whose shape double precision cannot follow.
 _LOAD_LIMIT = 1e12
+#: Fewest load cases per thread of a batch: below it a thread costs more than it saves.
+CASES_PER_THREAD = 16
 
 
 def _kernels():
@@ -431,6 +434,12 @@ class Solver:
     stability : bool
         Compute the stability verdict of every case (``Equilibrium.stability``; a backward
         sweep of the linearised equations, docs/stability.md). Default True.
+    threads : int, optional
+        Threads for a batch solved from the unloaded arm (:meth:`solve_from_unloaded`, what
+        :func:`softarm.solve` calls) and for the stability verdicts, in chunks of at least
+        16 cases; the answer is the same to the bit. Default: ``$SOFTARM_NUM_THREADS`` or
+        every core this process may run on (``softarm._threads``). A chained :meth:`solve`
+        runs its batch in order, in one thread.
 
     Examples
     --------
@@ -444,7 +453,7 @@ class Solver:
 
     def __init__(self, arm, *, s=None, tol=1e-8, base=None, max_iterations=12,
                  max_load_step=1.0, steps=None, max_steps=_N_MAX, max_shootings=10000,
-                 stability=True):
+                 stability=True, threads=None):
         self.arm = _check_arm(arm)
         self._data = _arm_data(arm)
         self.length = self._data.length
@@ -473,8 +482,14 @@ class Solver:
         if not isinstance(stability, (bool, np.bool_)):
             raise TypeError(f"stability must be True or False, got {stability!r}")
         self.stability = bool(stability)
+        self.threads = None if threads is None else count(threads, "threads", 1)
         self._coarse_ratio = 4  # the path runs on N / 4 steps (benchmarks/run.py measures it)
         self.reset()
+
+    def _threads(self, count: int) -> int:
+        """Threads for a batch of ``count`` independent cases."""
+        threads = self.threads if self.threads is not None else available_threads()
+        return min(threads, max(1, count // CASES_PER_THREAD))
 
     def reset(self) -> None:
         """Return the quasi-static state to the unloaded arm."""
@@ -635,11 +650,16 @@ class Solver:
         motion = np.zeros((count, S, 6, 6 + n_in) if jacobians else (1, S, 6, 6))
         base_wrench = np.empty((count, 6))
         lengths = np.empty((count, len(channels.actuators)))
-        k.solve_cases(self._base_kernel, channels.arm_tuple(),
-                      (channels.piece, channels.tip_loads), (first_piece, first_tip),
-                      self._options(chained, jacobians), s_kernel, memory, inputs,
-                      (poses, strains, stresses, info, status, jac, motion, base_wrench,
-                       lengths))
+        arm, options = channels.arm_tuple(), self._options(chained, jacobians)
+        outs = (poses, strains, stresses, info, status, jac, motion, base_wrench, lengths)
+
+        def run(a, b):  # cases [a, b): per-case arrays cut, the rest (placeholders) whole
+            k.solve_cases(self._base_kernel, arm, (channels.piece[a:b], channels.tip_loads[a:b]),
+                          (first_piece, first_tip), options, s_kernel, memory, inputs,
+                          tuple(x[a:b] if x.shape[0] == count else x for x in outs))
+
+        # (a chained batch is one path, case after case; unchained cases are independent)
+        in_threads(run, count, 1 if chained or near else self._threads(count))
         actuation = _actuation(channels, base_wrench, lengths, shape) if outputs else None
         failed = np.flatnonzero(status != k.OK)
         if failed.size:
@@ -664,7 +684,8 @@ class Solver:
             # from the tip (the last station when it is s = L) on the coarse grid N
             tips = poses[:, -1] if self.s[-1] == self.length else None
             actuation["stability"] = verdict(channels, self._base_kernel, base_wrench,
-                                             info[:, 4], shape, tips)
+                                             info[:, 4], shape, tips,
+                                             threads=self._threads(count))
         # fresh arrays, frozen before reshaping: Equilibrium takes them without a copy
         for array in (poses, strains, stresses, info):
             array.setflags(write=False)

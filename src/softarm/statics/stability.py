@@ -10,6 +10,7 @@ import math
 
 import numpy as np
 
+from .._threads import in_threads
 from ..equilibrium import Stability
 from ..loads import TipLoad, as_loads
 
@@ -43,10 +44,11 @@ def conservative(piece: np.ndarray, tip: np.ndarray) -> np.ndarray:
     return (follower == 0.0) & (couple == 0.0)
 
 
-def verdict(channels, base, xs, Ns, shape, tips=None, factor=1) -> Stability:
+def verdict(channels, base, xs, Ns, shape, tips=None, factor=1, threads=1) -> Stability:
     """The stability of every case solved by ``solve_cases`` (loads from zero to the
     channels' values, solution xs), swept on factor × Ns steps; ``tips`` (B, 4, 4): the
-    solution's tip poses (the forward pass to the tip is then skipped)."""
+    solution's tip poses (the forward pass to the tip is then skipped); in up to ``threads``
+    threads (:func:`softarm._threads.in_threads`)."""
     k = _k()
     count = xs.shape[0]
     index = np.zeros(count, dtype=np.int64)
@@ -56,8 +58,14 @@ def verdict(channels, base, xs, Ns, shape, tips=None, factor=1) -> Stability:
     tips = np.zeros((0, 4, 4)) if tips is None else np.array(tips, dtype=np.float64)
     xs = np.array(xs, dtype=np.float64)
     flags = np.empty(count, dtype=np.bool_)
-    k.stability_cases(base, channels.arm_tuple(), (channels.piece, channels.tip_loads), xs,
-                      np.array(Ns, dtype=np.float64), tips, int(factor), index, theta0, flags)
+    arm, Ns, factor = channels.arm_tuple(), np.array(Ns, dtype=np.float64), int(factor)
+
+    def run(a, b):  # cases [a, b)
+        k.stability_cases(base, arm, (channels.piece[a:b], channels.tip_loads[a:b]), xs[a:b],
+                          Ns[a:b], tips[a:b] if tips.shape[0] else tips, factor, index[a:b],
+                          theta0[a:b], flags[a:b])
+
+    in_threads(run, count, threads)
     return make(index, flags, shape)
 
 
@@ -150,4 +158,4 @@ def closed_form_verdict(solver, loads, eq) -> Stability | None:
     if eq.s[-1] == solver.length:
         tips = np.broadcast_to(eq.poses[..., -1, :, :], (*shape, 4, 4)).reshape(count, 4, 4)
     return verdict(channels, solver._base_kernel, xs, _closed_form_steps(channels, data),
-                   shape, tips)
+                   shape, tips, threads=solver._threads(count))
