@@ -50,11 +50,20 @@ def _vector(obj, name: str) -> np.ndarray:
     return array
 
 
+def _common_shape(shapes) -> tuple[int, ...]:
+    """np.broadcast_shapes, with the common case first: all shapes equal (one load case, or
+    one batch shape throughout) needs no broadcasting (np.broadcast_shapes: ~5 µs a call)."""
+    first = shapes[0] if shapes else ()
+    if all(shape == first for shape in shapes):
+        return first
+    return np.broadcast_shapes(*shapes)
+
+
 def _broadcast(obj, *names: str) -> tuple[int, ...]:
     """The batch shape of the named (..., 3) fields, ValueError if they do not broadcast."""
     shapes = [getattr(obj, name).shape[:-1] for name in names]
     try:
-        return np.broadcast_shapes(*shapes)
+        return _common_shape(shapes)
     except ValueError:
         kind = type(obj).__name__
         fields_ = " and ".join(f"{kind}.{name}" for name in names)
@@ -909,10 +918,8 @@ def as_loads(loads) -> tuple[Load, ...]:
 def batch_shape(loads) -> tuple[int, ...]:
     """The broadcast batch shape of all loads, ValueError if they do not broadcast."""
     shapes = [load.batch_shape for load in as_loads(loads)]
-    if all(shape == () for shape in shapes):  # one case (np.broadcast_shapes: ~5 µs)
-        return ()
     try:
-        return np.broadcast_shapes(*shapes)
+        return _common_shape(shapes)
     except ValueError as error:
         raise ValueError(f"loads have batch shapes {shapes} that do not broadcast") from error
 

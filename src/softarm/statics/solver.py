@@ -114,6 +114,7 @@ class _ArmData:
         _normal_positive([self.force_scale, bending / self.length],
                          "the arm's bending scale EI/L² and EI/L")
         self.scale = np.array([self.force_scale] * 3 + [bending / self.length] * 3)
+        self.least_bending = float(np.min(self.K[:, [4, 5], [4, 5]]))  # the smallest EI
         self.diag = bool(np.all(self.C[:, ~np.eye(6, dtype=bool)] == 0.0))
         # hard magnets: the magnetisation per length of each segment, and the dipole at each
         # segment's distal end (material components)
@@ -488,8 +489,10 @@ class Solver:
 
     def _threads(self, count: int) -> int:
         """Threads for a batch of ``count`` independent cases."""
+        if count < 2 * CASES_PER_THREAD:  # (before asking the system for its cores)
+            return 1
         threads = self.threads if self.threads is not None else available_threads()
-        return min(threads, max(1, count // CASES_PER_THREAD))
+        return min(threads, count // CASES_PER_THREAD)
 
     def reset(self) -> None:
         """Return the quasi-static state to the unloaded arm."""
@@ -508,9 +511,10 @@ class Solver:
         check_allocation(math.prod(shape), self.s.size, "loads")
         return loads, shape
 
-    def _prepare(self, loads, extra_cuts=()):
-        """(loads, batch shape, count, the kernel's arm tuple, load channels)."""
-        loads, shape = self.check_loads(loads)
+    def _prepare(self, loads, extra_cuts=(), *, checked=False):
+        """(loads, batch shape, count, the kernel's arm tuple, load channels); ``checked``:
+        ``loads`` is what :meth:`check_loads` returned (not checked again)."""
+        loads, shape = (loads, batch_shape(loads)) if checked else self.check_loads(loads)
         count = math.prod(shape)
         data = self._data
         cuts = tuple(sorted({float(c) for load in loads for c in load.cuts(self.arm)}

@@ -79,8 +79,7 @@ def _closed_form_steps(channels, data) -> np.ndarray:
     scales 1/√(F/EI) and EI/(F L), EI/M; 8 + 2 (kL + F L²/EI + M L/EI) steps keep h k and
     the turning per step below about 1/2, in [12, 256]."""
     k = _k()
-    EI = min(data.K[:, 4, 4].min(), data.K[:, 5, 5].min())
-    L = data.length
+    EI, L = data.least_bending, data.length
     if channels.count == 1:  # one case: scalar arithmetic (numpy's per-call cost dominates)
         t = channels.tip_loads[0].tolist()
         force = math.sqrt(sum((abs(t[k.TD + i]) + abs(t[k.TF + i])) ** 2 for i in range(3)))
@@ -127,7 +126,8 @@ def _axial_index(eq, data, loads):
 
 
 def closed_form_verdict(solver, loads, eq) -> Stability | None:
-    """The stability of a closed-form equilibrium ``eq`` of ``loads`` on ``solver``'s arm.
+    """The stability of a closed-form equilibrium ``eq`` of ``loads`` (as
+    ``solver.check_loads`` returns them) on ``solver``'s arm.
 
     The straight arm under a dead axial force has its index in closed form; every other
     closed form gets the backward sweep from its base reaction (the internal wrench at
@@ -142,7 +142,7 @@ def closed_form_verdict(solver, loads, eq) -> Stability | None:
         index = _axial_index(eq, data, as_loads(loads))
         if index is not None:
             return make(index, np.ones(index.shape, dtype=bool), index.shape)
-    _, shape, count, _, channels = solver._prepare(loads)
+    _, shape, count, _, channels = solver._prepare(loads, checked=True)
     if channels.actuators:
         return None
     # the base reaction: the internal wrench at s = 0 in spatial components, R(0) (n; m)
