@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from scipy.optimize import lsq_linear
 
-from softarm._bounded import box_least_squares
+from softarm._bounded import box_least_squares, regularised_step, solve_square
 
 
 def _problem(rng):
@@ -50,3 +50,42 @@ def test_box_least_squares_with_all_variables_at_bounds():
     A, b = np.eye(2), np.array([2.0, -3.0])
     x = box_least_squares(A, b, np.zeros(2), np.ones(2))
     np.testing.assert_array_equal(x, [1.0, 0.0])
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_regularised_step_matches_scipy_on_the_stacked_system(seed):
+    """inverse statics' step: the stacked system [J s; √μ σ I; √ε σ I] δu ≈ [b; 0; -√ε σ u]
+    built here with numpy and solved by scipy's bvls, against the compiled build and solve."""
+    rng = np.random.default_rng(10 + seed)
+    for _ in range(50):
+        n = int(rng.integers(1, 7))
+        m = int(rng.integers(1, 7))
+        J, b = rng.normal(size=(m, n)), rng.normal(size=m)
+        scales = np.exp(rng.normal(size=n))
+        q = rng.uniform(0.0, 2.0, n)
+        lower, upper = np.zeros(n), np.where(rng.random(n) < 0.5, np.inf, 2.5)
+        mu = 0.0 if rng.random() < 0.5 else 10.0 ** rng.uniform(-4, 0)
+        Js = J * scales
+        sigma = np.sqrt(np.sum(Js**2))
+        rows = np.vstack([Js, np.sqrt(mu) * sigma * np.eye(n), 1e-6 * sigma * np.eye(n)])
+        rhs = np.concatenate([b, np.zeros(n), -1e-6 * sigma * q / scales])
+        reference = lsq_linear(rows, rhs, bounds=(lower / scales - q / scales,
+                                                  upper / scales - q / scales),
+                               method="bvls", tol=1e-14).x * scales
+        step = regularised_step(J, b, q, scales, mu, lower, upper)
+        assert np.all((lower <= q + step + 1e-15) & (q + step <= upper + 1e-15))
+        np.testing.assert_allclose(step, reference, rtol=0.0,
+                                   atol=1e-8 * (1.0 + np.max(np.abs(reference))))
+
+
+def test_solve_square_matches_numpy_and_refuses_a_singular_matrix():
+    rng = np.random.default_rng(3)
+    for n, k in ((1, 1), (3, 2), (6, 4), (9, 1)):
+        A = rng.normal(size=(n, n)) * np.exp(3.0 * rng.normal(size=n))  # columns scaled
+        B = rng.normal(size=(n, k))
+        X = solve_square(A, B)
+        np.testing.assert_allclose(A @ X, B, rtol=0.0, atol=1e-11 * np.abs(A).max()
+                                   * np.abs(X).max() + 1e-13)
+        np.testing.assert_allclose(X, np.linalg.solve(A, B), rtol=1e-8, atol=1e-12)
+    singular = np.array([[1.0, 2.0], [2.0, 4.0]])
+    assert solve_square(singular, np.ones((2, 1))) is None

@@ -296,3 +296,18 @@ def test_pose_targets_are_reached_cold_and_tracked():
     position_only = inverse(arm, six(np.zeros(6)), poses[0, :3, 3], loads=[GRAVITY])
     assert position_only.reached
     assert rotation_error(position_only.equilibrium.tip[None], poses[:1]) > 1e-3
+
+
+def test_the_inner_loops_actuators_equal_validated_ones():
+    """The fast route builds its actuators at new inputs without validating them again
+    (``Load._with_checked``: inputs it keeps finite and in bounds); they must equal the
+    validated ones field by field, and inputs out of bounds still go through validation."""
+    solver = InverseSolver(robot(), tendons((0.5, 0.0, 0.0)), [GRAVITY], bounds=(0.0, 4.0))
+    q = np.array([1.5, 0.25, 2.0])
+    for fast, checked in zip(solver._actuators_at(q), solver.actuators_at(q), strict=True):
+        assert type(fast) is type(checked)
+        assert np.array_equal(fast.tension, checked.tension)
+        assert fast.tension.dtype == np.float64 and not fast.tension.flags.writeable
+        assert fast.routing == checked.routing and fast.end == checked.end
+    with pytest.raises(ValueError, match=r"Tendon\.tension must be >= 0"):
+        solver._actuators_at(np.array([-1.0, 0.0, 0.0]))

@@ -140,3 +140,78 @@ def box_least_squares(A, b, lower, upper, iterations):
     for j in range(n):
         x[j] = min(max(x[j], lower[j]), upper[j])
     return x, converged
+
+
+@_jit
+def regularised_step(J, b, q, scales, mu, lower, upper, iterations):
+    """The bounded Gauss–Newton step of inverse statics, in scaled inputs u = q / s:
+    argmin |J' δu - b|² + μ σ² |δu|² + ε σ² |u + δu|² within the bounds, J' = J s (columns
+    scaled), σ = |J'|_F, ε = 1e-12 (root 1e-6); returns δq = s δu. The stacked system built
+    here, one call instead of a dozen numpy ones per step."""
+    m, n = J.shape
+    sigma = 0.0
+    for i in range(m):
+        for j in range(n):
+            sigma += (J[i, j] * scales[j]) ** 2
+    sigma = max(math.sqrt(sigma), 1e-300)
+    root_eps = 1e-6
+    A = np.zeros((m + 2 * n, n))
+    rhs = np.zeros(m + 2 * n)
+    lo = np.empty(n)
+    hi = np.empty(n)
+    for i in range(m):
+        rhs[i] = b[i]
+        for j in range(n):
+            A[i, j] = J[i, j] * scales[j]
+    for j in range(n):
+        u = q[j] / scales[j]
+        A[m + j, j] = math.sqrt(mu) * sigma
+        A[m + n + j, j] = root_eps * sigma
+        rhs[m + n + j] = -root_eps * sigma * u
+        lo[j] = lower[j] / scales[j] - u
+        hi[j] = upper[j] / scales[j] - u
+    step, _ = box_least_squares(A, rhs, lo, hi, iterations)
+    for j in range(n):
+        step[j] *= scales[j]
+    return step
+
+
+@_jit
+def solve_square(A, B):
+    """X = A⁻¹ B for a small square A (n, n) and B (n, k), by Gaussian elimination with
+    partial pivoting; (X, False) if a pivot is exactly zero or X is not finite (A singular
+    to working precision)."""
+    n, k = B.shape
+    M = np.empty((n, n + k))
+    for i in range(n):
+        for j in range(n):
+            M[i, j] = A[i, j]
+        for j in range(k):
+            M[i, n + j] = B[i, j]
+    for c in range(n):
+        p = c
+        for i in range(c + 1, n):
+            if abs(M[i, c]) > abs(M[p, c]):
+                p = i
+        if M[p, c] == 0.0:
+            return np.zeros((n, k)), False
+        if p != c:
+            for j in range(n + k):
+                M[c, j], M[p, j] = M[p, j], M[c, j]
+        for i in range(c + 1, n):
+            f = M[i, c] / M[c, c]
+            if f != 0.0:
+                for j in range(c, n + k):
+                    M[i, j] -= f * M[c, j]
+    X = np.empty((n, k))
+    for j in range(k):
+        for i in range(n - 1, -1, -1):
+            acc = M[i, n + j]
+            for t in range(i + 1, n):
+                acc -= M[i, t] * X[t, j]
+            X[i, j] = acc / M[i, i]
+    for i in range(n):
+        for j in range(k):
+            if not math.isfinite(X[i, j]):
+                return X, False
+    return X, True

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._bounded import box_least_squares as _box_least_squares
+from ._bounded import regularised_step, solve_square
 from ._validate import count, real
 from .errors import ConvergenceError
 from .lie import so3
@@ -198,9 +198,15 @@ class InverseSolver:
                 getattr(actuators[i], name), dtype=float)))
             current[c] = value
         out = list(actuators)
+        # the inner loop's own inputs (finite, clipped to the bounds: tensions >= 0) need no
+        # validation; the public actuators_at validates
+        trusted = not given and bool(np.isfinite(q).all()) and bool(
+            np.all((q >= self.lower) & (q <= self.upper)))
         for (i, name), value in fields.items():
             shape = np.shape(getattr(actuators[i], name))
-            out[i] = out[i].replace(**{name: value.reshape(shape)})
+            value = value.reshape(shape)
+            out[i] = (out[i]._with_checked(**{name: value}) if trusted
+                      else out[i].replace(**{name: value}))
         return out
 
     def actuators_at(self, inputs) -> list:
@@ -254,21 +260,8 @@ class InverseSolver:
         side b: in scaled inputs u = q/s, min |J δu - b|² + μ σ² |δu|² + ε σ² |u + δu|²
         (σ = |J|_F) within the bounds; ε (1e-12) picks the least effort along the task's
         null space and moves the task solution by ~1e-12 relative."""
-        J = J * self.scales
-        sigma = max(float(np.sqrt(np.sum(J * J))), 1e-300)  # |J|_F: within √n of |J|₂
-        u = q / self.scales
-        n, m = self.n_inputs, J.shape[0]
-        root_eps = 1e-6  # √ε
-        rows = np.zeros((m + 2 * n, n))
-        rows[:m] = J
-        diagonal = np.arange(n)
-        rows[m + diagonal, diagonal] = np.sqrt(mu) * sigma
-        rows[m + n + diagonal, diagonal] = root_eps * sigma
-        rhs = np.zeros(m + 2 * n)
-        rhs[:m] = b
-        rhs[m + n:] = -root_eps * sigma * u
-        return _box_least_squares(rows, rhs, self.lower / self.scales - u,
-                                  self.upper / self.scales - u) * self.scales
+        # (σ = |J|_F: within √n of |J|₂)
+        return regularised_step(J, b, q, self.scales, mu, self.lower, self.upper)
 
     def _shooting_newton(self, q, target, orientation):
         """The fast route: Newton on the base reaction x and the inputs q together, one
@@ -323,9 +316,8 @@ class InverseSolver:
                 shot = shooter(x, every, steps=("solution", N))
                 Jq = shot.jacobian_inputs[:, first:first + self.n_inputs]
                 Eq = shot.tip_motion_inputs[:, first:first + self.n_inputs]
-                try:
-                    G = np.linalg.solve(shot.jacobian_x, np.column_stack([shot.residual, Jq]))
-                except np.linalg.LinAlgError:
+                G = solve_square(shot.jacobian_x, np.column_stack([shot.residual, Jq]))
+                if G is None:
                     return None
                 A = Eq - shot.tip_motion_x @ G[:, 1:]
                 e, w = self._pose_task(shot.tip_pose, target, orientation)
