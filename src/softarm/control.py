@@ -260,7 +260,6 @@ class InverseSolver:
         side b: in scaled inputs u = q/s, min |J δu - b|² + μ σ² |δu|² + ε σ² |u + δu|²
         (σ = |J|_F) within the bounds; ε (1e-12) picks the least effort along the task's
         null space and moves the task solution by ~1e-12 relative."""
-        # (σ = |J|_F: within √n of |J|₂)
         return regularised_step(J, b, q, self.scales, mu, self.lower, self.upper)
 
     def _shooting_newton(self, q, target, orientation):

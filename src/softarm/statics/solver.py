@@ -487,12 +487,12 @@ class Solver:
         self._coarse_ratio = 4  # the path runs on N / 4 steps (benchmarks/run.py measures it)
         self.reset()
 
-    def _threads(self, count: int) -> int:
-        """Threads for a batch of ``count`` independent cases."""
-        if count < 2 * CASES_PER_THREAD:  # (before asking the system for its cores)
+    def _threads(self, cases: int) -> int:
+        """Threads for a batch of ``cases`` independent cases."""
+        if cases < 2 * CASES_PER_THREAD:  # (before asking the system for its cores)
             return 1
         threads = self.threads if self.threads is not None else available_threads()
-        return min(threads, count // CASES_PER_THREAD)
+        return min(threads, cases // CASES_PER_THREAD)
 
     def reset(self) -> None:
         """Return the quasi-static state to the unloaded arm."""
