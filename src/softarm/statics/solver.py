@@ -192,7 +192,7 @@ class _Channels:
         self.actuators = []  # (kind code, routing, active rows, span) per actuator column
 
     def _rows(self, span):
-        if span is None:
+        if span is None or (span[0] <= 0.0 and span[1] >= self.length):  # the whole arm
             return slice(None)
         middle = self.starts + 0.5 * self.lengths
         return np.flatnonzero((middle > span[0]) & (middle < span[1]))
@@ -869,6 +869,8 @@ def _recut(old_starts, old_piece, new_starts) -> np.ndarray:
     """Piece loads given on the cut ``old_starts`` re-expressed on ``new_starts`` (a cut that
     contains every old cut): distributed channels from the old piece that contains the new
     piece, point wrenches where an old piece started."""
+    if np.array_equal(old_starts, new_starts):  # the same cut (a control loop's usual case)
+        return old_piece.copy()
     k = _kernels()
     out = np.zeros((new_starts.size, old_piece.shape[1]))
     inside = np.clip(np.searchsorted(old_starts, new_starts, side="right") - 1, 0, None)
@@ -898,19 +900,26 @@ def _compliances(jac, motion, shape, tendons):
     without inputs (the last also without tendons)."""
     lengths = jac[:, 6 + tendons, :]
     jac = jac[:, :6]
+    count, S, _, m = motion.shape
+    n = m - 6
     inverse = np.linalg.inv(jac[:, :, :6])
-    station = motion[..., :6] @ inverse[:, None]
-    tip = station[:, -1].copy()
-    S = motion.shape[1]
-    n = jac.shape[2] - 6
-    out = [tip.reshape(*shape, 6, 6), station.reshape(*shape, S, 6, 6)]
+    through_x = inverse @ jac[:, :, 6:]  # J_x⁻¹ J_q, (B, 6, n)
+    # both at once, every station in one product per case: E (S·6 × m) times
+    # [[J_x⁻¹, -J_x⁻¹ J_q], [0, I]] (numpy's matmul over a stack of S small matrices cost
+    # most of this function)
+    M = np.zeros((count, m, m))
+    M[:, :6, :6] = inverse
+    M[:, :6, 6:] = -through_x
+    M[:, 6:, 6:] = np.eye(n)
+    both = (motion.reshape(count, S * 6, m) @ M).reshape(count, S, 6, m)
+    station = np.ascontiguousarray(both[..., :6])
+    out = [station[:, -1].copy().reshape(*shape, 6, 6), station.reshape(*shape, S, 6, 6)]
     if n:
-        through_x = np.einsum("bij,bjk->bik", inverse, jac[:, :, 6:])
-        inputs = motion[..., 6:] - motion[..., :6] @ through_x[:, None]
+        inputs = np.ascontiguousarray(both[..., 6:])
         out += [inputs[:, -1].copy().reshape(*shape, 6, n), inputs.reshape(*shape, S, 6, n)]
         if tendons.size:
-            out.append((lengths[..., 6:] - np.einsum("bij,bjk->bik", lengths[..., :6],
-                                                     through_x)).reshape(*shape, -1, n))
+            out.append((lengths[..., 6:] - lengths[..., :6] @ through_x).reshape(
+                *shape, -1, n))
         else:
             out.append(None)
     else:
