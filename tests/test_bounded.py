@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from scipy.optimize import lsq_linear
 
-from softarm._bounded import box_least_squares, regularised_step, solve_square
+from softarm._bounded import box_least_squares, regularised_step
 
 
 def _problem(rng):
@@ -76,16 +76,3 @@ def test_regularised_step_matches_scipy_on_the_stacked_system(seed):
         assert np.all((lower <= q + step + 1e-15) & (q + step <= upper + 1e-15))
         np.testing.assert_allclose(step, reference, rtol=0.0,
                                    atol=1e-8 * (1.0 + np.max(np.abs(reference))))
-
-
-def test_solve_square_matches_numpy_and_refuses_a_singular_matrix():
-    rng = np.random.default_rng(3)
-    for n, k in ((1, 1), (3, 2), (6, 4), (9, 1)):
-        A = rng.normal(size=(n, n)) * np.exp(3.0 * rng.normal(size=n))  # columns scaled
-        B = rng.normal(size=(n, k))
-        X = solve_square(A, B)
-        np.testing.assert_allclose(A @ X, B, rtol=0.0, atol=1e-11 * np.abs(A).max()
-                                   * np.abs(X).max() + 1e-13)
-        np.testing.assert_allclose(X, np.linalg.solve(A, B), rtol=1e-8, atol=1e-12)
-    singular = np.array([[1.0, 2.0], [2.0, 4.0]])
-    assert solve_square(singular, np.ones((2, 1))) is None

@@ -1,14 +1,13 @@
-"""Bounded least squares, and the small dense solve, of the bounded Newton methods of the
-solver (displacement-controlled tendons, ``softarm.statics``) and of inverse statics
-(``softarm.control``), below both in the layering. Compiled (``_bounded_kernels``, imported
-on first use): a control loop takes a step per iteration, where scipy's bounded least
-squares costs about 90 µs a call and numpy's dense solve about 20 µs."""
+"""Bounded least squares for the bounded Newton methods of the solver (displacement-controlled
+tendons, ``softarm.statics``) and of inverse statics (``softarm.control``), below both in the
+layering. The step is compiled (``_bounded_kernels``, imported on first use): a control loop
+takes one per iteration, where scipy's bounded least squares costs about 90 µs a call."""
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["box_least_squares", "regularised_step", "solve_square"]
+__all__ = ["box_least_squares", "regularised_step"]
 
 
 def _floats(value):
@@ -26,16 +25,6 @@ def box_least_squares(A, b, lower, upper, iterations: int = 100):
 
     x, _ = compiled(_floats(A), _floats(b), _floats(lower), _floats(upper), int(iterations))
     return x
-
-
-def solve_square(A, B):
-    """A⁻¹ B for a small square A (n, n) and B (n, k) (Gaussian elimination with partial
-    pivoting, compiled: numpy's solve costs ~20 µs a call at this size), or None if A is
-    singular to working precision."""
-    from ._bounded_kernels import solve_square as compiled
-
-    X, ok = compiled(_floats(A), _floats(B))
-    return X if ok else None
 
 
 def regularised_step(J, b, q, scales, mu, lower, upper, iterations: int = 100):

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._bounded import regularised_step, solve_square
+from ._bounded import regularised_step
 from ._validate import count, real
 from .errors import ConvergenceError
 from .lie import so3
@@ -315,8 +315,9 @@ class InverseSolver:
                 shot = shooter(x, every, steps=("solution", N))
                 Jq = shot.jacobian_inputs[:, first:first + self.n_inputs]
                 Eq = shot.tip_motion_inputs[:, first:first + self.n_inputs]
-                G = solve_square(shot.jacobian_x, np.column_stack([shot.residual, Jq]))
-                if G is None:
+                try:
+                    G = np.linalg.solve(shot.jacobian_x, np.column_stack([shot.residual, Jq]))
+                except np.linalg.LinAlgError:
                     return None
                 A = Eq - shot.tip_motion_x @ G[:, 1:]
                 e, w = self._pose_task(shot.tip_pose, target, orientation)
