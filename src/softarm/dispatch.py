@@ -151,9 +151,10 @@ def warn_unstable(eq: Equilibrium, stacklevel: int = 3) -> Equilibrium:
     verdict = eq.stability
     if verdict is None:
         return eq
-    unstable = np.asarray(verdict.unstable)
-    if not np.any(unstable):
+    unstable = verdict.unstable
+    if unstable is False or not np.any(unstable):
         return eq
+    unstable = np.asarray(unstable)
     index = np.asarray(verdict.index)
     first = tuple(int(i) for i in np.unravel_index(
         int(np.flatnonzero(unstable.ravel())[0]), index.shape)) if index.shape else ()
@@ -189,8 +190,7 @@ def solve_prepared(solver: Solver, loads, method="auto") -> Equilibrium:
             if solver.stability:
                 from .statics.stability import closed_form_verdict
 
-                result = dataclasses.replace(
-                    result, stability=closed_form_verdict(solver, loads, result))
+                result = result._with_stability(closed_form_verdict(solver, loads, result))
             return warn_unstable(result, 4)
         if method == "analytic":
             raise ValueError(

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass
 
 import numpy as np
@@ -94,6 +95,8 @@ class Stability:
     def unstable(self):
         """Proven unstable: index > 0 (for a nonconservative load only an odd index is a
         proof, a divergence; an even one is reported but proves nothing)."""
+        if isinstance(self.index, int):  # one case: Python scalars
+            return self.index > 0 and (self.conservative or self.index % 2 == 1)
         index = np.asarray(self.index)
         out = (index > 0) & (np.asarray(self.conservative) | (index % 2 == 1))
         return out if out.shape else bool(out)
@@ -210,6 +213,14 @@ class Equilibrium:
                 f"strains {self.strains.shape}, stresses {self.stresses.shape}"
             )
         object.__setattr__(self, "loads", tuple(self.loads))
+
+    def _with_stability(self, stability: Stability | None) -> Equilibrium:
+        """This equilibrium with its stability verdict: a copy sharing the (frozen) arrays,
+        not checked again (``dataclasses.replace`` re-runs every check: a tenth of a
+        closed-form solve)."""
+        new = copy.copy(self)
+        object.__setattr__(new, "stability", stability)
+        return new
 
     @property
     def batch_shape(self) -> tuple[int, ...]:

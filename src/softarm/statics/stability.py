@@ -156,6 +156,7 @@ def closed_form_verdict(solver, loads, eq) -> Stability | None:
         xs = np.ascontiguousarray(np.broadcast_to(xs, (*shape, 6)).reshape(count, 6))
     tips = None
     if eq.s[-1] == solver.length:
-        tips = np.broadcast_to(eq.poses[..., -1, :, :], (*shape, 4, 4)).reshape(count, 4, 4)
+        tips = eq.poses[None, -1] if eq.poses.ndim == 3 else np.broadcast_to(
+            eq.poses[..., -1, :, :], (*shape, 4, 4)).reshape(count, 4, 4)
     return verdict(channels, solver._base_kernel, xs, _closed_form_steps(channels, data),
                    shape, tips, threads=solver._threads(count))
