@@ -23,7 +23,7 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import root
 
 import softarm
-from softarm._threads import available_threads
+from softarm._threads import threads_for
 from softarm.routing import Straight
 from softarm.statics.solver import CASES_PER_THREAD
 
@@ -178,7 +178,7 @@ def main(argv=None):
     wall1, cpu1 = time.perf_counter() - t0, time.process_time() - c0
     print(f"the same batch, 101 stations, on one thread (threads=1): {wall1:.2f} s wall, "
           f"{cpu1:.2f} s CPU; the batches above ran on "
-          f"{min(available_threads(), max(1, args.cases // CASES_PER_THREAD))} thread(s)")
+          f"{threads_for(args.cases, CASES_PER_THREAD)} thread(s)")
 
 
 if __name__ == "__main__":

@@ -84,7 +84,7 @@ def _reset_peak_rss() -> bool:
 def _batch_child(n_cases: int, tol: float, n_stations: int) -> dict:
     """One warm batched solve in this process: time, CPU time, peak RSS and accuracy."""
     import softarm
-    from softarm._threads import available_threads
+    from softarm._threads import threads_for
     from softarm.statics.solver import CASES_PER_THREAD
 
     arm = soft_arm()
@@ -123,7 +123,7 @@ def _batch_child(n_cases: int, tol: float, n_stations: int) -> dict:
         "output_bytes": output_bytes,
         "max_error_estimate_over_L": float(np.max(eq.error_estimate)) / _L,
         "max_gap_to_tight_over_L": max(gaps),
-        "threads": min(available_threads(), max(1, n_cases // CASES_PER_THREAD)),
+        "threads": threads_for(n_cases, CASES_PER_THREAD),
     }
 
 

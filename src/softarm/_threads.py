@@ -14,7 +14,7 @@ from __future__ import annotations
 import os
 from concurrent.futures import ThreadPoolExecutor
 
-__all__ = ["THREADS_VARIABLE", "available_threads", "in_threads", "thread_setting"]
+__all__ = ["THREADS_VARIABLE", "available_threads", "in_threads", "thread_setting", "threads_for"]
 
 #: Environment variable capping the threads of every batch kernel.
 THREADS_VARIABLE = "SOFTARM_NUM_THREADS"
@@ -45,6 +45,12 @@ def available_threads() -> int:
     if hasattr(os, "sched_getaffinity"):
         return len(os.sched_getaffinity(0))
     return os.cpu_count() or 1  # pragma: no cover - not on Linux
+
+
+def threads_for(work: int, per_thread: int, limit: int | None = None) -> int:
+    """Threads for ``work`` units with at least ``per_thread`` each (1 for small work): at
+    most ``limit`` or, None, :func:`available_threads`."""
+    return max(1, min(available_threads() if limit is None else limit, work // per_thread))
 
 
 def in_threads(work, size: int, threads: int) -> None:

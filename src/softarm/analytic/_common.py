@@ -14,7 +14,7 @@ import math
 
 import numpy as np
 
-from .._threads import THREADS_VARIABLE, available_threads, in_threads, thread_setting
+from .._threads import THREADS_VARIABLE, in_threads, thread_setting, threads_for
 from .._validate import as_vectors, stations
 from ..equilibrium import Equilibrium
 from ..model import Arm, SegmentedArm
@@ -145,7 +145,7 @@ def thread_count(elements: int) -> int:
     At most :func:`softarm._threads.available_threads` (``$SOFTARM_NUM_THREADS`` or the CPUs
     available to the process); at least ``_PER_THREAD`` elements per thread.
     """
-    return max(1, min(available_threads(), elements // _PER_THREAD))
+    return threads_for(elements, _PER_THREAD)
 
 
 def _broadcast(array: np.ndarray, shape: tuple) -> np.ndarray:

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._threads import available_threads, in_threads
+from .._threads import in_threads, threads_for
 from .._validate import check_allocation, count, real, rigid_transform, stations
 from ..equilibrium import Equilibrium
 from ..errors import ConvergenceError
@@ -489,10 +489,9 @@ class Solver:
 
     def _threads(self, cases: int) -> int:
         """Threads for a batch of ``cases`` independent cases."""
-        if cases < 2 * CASES_PER_THREAD:  # (before asking the system for its cores)
+        if cases < 2 * CASES_PER_THREAD:  # one thread whatever the setting: no system call
             return 1
-        threads = self.threads if self.threads is not None else available_threads()
-        return min(threads, cases // CASES_PER_THREAD)
+        return threads_for(cases, CASES_PER_THREAD, self.threads)
 
     def reset(self) -> None:
         """Return the quasi-static state to the unloaded arm."""
