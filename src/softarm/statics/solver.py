@@ -337,7 +337,11 @@ class Shooter:
         piece, tip = channels.piece[0], channels.tip_loads[0]
         self.inputs = inputs
         self._unit_piece, self._unit_tip = unit_piece, unit_tip
-        self._unit_flat = unit_piece.reshape(inputs.size, -1)
+        # the kernel reads the first rate row even at λ = 0: loads without inputs get a zero
+        # row, and its column is dropped from the result
+        self._rates = (unit_piece, unit_tip) if inputs.size else (
+            np.zeros((1, *piece.shape)), np.zeros((1, tip.size)))
+        self._unit_flat = unit_piece.reshape(inputs.size, piece.size)  # (n = 0 too)
         # the channels at q = 0
         self._piece0 = piece - (inputs @ self._unit_flat).reshape(piece.shape)
         self._tip0 = tip - inputs @ unit_tip
@@ -355,15 +359,19 @@ class Shooter:
         lam = float(load_factor)
         piece, tip = self._at(q)
         k = _kernels()
-        case = (lam * piece, lam * self._unit_piece, lam * tip, lam * self._unit_tip)
+        case = (lam * piece, lam * self._rates[0], lam * tip, lam * self._rates[1])
         key = steps if steps is None or isinstance(steps, (int, tuple)) else None
         counts = self._counts.get(key) if key is not None else None
         if counts is None:
             counts = self._solver._step_counts(self._piece_lengths, steps)
             if key is not None and len(self._counts) < 64:
                 self._counts[key] = counts
-        return _shoot(k, x, 0.0, counts, self._solver._base_kernel, self._arm, case,
-                      self._actuators)
+        result = _shoot(k, x, 0.0, counts, self._solver._base_kernel, self._arm, case,
+                        self._actuators)
+        if not self.inputs.size:
+            result = dataclasses.replace(result, jacobian_inputs=result.jacobian_inputs[:, :0],
+                                         tip_motion_inputs=result.tip_motion_inputs[:, :0])
+        return result
 
     def solve_near(self, loads, x, steps: int, inputs) -> Equilibrium:
         """:meth:`Solver.solve_near` for ``loads``, the prepared loads with ``inputs``
