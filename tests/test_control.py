@@ -214,6 +214,25 @@ def test_tracking_takes_the_shooting_route_and_agrees_with_forward_solves():
     assert np.max(np.linalg.norm(again - targets[1:], axis=-1)) / L <= 1e-6
 
 
+def test_tracking_a_dense_path_takes_one_integration_a_target():
+    """Along a smooth path the warm step's second-order term is carried over from the last
+    target (InverseSolver._second_order): after the first two targets (no term measured
+    yet), one integration a target (iterations 2: the warm step and one integration) puts
+    the tip within tol, which independent forward solves of the returned tensions confirm.
+    The linear warm step alone leaves 2e-6 L here and needs a second integration."""
+    arm = robot()
+    phase = np.linspace(0.0, 0.6, 101)  # the spacing of 1000 targets around the circle
+    pattern = 1.5 + 1.2 * np.cos(phase[:, None] - 2 * np.pi * np.arange(3) / 3)
+    targets = forward(arm, pattern).tip_position
+    tracker = InverseSolver(arm, tendons(), [GRAVITY])
+    tracker.solve(targets[0])
+    result = tracker.track(targets[1:])
+    assert result.reached.all()
+    assert np.all(result.iterations[2:] == 2), np.bincount(result.iterations)
+    again = forward(arm, result.inputs).tip_position
+    assert np.max(np.linalg.norm(again - targets[1:], axis=-1)) / L <= 1e-6
+
+
 def test_a_prepared_shooter_equals_shooting_the_rebuilt_loads():
     """``Solver.shooter`` recombines channels prepared once (they are affine in the inputs);
     against ``Solver.shoot`` of the loads rebuilt with the same new inputs (each load's own
@@ -251,6 +270,13 @@ def test_a_prepared_shooter_equals_shooting_the_rebuilt_loads():
     assert bool(near.stability.stable) and bool(again.stability.stable)
     with pytest.raises(ValueError, match="inputs must have shape"):
         shooter(x, q1[:3])
+    # loads without inputs: no input columns, the same integration as Solver.shoot
+    bare = solver.shooter([GRAVITY])(x, steps=("solution", N))
+    direct = solver.shoot([GRAVITY], x, steps=("solution", N))
+    assert bare.jacobian_inputs.shape == (6, 0)
+    np.testing.assert_allclose(bare.residual, direct.residual, rtol=0,
+                               atol=1e-12 * np.abs(direct.residual).max())
+    np.testing.assert_allclose(bare.tip_pose, direct.tip_pose, rtol=0, atol=1e-15)
 
 
 def test_pose_targets_are_reached_cold_and_tracked():
