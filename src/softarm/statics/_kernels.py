@@ -110,8 +110,8 @@ TIP_LOADS = 12
 
 # Solver options, one float array (OPTIONS long): see solve_cases.
 (_O_TOL, _O_ITER, _O_LOADSTEP, _O_NFIXED, _O_NMAX, _O_BUDGET, _O_CHAINED,
- _O_JACOBIANS, _O_COARSE) = range(9)
-OPTIONS = 9
+ _O_JACOBIANS, _O_COARSE, _O_NEAR) = range(10)
+OPTIONS = 10
 
 # The memory of a chained (quasi-static) solve, in and out (MEMORY long): x at the coarse
 # step count N (6), x at 2N (6), N, valid (1 if the memory holds a solved case).
@@ -1563,7 +1563,10 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
         chained.
     options : (OPTIONS,) tol (m; inf with a fixed step count), max_iterations, max_load_step,
         fixed step count (0: from tol), largest step count, shootings budget, chained (0/1),
-        jacobians (0/1), the ratio of the step counts of the solution and of the path.
+        jacobians (0/1), the ratio of the step counts of the solution and of the path, near
+        (0/1: case 0's start loads are its own and ``memory`` holds a solution on its fine
+        grid, :meth:`Solver.solve_near`; its coarse solution is corrected from there, the
+        path only if that fails).
     memory : (MEMORY,) the chained start (x at N, x at 2N, N, valid), read and rewritten.
     inputs : (piece (n, P, PIECE_LOADS + A), tip (n, TIP_LOADS)): the load channels per unit
         of each actuation input (n = 0: none); with jacobians the output pass integrates
@@ -1586,6 +1589,7 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
     n_max = int(options[_O_NMAX])
     budget = int(options[_O_BUDGET])
     chained = options[_O_CHAINED] > 0.0
+    near = chained and options[_O_NEAR] > 0.0
     nt_out = 6 if options[_O_JACOBIANS] > 0.0 else 0
     coarse_ratio = int(options[_O_COARSE])
     info, status, jac = out[3], out[4], out[5]
@@ -1648,6 +1652,20 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
         recorded = False
         resume = False
         deferred_failed = False
+        if near and warm and b == 0:
+            # a solution at 2N is known: its coarse partner at N is one correction away (the
+            # distance between them is the discretisation error), no path needed
+            _fill_steps(length, arm[1], N, np.int64(1), steps)
+            for i in range(6):
+                x[i] = memory[_MXF + i]
+            if _corrector(x, 1.0, six, steps, base, arm, case, scratch, scale, dscale, length,
+                          threshold, max_iterations, _REFINE_MAX, final_step, r, J, tip_c,
+                          counter):
+                _copy(J, J_c)
+                path = False
+                for i in range(6):  # the chord at 2N starts from the known solution
+                    x_f[i] = memory[_MXF + i]
+                resume = True
         while True:
             if path:
                 # the path on a coarse grid (N / coarse_ratio steps) unless that failed

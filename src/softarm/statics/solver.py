@@ -561,13 +561,13 @@ class Solver:
                 f"times the bending scale (EI/L² = {fs:.3g} N, EI/L = {ms:.3g} N m), where "
                 "double precision cannot follow the shape")
 
-    def _options(self, chained: bool, jacobians: bool) -> np.ndarray:
+    def _options(self, chained: bool, jacobians: bool, near: bool = False) -> np.ndarray:
         n_fixed = self.steps if self.steps is not None else 0
         n_max = max(self.max_steps, self.steps or 0)
         tol = math.inf if self.steps is not None else self.tol * self.length
         return np.array([tol, self.max_iterations, self.max_load_step, n_fixed, n_max,
                          self.max_shootings, float(chained), float(jacobians),
-                         self._coarse_ratio])
+                         self._coarse_ratio, float(near)])
 
     # ---------------------------------------------------------------- solving
 
@@ -661,7 +661,7 @@ class Solver:
         motion = np.zeros((count, S, 6, 6 + n_in) if jacobians else (1, S, 6, 6))
         base_wrench = np.empty((count, 6))
         lengths = np.empty((count, len(channels.actuators)))
-        arm, options = channels.arm_tuple(), self._options(chained, jacobians)
+        arm, options = channels.arm_tuple(), self._options(chained, jacobians, near)
         outs = (poses, strains, stresses, info, status, jac, motion, base_wrench, lengths)
 
         def run(a, b):  # cases [a, b): per-case arrays cut, the rest (placeholders) whole
