@@ -514,3 +514,29 @@ def test_prepared_solver_follows_through_a_change_of_cut():
     np.testing.assert_allclose(followed.poses, direct.poses, rtol=0, atol=1e-8)
     solver.reset()  # back to the unloaded arm: the same answer again, from there
     np.testing.assert_allclose(solver.solve(second).poses, direct.poses, rtol=0, atol=1e-8)
+
+
+def test_solve_near_returns_the_solution_it_starts_near_or_raises():
+    """``Solver.solve_near`` from a base reaction on the fine grid corrects the coarse
+    solution from it (one Newton correction, no path); when that correction is rejected, the
+    path from its own loads, which raises for a start too far (5 % and 30 % here). Never
+    another answer: from the solution and from starts moved by 1 %, 5 % and 30 %
+    (Mattiasson k = 5, dead tip force), the equilibrium of a plain solve (tip to 1e-7 L,
+    stable, estimate within tol) or a ConvergenceError; the first two must succeed."""
+    arm = softarm.Arm.from_stiffness(1.0, EA=1e8, GAy=1e8, GAz=1e8, GJ=1.0, EIy=1.0,
+                                     EIz=1.0)
+    load = TipLoad(force=[0.0, 0.0, 5.0])
+    solver = Solver(arm, tol=1e-8)
+    reference = solver.solve(load)
+    x, N = solver.last_solution()
+    moved = np.array([1.0, -0.5, 0.3, 0.2, 0.4, -0.3])
+    for change in (0.0, 0.01, 0.05, 0.3):
+        start = x + change * np.abs(x).max() * moved
+        try:
+            near = Solver(arm, tol=1e-8).solve_near(load, start, 2 * N)
+        except softarm.ConvergenceError:
+            assert change > 0.01
+            continue
+        assert np.linalg.norm(near.tip_position - reference.tip_position) <= 1e-7, change
+        assert near.error_estimate <= 1e-8
+        assert bool(near.stability.stable)
