@@ -123,7 +123,9 @@ class InverseSolver:
         # displacement-controlled tendons are solved in their tensions (self._actuators)
         self._actuators, self._displaced = self._in_tensions(arm, s, solver_tol)
         self._shooter = None  # the fast route's prepared shooting (Solver.shooter)
-        self._warm = None  # the fast route's last answer: q, x, tip pose, A, J_x⁻¹ [r | J_q]
+        # the fast route's last answer: q, x, tip pose, A, J_x⁻¹ [r | J_q], the linear warm
+        # step's miss (_second_order), whether the task is redundant there
+        self._warm = None
         self._slots = []  # (actuator index, field, component, is tension)
         values = []
         for i, load in enumerate(self._actuators):
@@ -250,10 +252,17 @@ class InverseSolver:
         rotation = so3.log(orientation @ tip[:3, :3].T)  # spatial δθ to the target
         return np.concatenate([e, rotation]), weights
 
-    def _redundant(self, J) -> bool:
-        """More inputs than the rank of the weighted task Jacobian J (task × inputs)."""
-        tol = 1e-10 * np.max(np.abs(J), initial=1e-300) * self.n_inputs
-        return self.n_inputs > np.linalg.matrix_rank(J, tol=tol)
+    def _singular(self, J) -> np.ndarray:
+        """The singular values of the weighted task Jacobian J (task × inputs) in scaled
+        inputs (J diag(s)), largest first."""
+        return np.linalg.svd(J * self.scales, compute_uv=False)
+
+    def _redundant(self, J, singular=None) -> bool:
+        """More inputs than the rank of the weighted task Jacobian J in scaled inputs
+        (singular values below 1e-10 n σ_max count as zero); ``singular``: J's, if known."""
+        singular = self._singular(J) if singular is None else singular
+        rank = int(np.count_nonzero(singular > 1e-10 * self.n_inputs * singular[0]))
+        return self.n_inputs > rank
 
     def _step(self, J, b, q, mu):
         """The bounded Gauss–Newton step δq for the weighted task Jacobian J and right-hand
@@ -318,7 +327,7 @@ class InverseSolver:
         every = shooter.inputs.copy()  # every input of the loads, the actuators' at slots
         task = slice(0, 3 if orientation is None else 6)
         warm, self._warm = self._warm, None
-        if warm is not None and not (np.array_equal(warm[0], q) and np.array_equal(warm[1], x)):
+        if warm is not None and not (bool((warm[0] == q).all()) and bool((warm[1] == x).all())):
             warm = None  # the Solver or the inputs moved since
         redundant = None
         merit = np.inf
@@ -329,7 +338,7 @@ class InverseSolver:
             if iterations > self.max_iterations:
                 return None
             if warm is not None:  # at the last answer: r = 0, its tip, the last A and G
-                _, _, tip, A, G, miss = warm
+                _, _, tip, A, G, miss, redundant = warm  # (its J is the last answer's)
                 warm, shot = None, None
                 e, w = self._pose_task(tip, target, orientation)
                 rhs = e
@@ -387,14 +396,15 @@ class InverseSolver:
         if size > self.tol:
             return None
         self.q = q
+        singular = self._singular(J)
         last = self.solver.last_solution()
         if last is not None:
             miss = None
             if linear is not None:  # what the linear warm step missed (see _second_order)
                 x0, q0, q_linear, G0, e0 = linear
                 miss = (q - q_linear, last[0] - (x0 - G0[:, 1:] @ (q - q0)), e0)
-            self._warm = (q.copy(), last[0], eq.tip, A, G, miss)
-        singular = np.linalg.svd(J * self.scales, compute_uv=False)
+            self._warm = (q.copy(), last[0], eq.tip, A, G, miss,
+                          self._redundant(J, singular))
         condition = float(singular[0] / singular[-1]) if singular[-1] > 0 else np.inf
         at_bound = (q <= self.lower) | (q >= self.upper)
         return InverseResult(q.copy(), eq, True, float(size), iterations, at_bound, condition)
@@ -456,7 +466,7 @@ class InverseSolver:
                 self.solver.reset()
                 eq, A = self._forward(q)  # back to the accepted point (the solver moved)
         self.q = q
-        singular = np.linalg.svd((w[:, None] * A[:e.size]) * self.scales, compute_uv=False)
+        singular = self._singular(w[:, None] * A[:e.size])
         condition = float(singular[0] / singular[-1]) if singular[-1] > 0 else np.inf
         at_bound = (q <= self.lower) | (q >= self.upper)
         inputs, eq = self._displacement_answer(q, eq)

@@ -22,6 +22,7 @@ from ..equilibrium import Equilibrium
 from ..errors import ConvergenceError
 from ..loads import as_loads, batch_shape
 from ..model import Arm, SegmentedArm
+from .stability import verdict
 
 __all__ = ["METHOD", "ShootResult", "Shooter", "Solver", "check_base", "check_tol", "solve_numeric"]
 
@@ -190,6 +191,7 @@ class _Channels:
         self._piece = self.piece.reshape(*shape, P, k.PIECE_LOADS)
         self._tip = self.tip_loads.reshape(*shape, k.TIP_LOADS)
         self.actuators = []  # (kind code, routing, active rows, span) per actuator column
+        self._memo = {}  # what depends on the actuators only (tendons())
 
     def _rows(self, span):
         if span is None or (span[0] <= 0.0 and span[1] >= self.length):  # the whole arm
@@ -283,6 +285,18 @@ class _Channels:
         out._piece, out._tip = piece, tip
         return out
 
+    def tendons(self) -> tuple[np.ndarray, np.ndarray]:
+        """The actuator columns that are tendons and their lengths in the unloaded arm (m),
+        computed once for these actuators (and shared with the :meth:`single` copies)."""
+        found = self._memo.get("tendons")
+        if found is None or found[0] != len(self.actuators):
+            columns = np.array([a for a, actuator in enumerate(self.actuators)
+                                if actuator[0] == self.k.TENDON], dtype=np.int64)
+            unloaded = np.array([_unloaded_length(self.pieces, self.actuators[a])
+                                 for a in columns])
+            found = self._memo["tendons"] = (len(self.actuators), columns, unloaded)
+        return found[1], found[2]
+
     def signature(self) -> tuple:
         """What identifies the actuators (kinds, paths, where they act): a chained solve
         continues from the last case only if this is unchanged."""
@@ -359,7 +373,8 @@ class Shooter:
         lam = float(load_factor)
         piece, tip = self._at(q)
         k = _kernels()
-        case = (lam * piece, lam * self._rates[0], lam * tip, lam * self._rates[1])
+        case = (piece, self._rates[0], tip, self._rates[1]) if lam == 1.0 else (
+            lam * piece, lam * self._rates[0], lam * tip, lam * self._rates[1])
         key = steps if steps is None or isinstance(steps, (int, tuple)) else None
         counts = self._counts.get(key) if key is not None else None
         if counts is None:
@@ -658,7 +673,7 @@ class Solver:
         # rows 6 + a: actuator a's length per column (a tendon's; 0 for a chamber)
         jac = np.zeros((count, 6 + len(channels.actuators), 6 + n_in) if jacobians
                        else (0, 6, 6))
-        motion = np.zeros((count, S, 6, 6 + n_in) if jacobians else (1, S, 6, 6))
+        motion = np.zeros((count, S, 6, 6 + n_in)) if jacobians else self._no_motion(S)
         base_wrench = np.empty((count, 6))
         lengths = np.empty((count, len(channels.actuators)))
         arm, options = channels.arm_tuple(), self._options(chained, jacobians, near)
@@ -690,8 +705,6 @@ class Solver:
                              station_actuation_jacobian=station_inputs,
                              tendon_length_jacobian=lengths_inputs)
         if self.stability:
-            from .stability import verdict
-
             # from the tip (the last station when it is s = L) on the coarse grid N
             tips = poses[:, -1] if self.s[-1] == self.length else None
             actuation["stability"] = verdict(channels, self._base_kernel, base_wrench,
@@ -717,6 +730,14 @@ class Solver:
             compliance=compliance,
             **actuation,
         )
+
+    def _no_motion(self, stations: int) -> np.ndarray:
+        """The kernel's station-motion argument without Jacobians: a (1, S, 6, 6)
+        placeholder it never writes, made once per station count."""
+        found = self.__dict__.get("_placeholder")
+        if found is None or found.shape[1] != stations:
+            found = self._placeholder = np.zeros((1, stations, 6, 6))
+        return found
 
     def _input_channels(self, loads, pieces, width):
         """:func:`_input_channels`, remembered per arm for the last few load structures (the
@@ -819,15 +840,13 @@ def _actuation(channels, base_wrench, lengths, shape) -> dict:
     """The Equilibrium's actuation fields: the total base wrench and, per tendon (in the
     order given), its tension, length and length change from the unloaded arm."""
     k = channels.k
-    tendons = [a for a, actuator in enumerate(channels.actuators) if actuator[0] == k.TENDON]
     base_wrench.setflags(write=False)
     out = {"base_wrench": base_wrench.reshape(*shape, 6)}
-    if not tendons:
+    tendons, unloaded = channels.tendons()
+    if not tendons.size:
         return out
-    pieces = channels.pieces
-    unloaded = np.array([_unloaded_length(pieces, channels.actuators[a]) for a in tendons])
-    length = lengths[:, tendons]
-    tension = channels.piece[:, :, k.ACT + np.array(tendons)].max(axis=1)
+    length = lengths if tendons.size == lengths.shape[1] else lengths[:, tendons]
+    tension = channels.piece[:, :, k.ACT + tendons].max(axis=1)
     for array in (length, tension):
         array.setflags(write=False)
     change = length - unloaded
