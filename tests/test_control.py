@@ -101,6 +101,13 @@ def test_tracking_a_circle_follows_every_target():
     np.testing.assert_allclose(forward(arm, result.inputs).tip_position, targets, rtol=0,
                                atol=1e-6 * L)
     assert result.equilibrium.tip_position.shape == (12, 3)
+    # the batched equilibrium: its loads carry every target's tensions, its verdict is one
+    # batched Stability (each target's own: the robot is stable along the circle)
+    batched = [load for load in result.equilibrium.loads if isinstance(load, softarm.Tendon)]
+    np.testing.assert_array_equal(np.stack([t.tension for t in batched], -1), result.inputs)
+    np.testing.assert_array_equal(result.equilibrium.stability.index, np.zeros(12))
+    assert result.equilibrium.stability.stable.shape == (12,)
+    assert result.equilibrium.stability.stable.all()
 
 
 def test_bad_input_is_named():
@@ -337,3 +344,59 @@ def test_the_inner_loops_actuators_equal_validated_ones():
         assert fast.routing == checked.routing and fast.end == checked.end
     with pytest.raises(ValueError, match=r"Tendon\.tension must be >= 0"):
         solver._actuators_at(np.array([-1.0, 0.0, 0.0]))
+
+
+def test_an_unstable_answer_is_not_returned_silently():
+    """A column under 1.5 times Euler's load, whose straight tip is the target: the answer
+    (the tendon slack) is the straight column, unstable with Morse index 2 (both bending
+    planes, buckling.json's Euler column), and inverse, InverseSolver.solve and track each
+    say so once with a StabilityWarning."""
+    arm = softarm.Arm.from_stiffness(1.0, EA=1e6, GAy=1e6, GAz=1e6, GJ=1.0, EIy=1.0, EIz=1.0)
+    P = 1.5 * np.pi ** 2 / 4
+    fixed = [softarm.TipLoad(force=[-P, 0.0, 0.0])]
+    tendon = [softarm.Tendon(0.0, Straight(0.0, 0.01))]
+    target = np.array([1.0 - P / 1e6, 0.0, 0.0])
+    with pytest.warns(softarm.StabilityWarning, match="Morse index 2"):
+        answer = inverse(arm, tendon, target, loads=fixed)
+    assert answer.reached and answer.inputs[0] <= 1e-12
+    assert (answer.equilibrium.stability.index, answer.equilibrium.stability.stable) == (2, False)
+    tracker = InverseSolver(arm, tendon, fixed)
+    with pytest.warns(softarm.StabilityWarning, match="Morse index 2") as caught:
+        tracker.solve(target)
+    assert len(caught) == 1
+    with pytest.warns(softarm.StabilityWarning, match=r"load case \(0,\), and 1 more") as caught:
+        result = tracker.track(np.array([target, target]))
+    assert len(caught) == 1
+    np.testing.assert_array_equal(result.equilibrium.stability.index, [2, 2])
+
+
+def test_the_inverse_command_says_in_one_line_when_the_answer_is_unstable(tmp_path, capsys):
+    # the column above: `softarm inverse` answers (exit 0) and says on stderr, in one line,
+    # that the equilibrium is unstable
+    from softarm.cli import main
+
+    P = 1.5 * np.pi ** 2 / 4
+    case = tmp_path / "column.toml"
+    case.write_text(f"""
+[arm]
+length = 1.0
+stiffness = {{ EA = 1.0e6, GAy = 1.0e6, GAz = 1.0e6, GJ = 1.0, EIy = 1.0, EIz = 1.0 }}
+
+[[load]]
+kind = "tip"
+force = [{-P!r}, 0.0, 0.0]
+
+[[load]]
+kind = "tendon"
+tension = 0.0
+routing = {{ kind = "straight", y = 0.0, z = 0.01 }}
+
+[inverse]
+target = [{1.0 - P / 1e6!r}, 0.0, 0.0]
+""")
+    assert main(["inverse", str(case)]) == 0
+    captured = capsys.readouterr()
+    assert "reached   yes" in captured.out
+    lines = captured.err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(
+        "softarm: warning: the equilibrium returned is unstable: Morse index 2"), lines

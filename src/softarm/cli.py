@@ -430,14 +430,20 @@ def _solve(case: Case, args) -> tuple:
     finally:
         notice.cancel()
         progress.close()
-    for warning in caught:  # one line each on stderr; anything else as Python shows it
+    _report(caught)
+    return result, time.perf_counter() - start
+
+
+def _report(caught) -> None:
+    """Warnings caught around a solve: a StabilityWarning as one line on stderr, anything
+    else as Python shows it."""
+    for warning in caught:
         if issubclass(warning.category, StabilityWarning):
             print(_line(f"softarm: warning: {str(warning.message).removeprefix('softarm: ')}"),
                   file=sys.stderr)
         else:
             warnings.showwarning(warning.message, warning.category, warning.filename,
                                  warning.lineno)
-    return result, time.perf_counter() - start
 
 
 def _run_critical(args) -> int:
@@ -536,8 +542,11 @@ def _run_inverse(args) -> int:
     except (ValueError, TypeError) as error:
         raise CaseError(f"{args.case}: inverse: {error}") from None
     start = time.perf_counter()
-    answer = solver.solve(target)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", StabilityWarning)
+        answer = solver.solve(target)
     seconds = time.perf_counter() - start
+    _report(caught)
     solved = [*others, *solver.actuators_at(answer.inputs)]
     names = [f"{load.kind} {k + 1} {name}" for k, load in enumerate(actuators)
              for name in load.inputs for _ in range(_input_size(load, name))]

@@ -26,6 +26,8 @@ import numpy as np
 
 from ._bounded import regularised_step
 from ._validate import count, real
+from .dispatch import warn_unstable
+from .equilibrium import Equilibrium, Stability
 from .errors import ConvergenceError
 from .lie import so3
 from .loads import as_loads
@@ -209,6 +211,19 @@ class InverseSolver:
             value = value.reshape(shape)
             out[i] = (out[i]._with_checked(**{name: value}) if trusted
                       else out[i].replace(**{name: value}))
+        return out
+
+    def _stacked_actuators(self, inputs) -> list:
+        """The actuators (as given) with one case per row of ``inputs`` (N, n): loads of
+        batch shape (N,), the loads of :meth:`track`'s batched equilibrium."""
+        columns: dict[tuple[int, str], list[int]] = {}
+        for k, (i, name, _, _) in enumerate(self._slots):
+            name = "displacement" if i in self._displaced else name
+            columns.setdefault((i, name), []).append(k)
+        out = list(self.actuators)
+        for (i, name), cols in columns.items():
+            shape = np.shape(getattr(self.actuators[i], name))
+            out[i] = out[i].replace(**{name: inputs[:, cols].reshape(len(inputs), *shape)})
         return out
 
     def actuators_at(self, inputs) -> list:
@@ -412,7 +427,14 @@ class InverseSolver:
     def solve(self, target, orientation=None) -> InverseResult:
         """The inputs that bring the tip to ``target`` (m, spatial, shape (3,)) or, with
         ``orientation`` (3 × 3 rotation), to that pose, starting from the current inputs and
-        the last equilibrium (quasi-static)."""
+        the last equilibrium (quasi-static). A :class:`~softarm.StabilityWarning` if the
+        equilibrium reached is unstable."""
+        result = self._solve(target, orientation)
+        warn_unstable(result.equilibrium, 3)
+        return result
+
+    def _solve(self, target, orientation) -> InverseResult:
+        """:meth:`solve` without the warning (:meth:`track` warns once for its path)."""
         target = np.asarray(target, dtype=float)
         if target.shape != (3,) or not np.all(np.isfinite(target)):
             raise ValueError(f"target must be a position (3 finite numbers, m), got {target!r}")
@@ -476,19 +498,17 @@ class InverseSolver:
     def track(self, targets, orientations=None) -> InverseResult:
         """Solve a sequence of targets, (N, 3) positions or (N, 4, 4) poses, each from the
         last answer: batched fields (``inputs`` (N, n), ``reached`` (N,), ...) and the
-        equilibria batched along N."""
+        equilibria batched along N (their loads: the actuators with inputs of batch shape
+        (N,)). One :class:`~softarm.StabilityWarning` if any equilibrium reached is
+        unstable, naming the first."""
         targets = np.asarray(targets, dtype=float)
         if targets.ndim == 3 and targets.shape[1:] == (4, 4):
             orientations, targets = targets[:, :3, :3], targets[:, :3, 3]
         if targets.ndim != 2 or targets.shape[1] != 3:
             raise ValueError(f"targets must have shape (N, 3) or (N, 4, 4), got "
                              f"{targets.shape}")
-        results = [self.solve(t, None if orientations is None else orientations[k])
+        results = [self._solve(t, None if orientations is None else orientations[k])
                    for k, t in enumerate(targets)]
-        import dataclasses
-
-        from .equilibrium import Equilibrium
-
         first = results[0].equilibrium
 
         def stack(name):
@@ -498,13 +518,20 @@ class InverseSolver:
 
         fields = {f.name: stack(f.name) for f in dataclasses.fields(Equilibrium)
                   if f.name not in ("s", "arm", "loads", "method", "exact", "residual",
-                                    "error_estimate")}
+                                    "error_estimate", "stability")}
+        verdicts = [r.equilibrium.stability for r in results]
+        stability = None if any(v is None for v in verdicts) else Stability.of(
+            np.array([v.index for v in verdicts]), np.array([v.conservative for v in verdicts]),
+            (len(results),))
+        inputs = np.array([r.inputs for r in results])
         equilibrium = dataclasses.replace(
-            first, **fields, loads=tuple(first.loads),
+            first, **fields, loads=(*self.loads, *self._stacked_actuators(inputs)),
+            stability=stability,
             residual=np.array([r.equilibrium.residual for r in results]),
             error_estimate=np.array([r.equilibrium.error_estimate for r in results]))
+        warn_unstable(equilibrium, 3)
         return InverseResult(
-            np.array([r.inputs for r in results]), equilibrium,
+            inputs, equilibrium,
             np.array([r.reached for r in results]), np.array([r.error for r in results]),
             np.array([r.iterations for r in results]),
             np.array([r.at_bound for r in results]), np.array([r.condition for r in results]))
@@ -556,4 +583,6 @@ def inverse(arm, actuators, target, *, loads=(), bounds=None, orientation=None, 
                                    scales=scales, tol=tol, max_iterations=max_iterations)
         else:
             solver.q = np.clip(x0, solver.lower, solver.upper)
-    return solver.solve(target, orientation)
+    result = solver._solve(target, orientation)
+    warn_unstable(result.equilibrium, 3)
+    return result
