@@ -223,7 +223,7 @@ def test_tracking_takes_the_shooting_route_and_agrees_with_forward_solves():
 
 def test_tracking_a_dense_path_takes_one_integration_a_target():
     """Along a smooth path the warm step's second-order term is carried over from the last
-    target (InverseSolver._second_order): after the first two targets (no term measured
+    target (InverseSolver._shooting_newton): after the first two targets (no term measured
     yet), one integration a target (iterations 2: the warm step and one integration) puts
     the tip within tol, which independent forward solves of the returned tensions confirm.
     The linear warm step alone leaves 2e-6 L here and needs a second integration."""
@@ -400,3 +400,25 @@ target = [{1.0 - P / 1e6!r}, 0.0, 0.0]
     lines = captured.err.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith(
         "softarm: warning: the equilibrium returned is unstable: Morse index 2"), lines
+
+
+def test_the_compiled_rotation_log_equals_the_lie_module():
+    """The fast route's orientation error is computed in the kernel (``_rotation_log``):
+    against ``softarm.lie.so3.log`` on random rotations and at the edges of its three
+    branches (θ below 1e-4, θ about 3, θ within 1e-9 of π), to 1e-12 rad."""
+    from softarm.lie import so3
+    from softarm.statics.solver import _kernels
+
+    k = _kernels()
+    rng = np.random.default_rng(3)
+    axes = rng.normal(size=(40, 3))
+    axes /= np.linalg.norm(axes, axis=1, keepdims=True)
+    angles = np.concatenate([rng.uniform(0.0, np.pi, 25), [0.0, 1e-9, 5e-5, 2e-4, 2.9999,
+                                                          3.0001, 3.1, np.pi - 1e-6,
+                                                          np.pi - 1e-9, 3.14159, 1.0, 2.0,
+                                                          0.5, 1e-3, 0.1]])
+    out = np.empty(3)
+    for axis, angle in zip(axes, angles, strict=True):
+        R = so3.exp(angle * axis)
+        k._rotation_log(np.ascontiguousarray(R), out)
+        np.testing.assert_allclose(out, so3.log(R), rtol=0, atol=1e-12)

@@ -32,8 +32,11 @@ from .errors import ConvergenceError
 from .lie import so3
 from .loads import as_loads
 from .statics import Solver
+from .statics.solver import _kernels
 
 __all__ = ["InverseResult", "InverseSolver", "inverse"]
+
+_EYE3 = np.eye(3)
 
 
 @dataclass(frozen=True)
@@ -125,8 +128,8 @@ class InverseSolver:
         # displacement-controlled tendons are solved in their tensions (self._actuators)
         self._actuators, self._displaced = self._in_tensions(arm, s, solver_tol)
         self._shooter = None  # the fast route's prepared shooting (Solver.shooter)
-        # the fast route's last answer: q, x, tip pose, A, J_x⁻¹ [r | J_q], the linear warm
-        # step's miss (_second_order), whether the task is redundant there
+        # the fast route's last answer: q, x, tip state (p, R row-major), A, J_x⁻¹ [r | J_q],
+        # the linear warm step's miss (_shooting_newton), whether the task is redundant there
         self._warm = None
         self._slots = []  # (actuator index, field, component, is tension)
         values = []
@@ -286,37 +289,15 @@ class InverseSolver:
         null space and moves the task solution by ~1e-12 relative."""
         return regularised_step(J, b, q, self.scales, mu, self.lower, self.upper)
 
-    def _second_order(self, linear, e, miss):
-        """The warm step's inputs ``linear`` (its linear prediction for the task step ``e``)
-        with the second-order term carried over from the last target, and the factor f of
-        that term (0: none).
-
-        Along a smooth path the answer moves as q(Δ) = q + A⁺ Δ + ½ q''[Δ, Δ] + O(|Δ|³)
-        (likewise the base reaction x); the linear step leaves out the middle term. For the
-        last target's task step Δ₀ it was measured (``miss``: the answer minus the linear
-        prediction, in q and in x beyond what the change of q explains). For Δ = α Δ₀ + Δ⊥
-        (α = Δ·Δ₀/|Δ₀|²) the term is α² times that one plus terms in Δ⊥, so the prediction
-        adds f = α² times the last miss (for f <= 4). What it gets wrong (a turn of the
-        path, a slack tendon) the next integration corrects, as it corrects the linear step.
-        Tracking a circle of 1000 targets this takes the task error at the first
-        integration from 2.3e-6 to 4e-8 L: one integration a target instead of two."""
-        if miss is None or miss[2].size != e.size:
-            return linear, 0.0
-        norm = float(miss[2] @ miss[2])
-        factor = (float(e @ miss[2]) / norm) ** 2 if norm > 0.0 else 0.0
-        if not 0.0 < factor <= 4.0:
-            return linear, 0.0
-        return np.minimum(np.maximum(linear + factor * miss[0], self.lower), self.upper), factor
-
     def _shooting_newton(self, q, target, orientation):
         """The fast route: Newton on the base reaction x and the inputs q together, one
-        integration per iteration (``Solver.shooter``: the shooting primitive with the input
-        columns, prepared once, on the grid of the last solution), from the Solver's last
-        equilibrium; then one solve at the answer (``solve_near``: refined to tol, with its
-        stability verdict) that must confirm the task error. None (the caller takes the
-        full-solve route) when there is no last equilibrium, displacement-controlled
-        tendons are among the actuators, or the iteration does not converge or the
-        confirmation fails.
+        integration per iteration (the shooting primitive with the input columns, prepared
+        once by ``Solver.shooter``, on the grid of the last solution), from the Solver's last
+        equilibrium, compiled whole (the kernel's ``inverse_newton``); then one solve at the
+        answer (``solve_near``: refined to tol, with its stability verdict) that must
+        confirm the task error. None (the caller takes the full-solve route) when there is
+        no last equilibrium, displacement-controlled tendons are among the actuators, or the
+        iteration does not converge or the confirmation fails.
 
         Linearised, r + J_x δx + J_q δq = 0 gives δx = -J_x⁻¹ (r + J_q δq), and the task
         error e = w (target - p(L)) changes by -w (E_x δx + E_q δq): the step solves
@@ -325,13 +306,21 @@ class InverseSolver:
 
         Tracking: when the last answer came from this route, the first step needs no
         integration. The last equilibrium has r = 0 and a known tip, and A and J_x⁻¹ J_q
-        from the last integration before it (one small step away) give the step.
+        from the last integration before it (one small step away) give the step. Along a
+        smooth path the answer moves as q(Δ) = q + A⁺ Δ + ½ q''[Δ, Δ] + O(|Δ|³) (likewise
+        x); the linear step leaves out the middle term. For the last target's task step Δ₀
+        it was measured (``miss``: the answer minus the linear prediction, in q and in x
+        beyond what the change of q explains); for Δ = α Δ₀ + Δ⊥ the term is α² times that
+        one plus terms in Δ⊥, so the prediction adds α² times the last miss (for α² <= 4).
+        What it gets wrong (a turn of the path, a slack tendon) the next integration
+        corrects, as it corrects the linear step. Tracking a circle of 1000 targets, this
+        takes the task error at the first integration from 2.3e-6 to 4e-8 L: one
+        integration a target instead of two.
         """
         last = self.solver.last_solution()
         if last is None or self._displaced:  # (displacement answers need the full route's
             return None                     # Jacobians, per metre of displacement)
         x, N = last
-        scale = self.solver._data.scale
         first = sum(_input_count(load) for load in self.loads)
         if self._shooter is None:  # prepared once; each iteration sets the inputs only
             try:
@@ -339,90 +328,65 @@ class InverseSolver:
             except ValueError:
                 return None
         shooter = self._shooter
-        every = shooter.inputs.copy()  # every input of the loads, the actuators' at slots
-        task = slice(0, 3 if orientation is None else 6)
+        n, t = self.n_inputs, 3 if orientation is None else 6
         warm, self._warm = self._warm, None
         if warm is not None and not (bool((warm[0] == q).all()) and bool((warm[1] == x).all())):
             warm = None  # the Solver or the inputs moved since
-        redundant = None
-        merit = np.inf
-        iterations = 0
-        linear = None  # the warm step's linear prediction and its task step, for the next
-        while True:
-            iterations += 1
-            if iterations > self.max_iterations:
-                return None
-            if warm is not None:  # at the last answer: r = 0, its tip, the last A and G
-                _, _, tip, A, G, miss, redundant = warm  # (its J is the last answer's)
-                warm, shot = None, None
-                e, w = self._pose_task(tip, target, orientation)
-                rhs = e
-            else:
-                every[first:first + self.n_inputs] = q
-                shot = shooter(x, every, steps=("solution", N))
-                Jq = shot.jacobian_inputs[:, first:first + self.n_inputs]
-                Eq = shot.tip_motion_inputs[:, first:first + self.n_inputs]
-                try:
-                    G = np.linalg.solve(shot.jacobian_x, np.column_stack([shot.residual, Jq]))
-                except np.linalg.LinAlgError:
-                    return None
-                A = Eq - shot.tip_motion_x @ G[:, 1:]
-                e, w = self._pose_task(shot.tip_pose, target, orientation)
-                rhs = e + w * (shot.tip_motion_x @ G[:, 0])[task]  # e at the equilibrium
-            J = w[:, None] * A[task]
-            if redundant is None:
-                redundant = self._redundant(J)
-            step = self._step(J, rhs, q, 0.0)
-            trial = np.minimum(np.maximum(q + step, self.lower), self.upper)
-            if shot is None:  # the warm step: r = 0
-                linear = (x, q, trial, G, e)
-                trial, factor = self._second_order(trial, e, miss)
-                x = x - G[:, 1:] @ (trial - q)
-                if factor:
-                    x = x + factor * miss[1]
-                q = trial
-                continue
-            size = _size(e)
-            residual = float(np.max(np.abs(shot.residual) / scale))
-            if not np.isfinite(size + residual) or size + residual > 2.0 * merit:
-                return None  # diverging: the full-solve route, damped, from q
-            merit = size + residual
-            x = x - G[:, 0] - G[:, 1:] @ (trial - q)
-            small = np.max(np.abs(trial - q) / self.scales) <= 1e-7 * (
-                1.0 + np.max(np.abs(q) / self.scales))
-            q = trial
-            # stop at an integration that shows the task within tol, also as linearised to
-            # the equilibrium (``rhs``), with the equilibrium residual small enough for that
-            # linearisation (the step taken from there only improves them; the solve at the
-            # answer checks). Not earlier: along the inputs' weak direction (equal tensions
-            # compress the arm) the second-order terms are large, and a step from a task
-            # error of 1e-4 was measured to leave 2e-7, not 1e-8
-            if (size <= 0.5 * self.tol and _size(rhs) <= 0.5 * self.tol and residual <= 1e-6
-                    and (small or not redundant)):
-                break
+        k = _kernels()
+        steps, base, arm, units = shooter.kernel_arrays(("solution", N))
+        every = shooter.inputs.copy()  # every input of the loads, the actuators' at slots
+        x, q = x.copy(), q.copy()
+        weights = np.full(t, 1.0 / self.length)
+        weights[3:] = 1.0
+        # (copies: a read-only array is another type to numba, one more compiled version)
+        goal = (np.array(target, dtype=np.float64),
+                _EYE3 if orientation is None else np.array(orientation, dtype=np.float64),
+                weights)
+        settings = np.array([self.tol, self.max_iterations, self.length,
+                             -1.0 if warm is None else float(warm[6])])
+        miss = None if warm is None else warm[5]
+        if miss is not None and miss[2].size != t:
+            miss = None
+        warm_in = (np.array([0.0 if warm is None else 1.0]),
+                   np.zeros(12) if warm is None else warm[2],
+                   np.zeros((6, n)) if warm is None else warm[3],
+                   np.zeros((6, 1 + n)) if warm is None else warm[4],
+                   np.array([0.0 if miss is None else 1.0]),
+                   np.zeros(n) if miss is None else miss[0],
+                   np.zeros(6) if miss is None else miss[1],
+                   np.zeros(t) if miss is None else miss[2])
+        A, G, J = np.empty((6, n)), np.empty((6, 1 + n)), np.empty((t, n))
+        linear = (np.empty(6), np.empty(n), np.empty(n), np.empty((6, 1 + n)), np.empty(t))
+        singular = np.empty(min(t, n))
+        info = np.zeros(4)
+        k.inverse_newton(x, q, every, first, steps, base, arm, units, goal,
+                         (self.lower, self.upper, self.scales), settings, warm_in,
+                         (A, G, J, linear, singular), info)
+        if info[0] != k.NEWTON_DONE:
+            return None  # diverging, or the cap: the full-solve route, damped, from q
         try:
-            every[first:first + self.n_inputs] = q
+            every[first:first + n] = q
             eq = shooter.solve_near([*self.loads, *self._actuators_at(q)], x, 2 * N, every)
         except ConvergenceError:
             self.solver.reset()
             return None
-        e, w = self._task(eq, target, orientation)
+        e, _ = self._task(eq, target, orientation)
         size = _size(e)
         if size > self.tol:
             return None
         self.q = q
-        singular = self._singular(J)
         last = self.solver.last_solution()
         if last is not None:
             miss = None
-            if linear is not None:  # what the linear warm step missed (see _second_order)
+            if info[3]:  # what the linear warm step missed (the kernel adds it next time)
                 x0, q0, q_linear, G0, e0 = linear
                 miss = (q - q_linear, last[0] - (x0 - G0[:, 1:] @ (q - q0)), e0)
-            self._warm = (q.copy(), last[0], eq.tip, A, G, miss,
-                          self._redundant(J, singular))
+            tip = np.concatenate([eq.tip[:3, 3], eq.tip[:3, :3].ravel()])
+            self._warm = (q.copy(), last[0], tip, A, G, miss, bool(info[2]))
         condition = float(singular[0] / singular[-1]) if singular[-1] > 0 else np.inf
         at_bound = (q <= self.lower) | (q >= self.upper)
-        return InverseResult(q.copy(), eq, True, float(size), iterations, at_bound, condition)
+        return InverseResult(q.copy(), eq, True, float(size), int(info[1]), at_bound,
+                             condition)
 
     def solve(self, target, orientation=None) -> InverseResult:
         """The inputs that bring the tip to ``target`` (m, spatial, shape (3,)) or, with

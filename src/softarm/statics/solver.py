@@ -375,18 +375,31 @@ class Shooter:
         k = _kernels()
         case = (piece, self._rates[0], tip, self._rates[1]) if lam == 1.0 else (
             lam * piece, lam * self._rates[0], lam * tip, lam * self._rates[1])
+        result = _shoot(k, x, 0.0, self._steps(steps), self._solver._base_kernel, self._arm,
+                        case, self._actuators)
+        if not self.inputs.size:
+            result = dataclasses.replace(result, jacobian_inputs=result.jacobian_inputs[:, :0],
+                                         tip_motion_inputs=result.tip_motion_inputs[:, :0])
+        return result
+
+    def kernel_arrays(self, steps) -> tuple:
+        """What a compiled caller of the kernel's ``shoot`` needs to integrate these loads
+        at any inputs q (inverse statics' ``inverse_newton``): the step counts (``steps`` as
+        in :meth:`Solver.shoot`), the base pose, the arm tuple, and the channels at q = 0
+        and per unit input (piece0 (P, W), unit piece (n, P, W), tip0 (12,), unit tip
+        (n, 12); piece(q) = piece0 + Σᵢ qᵢ unitᵢ)."""
+        return (self._steps(steps), self._solver._base_kernel, self._arm,
+                (self._piece0, self._rates[0], self._tip0, self._rates[1]))
+
+    def _steps(self, steps) -> np.ndarray:
+        """The step counts per piece for ``steps`` (as in :meth:`Solver.shoot`), kept."""
         key = steps if steps is None or isinstance(steps, (int, tuple)) else None
         counts = self._counts.get(key) if key is not None else None
         if counts is None:
             counts = self._solver._step_counts(self._piece_lengths, steps)
             if key is not None and len(self._counts) < 64:
                 self._counts[key] = counts
-        result = _shoot(k, x, 0.0, counts, self._solver._base_kernel, self._arm, case,
-                        self._actuators)
-        if not self.inputs.size:
-            result = dataclasses.replace(result, jacobian_inputs=result.jacobian_inputs[:, :0],
-                                         tip_motion_inputs=result.tip_motion_inputs[:, :0])
-        return result
+        return counts
 
     def solve_near(self, loads, x, steps: int, inputs) -> Equilibrium:
         """:meth:`Solver.solve_near` for ``loads``, the prepared loads with ``inputs``
