@@ -195,7 +195,9 @@ class InverseSolver:
     def n_inputs(self) -> int:
         return self.q.size
 
-    def _actuators_at(self, q, actuators=None) -> list:
+    def _actuators_at(self, q, actuators=None, *, trusted=False) -> list:
+        """The actuators (default: in tensions) at the inputs q; ``trusted``: q is finite and
+        within the bounds (the compiled iteration's answer), not checked again."""
         given = actuators is not None  # the slots of a displaced tendon are its tension's
         actuators = actuators if given else self._actuators
         fields: dict[tuple[int, str], np.ndarray] = {}
@@ -207,8 +209,8 @@ class InverseSolver:
         out = list(actuators)
         # the inner loop's own inputs (finite, clipped to the bounds: tensions >= 0) need no
         # validation; the public actuators_at validates
-        trusted = not given and bool(np.isfinite(q).all()) and bool(
-            np.all((q >= self.lower) & (q <= self.upper)))
+        trusted = not given and (trusted or (bool(np.isfinite(q).all()) and bool(
+            np.all((q >= self.lower) & (q <= self.upper)))))
         for (i, name), value in fields.items():
             shape = np.shape(getattr(actuators[i], name))
             value = value.reshape(shape)
@@ -366,7 +368,8 @@ class InverseSolver:
             return None  # diverging, or the cap: the full-solve route, damped, from q
         try:
             every[first:first + n] = q
-            eq = shooter.solve_near([*self.loads, *self._actuators_at(q)], x, 2 * N, every)
+            eq = shooter.solve_near([*self.loads, *self._actuators_at(q, trusted=True)], x,
+                                    2 * N, every)
         except ConvergenceError:
             self.solver.reset()
             return None

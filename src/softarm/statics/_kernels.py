@@ -1666,7 +1666,21 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
                 for i in range(6):  # the chord at 2N starts from the known solution
                     x_f[i] = memory[_MXF + i]
                 resume = True
-        while True:
+                # the output pass from it is also the fine check (a chord integration there
+                # would repeat it without the stations): accepted if its residual is
+                # converged and the estimate meets tol, else the stages below go on
+                _fill_steps(length, arm[1], N, np.int64(2), steps)
+                _output(x_f, nt_out, steps, base, arm, case, piece_loads[b], tip_loads[b],
+                        inputs, scratch, s_out, out, b, r, J, J_out)
+                counter[0] += 1
+                d2 = 0.0
+                for i in range(3):
+                    d2 += (scratch[0][_P + i] - tip_c[i]) ** 2
+                if _norm_scaled(r, scale) <= threshold and (math.sqrt(d2) / 15.0 <= tol
+                                                            or n_fixed > 0):
+                    estimate = math.sqrt(d2) / 15.0
+                    recorded = True
+        while not recorded:
             if path:
                 # the path on a coarse grid (N / coarse_ratio steps) unless that failed
                 n_path = N if fine_path or N <= 6 else max(3, (N + coarse_ratio - 1)

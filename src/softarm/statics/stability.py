@@ -18,9 +18,15 @@ __all__ = ["conservative", "verdict"]
 
 
 def _k():
-    from .solver import _kernels
+    global _KERNELS
+    if _KERNELS is None:  # (a function-level import costs about 5 µs a call)
+        from .solver import _kernels
 
-    return _kernels()
+        _KERNELS = _kernels()
+    return _KERNELS
+
+
+_KERNELS = None
 
 
 def conservative(piece: np.ndarray, tip: np.ndarray) -> np.ndarray:
