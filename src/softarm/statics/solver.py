@@ -859,7 +859,10 @@ def _actuation(channels, base_wrench, lengths, shape) -> dict:
     if not tendons.size:
         return out
     length = lengths if tendons.size == lengths.shape[1] else lengths[:, tendons]
-    tension = channels.piece[:, :, k.ACT + tendons].max(axis=1)
+    # (the actuators' columns by a slice, then the tendons': fancy indexing first cost 3×)
+    tension = channels.piece[:, :, k.ACT:].max(axis=1)
+    if tendons.size != tension.shape[1]:
+        tension = tension[:, tendons]
     for array in (length, tension):
         array.setflags(write=False)
     change = length - unloaded
