@@ -21,6 +21,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -37,6 +38,18 @@ from .statics.solver import _kernels
 __all__ = ["InverseResult", "InverseSolver", "inverse"]
 
 _EYE3 = np.eye(3)
+
+
+class _Warm(NamedTuple):
+    """The fast route's last answer, where the next target's warm step starts."""
+
+    q: np.ndarray  # the inputs
+    x: np.ndarray  # the base reaction (N, N m, spatial)
+    tip: np.ndarray  # the tip state (12,): p, then R row-major
+    A: np.ndarray  # the actuation Jacobian (6, n) of the last integration
+    G: np.ndarray  # J_x⁻¹ [r | J_q] (6, 1 + n) of the last integration
+    miss: tuple | None  # what the linear warm step missed: (in q, in x, its task step)
+    redundant: bool  # whether the task is redundant there
 
 
 @dataclass(frozen=True)
@@ -128,9 +141,7 @@ class InverseSolver:
         # displacement-controlled tendons are solved in their tensions (self._actuators)
         self._actuators, self._displaced = self._in_tensions(arm, s, solver_tol)
         self._shooter = None  # the fast route's prepared shooting (Solver.shooter)
-        # the fast route's last answer: q, x, tip state (p, R row-major), A, J_x⁻¹ [r | J_q],
-        # the linear warm step's miss (_shooting_newton), whether the task is redundant there
-        self._warm = None
+        self._warm = None  # the fast route's last answer (_Warm)
         self._slots = []  # (actuator index, field, component, is tension)
         values = []
         for i, load in enumerate(self._actuators):
@@ -332,7 +343,7 @@ class InverseSolver:
         shooter = self._shooter
         n, t = self.n_inputs, 3 if orientation is None else 6
         warm, self._warm = self._warm, None
-        if warm is not None and not (bool((warm[0] == q).all()) and bool((warm[1] == x).all())):
+        if warm is not None and not (bool((warm.q == q).all()) and bool((warm.x == x).all())):
             warm = None  # the Solver or the inputs moved since
         k = _kernels()
         steps, base, arm, units = shooter.kernel_arrays(("solution", N))
@@ -345,14 +356,14 @@ class InverseSolver:
                 _EYE3 if orientation is None else np.array(orientation, dtype=np.float64),
                 weights)
         settings = np.array([self.tol, self.max_iterations, self.length,
-                             -1.0 if warm is None else float(warm[6])])
-        miss = None if warm is None else warm[5]
+                             -1.0 if warm is None else float(warm.redundant)])
+        miss = None if warm is None else warm.miss
         if miss is not None and miss[2].size != t:
             miss = None
         warm_in = (np.array([0.0 if warm is None else 1.0]),
-                   np.zeros(12) if warm is None else warm[2],
-                   np.zeros((6, n)) if warm is None else warm[3],
-                   np.zeros((6, 1 + n)) if warm is None else warm[4],
+                   np.zeros(12) if warm is None else warm.tip,
+                   np.zeros((6, n)) if warm is None else warm.A,
+                   np.zeros((6, 1 + n)) if warm is None else warm.G,
                    np.array([0.0 if miss is None else 1.0]),
                    np.zeros(n) if miss is None else miss[0],
                    np.zeros(6) if miss is None else miss[1],
@@ -385,7 +396,7 @@ class InverseSolver:
                 x0, q0, q_linear, G0, e0 = linear
                 miss = (q - q_linear, last[0] - (x0 - G0[:, 1:] @ (q - q0)), e0)
             tip = np.concatenate([eq.tip[:3, 3], eq.tip[:3, :3].ravel()])
-            self._warm = (q.copy(), last[0], tip, A, G, miss, bool(info[2]))
+            self._warm = _Warm(q.copy(), last[0], tip, A, G, miss, bool(info[2]))
         condition = float(singular[0] / singular[-1]) if singular[-1] > 0 else np.inf
         at_bound = (q <= self.lower) | (q >= self.upper)
         return InverseResult(q.copy(), eq, True, float(size), int(info[1]), at_bound,
