@@ -30,7 +30,6 @@ from ._validate import count, real
 from .dispatch import warn_unstable
 from .equilibrium import Equilibrium, Stability
 from .errors import ConvergenceError
-from .lie import so3
 from .loads import as_loads
 from .statics import Solver
 from .statics.solver import _kernels
@@ -274,26 +273,28 @@ class InverseSolver:
         return self._pose_task(eq.tip, target, orientation)
 
     def _pose_task(self, tip, target, orientation):
-        """The weighted task error e and its weights w at the tip pose ``tip`` (4 × 4)."""
-        e = (target - tip[:3, 3]) / self.length
-        weights = np.full(3 if orientation is None else 6, 1.0 / self.length)
-        if orientation is None:
-            return e, weights
+        """The weighted task error e and its weights w at the tip pose ``tip`` (4 × 4): the
+        kernel's ``task_error``, which the fast route computes in its iteration."""
+        t = 3 if orientation is None else 6
+        weights = np.full(t, 1.0 / self.length)
         weights[3:] = 1.0
-        rotation = so3.log(orientation @ tip[:3, :3].T)  # spatial δθ to the target
-        return np.concatenate([e, rotation]), weights
+        e = np.empty(t)
+        _kernels().task_error(np.concatenate([tip[:3, 3], tip[:3, :3].ravel()]),
+                              np.array(target, dtype=np.float64),
+                              _EYE3 if orientation is None else np.array(orientation,
+                                                                         dtype=np.float64),
+                              self.length, e)
+        return e, weights
 
     def _singular(self, J) -> np.ndarray:
         """The singular values of the weighted task Jacobian J (task × inputs) in scaled
         inputs (J diag(s)), largest first."""
         return np.linalg.svd(J * self.scales, compute_uv=False)
 
-    def _redundant(self, J, singular=None) -> bool:
-        """More inputs than the rank of the weighted task Jacobian J in scaled inputs
-        (singular values below 1e-10 n σ_max count as zero); ``singular``: J's, if known."""
-        singular = self._singular(J) if singular is None else singular
-        rank = int(np.count_nonzero(singular > 1e-10 * self.n_inputs * singular[0]))
-        return self.n_inputs > rank
+    def _redundant(self, J) -> bool:
+        """More inputs than the rank of the weighted task Jacobian J in scaled inputs (the
+        kernel's ``redundant_task``, the fast route's rule)."""
+        return bool(_kernels().redundant_task(self._singular(J), self.n_inputs))
 
     def _step(self, J, b, q, mu):
         """The bounded Gauss–Newton step δq for the weighted task Jacobian J and right-hand

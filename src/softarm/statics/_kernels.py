@@ -2361,7 +2361,7 @@ def _rotation_log(Q, out):
 
 
 @_jit
-def _task_error(tip, target, orientation, length, e):
+def task_error(tip, target, orientation, length, e):
     """The weighted task error at the tip state ``tip`` (p, R row-major): e[:3] = (target - p)
     / L and, with a 6-row task, e[3:] = log(orientation Rᵀ) (spatial, rad)."""
     for i in range(3):
@@ -2381,6 +2381,18 @@ def _task_size(e):
     p = e[0] * e[0] + e[1] * e[1] + e[2] * e[2]
     r = e[3] * e[3] + e[4] * e[4] + e[5] * e[5] if e.size == 6 else 0.0
     return math.sqrt(max(p, r))
+
+
+@_jit
+def redundant_task(singular, n):
+    """Whether a task Jacobian with these singular values (largest first) has a rank below
+    its n inputs (values at most 1e-10 n σ₁ count as zero): the least-effort term then
+    picks the answer among many (softarm.control)."""
+    rank = 0
+    for v in singular:
+        if v > 1e-10 * n * singular[0]:
+            rank += 1
+    return n > rank
 
 
 @_jit
@@ -2469,7 +2481,7 @@ def inverse_newton(x, q, every, first, steps, base, arm, units, goal, bounds, se
                     A[i, c] = warm[2][i, c]
                 for c in range(1 + n):
                     G[i, c] = warm[3][i, c]
-            _task_error(tip, target, orientation, length, e)
+            task_error(tip, target, orientation, length, e)
             for i in range(t):
                 rhs[i] = e[i]
         else:
@@ -2506,7 +2518,7 @@ def inverse_newton(x, q, every, first, steps, base, arm, units, goal, bounds, se
                     for k in range(6):
                         acc -= E[i, k] * G[k, 1 + c]
                     A[i, c] = acc
-            _task_error(y, target, orientation, length, e)
+            task_error(y, target, orientation, length, e)
             for i in range(t):
                 acc = 0.0
                 for k in range(6):
@@ -2515,13 +2527,9 @@ def inverse_newton(x, q, every, first, steps, base, arm, units, goal, bounds, se
         for i in range(t):
             for c in range(n):
                 J[i, c] = w[i] * A[i, c]
-        if redundant < 0:  # more inputs than the rank of J s (singular values > 1e-10 n σ₁)
+        if redundant < 0:
             _scaled_singular_values(J, scales, singular)
-            rank = 0
-            for v in singular:
-                if v > 1e-10 * n * singular[0]:
-                    rank += 1
-            redundant = 1 if n > rank else 0
+            redundant = 1 if redundant_task(singular, n) else 0
             info[2] = redundant
         step = regularised_step(J, rhs, q, scales, 0.0, lower, upper, np.int64(100))
         for c in range(n):
