@@ -1,5 +1,6 @@
 """Compiled kernels of the shooting solver (numba; the closed forms' one-load kernels are in
-analytic/_compiled.py).
+analytic/_compiled.py), with the bounded least squares of the bounded Newton methods and the
+compiled iteration of inverse statics, which call them (sections at the end).
 
 Design notes (layouts, the stage machine, why this file is whole): ``README.md`` beside it.
 

@@ -350,7 +350,7 @@ class Shooter:
         self._piece_lengths, self._actuators = pieces[1], len(channels.actuators)
         piece, tip = channels.piece[0], channels.tip_loads[0]
         self.inputs = inputs
-        self._unit_piece, self._unit_tip = unit_piece, unit_tip
+        self._unit_tip = unit_tip
         # the kernel reads the first rate row even at λ = 0: loads without inputs get a zero
         # row, and its column is dropped from the result
         self._rates = (unit_piece, unit_tip) if inputs.size else (
