@@ -534,8 +534,9 @@ def test_solve_near_returns_the_solution_it_starts_near_or_raises():
         start = x + change * np.abs(x).max() * moved
         try:
             near = Solver(arm, tol=1e-8).solve_near(load, start, 2 * N)
-        except softarm.ConvergenceError:
+        except softarm.ConvergenceError as error:
             assert change > 0.01
+            assert "no equilibrium of these loads near the given base reaction" in str(error)
             continue
         assert np.linalg.norm(near.tip_position - reference.tip_position) <= 1e-7, change
         assert near.error_estimate <= 1e-8

@@ -704,7 +704,7 @@ class Solver:
         if failed.size:
             if chained:
                 self.reset()
-            raise _failure(k, failed[0], shape, status, info, self)
+            raise _failure(k, failed[0], shape, status, info, self, near)
         if chained and count:
             self._last = (pieces[0], channels.piece[-1].copy(), channels.tip_loads[-1].copy(),
                           channels.signature())
@@ -1006,13 +1006,20 @@ def _input_channels(loads, pieces, data, width) -> tuple[np.ndarray, np.ndarray]
     return np.ascontiguousarray(piece), np.ascontiguousarray(tip)
 
 
-def _failure(k, b, shape, status, info, solver) -> ConvergenceError:
-    """The ConvergenceError of the first failed case."""
+def _failure(k, b, shape, status, info, solver, near=False) -> ConvergenceError:
+    """The ConvergenceError of the first failed case (``near``: of :meth:`Solver.solve_near`,
+    whose path has no load to follow: a failure there means no solution near its start)."""
     b = int(b)
     where = f" for load case {np.unravel_index(b, shape)}" if shape else ""
     residual, estimate, reached, shootings, N = info[b]
     code = int(status[b])
     tried = f"{int(shootings)} shootings, {2 * int(N)} RK4 steps"
+    if near and code in (k.PATH_FAILED, k.NEWTON_FAILED):
+        return ConvergenceError(
+            "Solver.solve_near found no equilibrium of these loads near the given base "
+            "reaction (neither the correction from it nor the path from its own loads "
+            "converged): start from a solution's base reaction (Solver.last_solution(), a "
+            "continuation point)", residual, tried)
     if code == k.TOO_MANY_STEPS:
         return ConvergenceError(
             f"the tip error estimate {estimate:.3e} m stayed above tol·L = "
