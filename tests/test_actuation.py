@@ -461,6 +461,28 @@ def test_the_actuated_closed_form_agrees_with_the_numerical_route_station_by_sta
     np.testing.assert_allclose(num.base_wrench, 0.0, atol=1e-10)
 
 
+def test_solves_of_different_actuator_structures_on_one_arm_do_not_mix():
+    # the arm's solver data remembers each actuator structure (routing rows, unloaded tendon
+    # lengths) for the next solve of that structure: interleaved solves of several structures
+    # on one arm must each match their own closed form
+    arm = Arm.from_stiffness(0.25, **STEEL)
+    structures = {
+        "a": [Tendon(1.2, Straight(0.0, 0.006))],
+        "b": [Tendon(0.9, Straight(-0.005, 0.002), end=0.1)],
+        "c": [Tendon(1.2, Straight(0.0, 0.006)), Tendon(0.4, Straight(0.004, -0.003))],
+        "d": [Chamber(2e4, 1e-5, Straight(0.004, -0.004))],
+    }
+    for name in "abcadbca":
+        loads = structures[name]
+        exact = softarm.analytic.actuated(arm, loads, s=11)
+        num = numeric(arm, loads, s=11, tol=1e-10)
+        np.testing.assert_allclose(num.poses, exact.poses, rtol=0, atol=1e-8 * 0.25,
+                                   err_msg=name)
+        if name != "d":
+            np.testing.assert_allclose(num.tendon_length_changes, exact.tendon_length_changes,
+                                       rtol=0, atol=1e-11, err_msg=name)
+
+
 def test_no_closed_form_for_curved_paths_or_other_loads():
     arm = Arm.from_stiffness(0.2, **STEEL, mass_per_length=0.02)
     assert softarm.analytic.actuated(arm, [Tendon(1.0, Helix(0.01, 1.0))]) is None

@@ -15,6 +15,7 @@ from .analytic.exact import closed_form
 from .equilibrium import Equilibrium
 from .errors import StabilityWarning
 from .statics import Solver
+from .statics.solver import _IDENTITY
 
 __all__ = ["METHODS", "solve", "solve_prepared"]
 
@@ -27,13 +28,10 @@ def _in_base_frame(loads, R: np.ndarray) -> tuple:
     return tuple(load.in_base_frame(R) for load in loads)
 
 
-_EYE4 = np.eye(4)
-
-
 def _closed_form(arm, loads, shape, s, H0) -> Equilibrium | None:
     """An exact closed form for these checked loads (batch shape ``shape``) on the arm
     clamped at H0, at the checked stations s, or None."""
-    identity = bool((H0 == _EYE4).all())
+    identity = H0 is _IDENTITY or bool((H0 == _IDENTITY).all())  # (is: the default, cheaply)
     result = closed_form(arm, loads if identity else _in_base_frame(loads, H0[:3, :3]), s,
                          shape)
     if result is None or identity:
@@ -183,7 +181,8 @@ def solve_prepared(solver: Solver, loads, method="auto") -> Equilibrium:
     the numerical one reuses ``solver``'s preparation of the arm.
     """
     _check_method(method)
-    if method != "numeric":  # the solver validates the loads itself
+    checked = method != "numeric"  # else the solver validates the loads itself
+    if checked:
         loads, shape = solver.check_loads(loads)
         result = _closed_form(solver.arm, loads, shape, solver.s, solver.base)
         if result is not None:
@@ -197,4 +196,6 @@ def solve_prepared(solver: Solver, loads, method="auto") -> Equilibrium:
                 "method='analytic' but no exact closed form applies to this arm and these "
                 "loads; use method='auto' or 'numeric'"
             )
-    return warn_unstable(solver.solve_from_unloaded(loads), 4)
+    # (Solver.solve_from_unloaded, without checking the loads a second time)
+    return warn_unstable(solver._solve(loads, chained=False, jacobians=False, checked=checked),
+                         4)

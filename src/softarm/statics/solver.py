@@ -121,6 +121,26 @@ class _ArmData:
         # segment's distal end (material components)
         self.magnetization = np.array([_magnet(seg, "magnetization") for seg in segments])
         self.dipoles = np.array([_magnet(seg, "tip_magnet") for seg in segments])
+        # what solves of one load structure share (:meth:`remember`)
+        self._remembered, self._kinds = {}, {}
+
+    def remembered(self, kind: str, key):
+        """What :meth:`remember` stored under (kind, key), or None."""
+        return self._remembered.get((kind, key))
+
+    def remember(self, kind: str, key, value, most: int = 8):
+        """Store ``value`` under (kind, key), keeping at most ``most`` entries of that kind
+        (the oldest go); returns it. Solvers in several threads may share an arm's data:
+        every step is one dict operation, and a lost entry is only computed again."""
+        entries = self._kinds.setdefault(kind, [])
+        while len(entries) >= most:
+            try:
+                self._remembered.pop(entries.pop(0), None)
+            except IndexError:
+                break
+        entries.append((kind, key))
+        self._remembered[kind, key] = value
+        return value
 
     @functools.lru_cache(maxsize=16)  # noqa: B019 (per arm data, itself cached per arm)
     def pieces(self, cuts: tuple[float, ...]) -> tuple:
@@ -190,8 +210,8 @@ class _Channels:
         self.tip_loads = np.zeros((count, k.TIP_LOADS))
         self._piece = self.piece.reshape(*shape, P, k.PIECE_LOADS)
         self._tip = self.tip_loads.reshape(*shape, k.TIP_LOADS)
+        self.data = data
         self.actuators = []  # (kind code, routing, active rows, span) per actuator column
-        self._memo = {}  # what depends on the actuators only (tendons())
 
     def _rows(self, span):
         if span is None or (span[0] <= 0.0 and span[1] >= self.length):  # the whole arm
@@ -257,11 +277,34 @@ class _Channels:
             self._piece[..., :, k.FG:k.FG + 9] += G[..., None, :]
 
     def arm_tuple(self) -> tuple:
-        """The kernel's arm tuple: the pieces and the actuators' paths (see _kernels);
-        built once (the solve and its stability verdict both pass it)."""
-        built = self.__dict__.get("_arm_tuple")
-        if built is not None and built[0] == len(self.actuators):
-            return built[1]
+        """The kernel's arm tuple: the pieces and the actuators' paths (see _kernels)."""
+        return self._actuated_arm()[0]
+
+    def tendons(self) -> tuple[np.ndarray, np.ndarray]:
+        """The actuator columns that are tendons (in the order given) and their lengths in
+        the unloaded arm (m)."""
+        return self._actuated_arm()[1:]
+
+    def _actuated_arm(self) -> tuple:
+        """(arm tuple, tendon columns, unloaded tendon lengths): what depends on the cut and
+        on the actuators' kinds, paths and spans alone, not on their magnitudes. A control
+        loop or a sweep solves many cases of one structure, so it is remembered per arm
+        (40-60 µs of every robot solve otherwise: routing rows, tendon quadratures)."""
+        mine = self.__dict__.get("_actuated")  # (this batch's solve and its verdict)
+        if mine is not None and mine[0] == len(self.actuators):
+            return mine[1]
+        key = (self.starts.tobytes(), self.signature())
+        try:
+            found = self.data.remembered("actuated arm", key)
+        except TypeError:  # a user's routing class that cannot be hashed: not remembered
+            found = self._build_actuated_arm()
+        else:
+            if found is None or found[0][0] is not self.pieces[0]:
+                found = self.data.remember("actuated arm", key, self._build_actuated_arm())
+        self._actuated = (len(self.actuators), found)
+        return found
+
+    def _build_actuated_arm(self) -> tuple:
         pieces = self.pieces
         degree = max([1] + [routing.degree for _, routing, _, _ in self.actuators])
         A = len(self.actuators)
@@ -272,9 +315,10 @@ class _Channels:
             routes[a] = routing.kernel_row(degree, self.length)
             kinds[a] = kind
             active[:, a] = rows
-        out = (*pieces[:8], pieces[8], routes, kinds, active, pieces[9], pieces[10])
-        self._arm_tuple = (A, out)
-        return out
+        arm = (*pieces[:8], pieces[8], routes, kinds, active, pieces[9], pieces[10])
+        columns = np.flatnonzero(kinds == self.k.TENDON)
+        unloaded = np.array([_unloaded_length(pieces, self.actuators[a]) for a in columns])
+        return arm, columns, unloaded
 
     def single(self, piece, tip) -> _Channels:
         """A copy of these channels (the same pieces and actuators) holding the single case
@@ -284,18 +328,6 @@ class _Channels:
         out.piece, out.tip_loads = piece[None], tip[None]
         out._piece, out._tip = piece, tip
         return out
-
-    def tendons(self) -> tuple[np.ndarray, np.ndarray]:
-        """The actuator columns that are tendons and their lengths in the unloaded arm (m),
-        computed once for these actuators (and shared with the :meth:`single` copies)."""
-        found = self._memo.get("tendons")
-        if found is None or found[0] != len(self.actuators):
-            columns = np.array([a for a, actuator in enumerate(self.actuators)
-                                if actuator[0] == self.k.TENDON], dtype=np.int64)
-            unloaded = np.array([_unloaded_length(self.pieces, self.actuators[a])
-                                 for a in columns])
-            found = self._memo["tendons"] = (len(self.actuators), columns, unloaded)
-        return found[1], found[2]
 
     def signature(self) -> tuple:
         """What identifies the actuators (kinds, paths, where they act): a chained solve
@@ -567,8 +599,7 @@ class Solver:
         fs, ms = self._data.scale[0], self._data.scale[3]
         # a cheap bound first: every channel at its largest, summed (finite loads: no
         # overflow here)
-        largest = float(max(np.max(np.abs(channels.piece), initial=0.0),
-                            np.max(np.abs(channels.tip_loads), initial=0.0)))
+        largest = max(_largest(channels.piece), _largest(channels.tip_loads))
         if largest * 12.0 * max(k, 1.0) / min(fs, ms) <= _LOAD_LIMIT:
             return
         with np.errstate(over="ignore", invalid="ignore"):
@@ -629,14 +660,17 @@ class Solver:
         return self._solve(loads, chained=False, jacobians=jacobians)
 
     def _solve(self, loads, *, chained: bool, jacobians: bool, near: bool = False,
-               prepared=None, outputs: bool = True) -> Equilibrium | None:
+               prepared=None, outputs: bool = True, checked: bool = False
+               ) -> Equilibrium | None:
         """``near``: a single case whose path starts at its own loads, from the memory
         :meth:`solve_near` wrote (λ = 0 and λ = 1 the same loads); ``prepared``: what
         :meth:`_prepare` returns for these loads (a :class:`Shooter`'s); ``outputs=False``:
-        only the memory of a chained solve (the tip its one station, no verdict), None."""
+        only the memory of a chained solve (the tip its one station, no verdict), None;
+        ``checked``: ``loads`` is what :meth:`check_loads` returned."""
         if not isinstance(jacobians, (bool, np.bool_)):
             raise TypeError(f"jacobians must be True or False, got {jacobians!r}")
-        loads = as_loads(loads)
+        if not checked:
+            loads = as_loads(loads)
         if any(load.displacement_controlled for load in loads):
             # the tensions are unknowns: a bounded Newton method over tension-controlled
             # solves from the unloaded arm (statics/displacement.py); a chained Solver
@@ -649,7 +683,7 @@ class Solver:
         k = _kernels()
         last = self._last if chained else None
         loads, shape, count, pieces, channels = prepared or self._prepare(
-            loads, () if last is None else tuple(last[0]))
+            loads, () if last is None else tuple(last[0]), checked=checked)
         if near:
             if shape != ():
                 raise ValueError(f"Solver.solve_near takes a single load case, got batch "
@@ -680,13 +714,14 @@ class Solver:
         info = np.zeros((count, 5))
         status = np.zeros(count, dtype=np.int64)
         inputs = self._input_channels(loads, pieces, channels.piece.shape[2]) \
-            if jacobians else (np.zeros((0, *channels.piece.shape[1:])),
-                               np.zeros((0, k.TIP_LOADS)))
+            if jacobians else (self._unused((0, *channels.piece.shape[1:])),
+                               self._unused((0, k.TIP_LOADS)))
         n_in = inputs[0].shape[0]
         # rows 6 + a: actuator a's length per column (a tendon's; 0 for a chamber)
-        jac = np.zeros((count, 6 + len(channels.actuators), 6 + n_in) if jacobians
-                       else (0, 6, 6))
-        motion = np.zeros((count, S, 6, 6 + n_in)) if jacobians else self._no_motion(S)
+        jac = np.zeros((count, 6 + len(channels.actuators), 6 + n_in)) if jacobians \
+            else self._unused((0, 6, 6))
+        motion = np.zeros((count, S, 6, 6 + n_in)) if jacobians \
+            else self._unused((1, S, 6, 6))
         base_wrench = np.empty((count, 6))
         lengths = np.empty((count, len(channels.actuators)))
         arm, options = channels.arm_tuple(), self._options(chained, jacobians, near)
@@ -713,7 +748,7 @@ class Solver:
         tip_compliance = compliance = None
         if jacobians:
             tip_compliance, compliance, tip_inputs, station_inputs, lengths_inputs = \
-                _compliances(jac, motion, shape, _tendon_rows(channels))
+                _compliances(jac, motion, shape, channels.tendons()[0])
             actuation.update(actuation_jacobian=tip_inputs,
                              station_actuation_jacobian=station_inputs,
                              tendon_length_jacobian=lengths_inputs)
@@ -744,12 +779,13 @@ class Solver:
             **actuation,
         )
 
-    def _no_motion(self, stations: int) -> np.ndarray:
-        """The kernel's station-motion argument without Jacobians: a (1, S, 6, 6)
-        placeholder it never writes, made once per station count."""
-        found = self.__dict__.get("_placeholder")
-        if found is None or found.shape[1] != stations:
-            found = self._placeholder = np.zeros((1, stations, 6, 6))
+    def _unused(self, shape: tuple) -> np.ndarray:
+        """A placeholder whose contents the kernel never uses (the argument of a feature not
+        asked for: the Jacobians' outputs, the input channels), made once per shape."""
+        placeholders = self.__dict__.setdefault("_placeholders", {})
+        found = placeholders.get(shape)
+        if found is None:
+            found = placeholders[shape] = np.zeros(shape)
         return found
 
     def _input_channels(self, loads, pieces, width):
@@ -760,16 +796,10 @@ class Solver:
         if not any(load.inputs for load in loads):  # nothing to build, nothing to remember
             return _input_channels(loads, pieces, self._data, width)
         key = (pieces[0].tobytes(), width, tuple(_structure(load) for load in loads))
-        cache = self._data.__dict__.setdefault("_inputs_cache", {})
-        found = cache.get(key)
-        if found is None:  # (Solvers in other threads may share the arm's cache: no
-            found = _input_channels(loads, pieces, self._data, width)  # read-then-pop)
-            while len(cache) >= 8:
-                try:
-                    cache.pop(next(iter(cache)), None)
-                except (StopIteration, RuntimeError):
-                    break
-            cache[key] = found
+        found = self._data.remembered("input channels", key)
+        if found is None:
+            found = self._data.remember("input channels", key,
+                                        _input_channels(loads, pieces, self._data, width))
         return found
 
     def solve_near(self, loads, x, steps: int) -> Equilibrium:
@@ -880,18 +910,8 @@ def _unloaded_length(pieces, actuator) -> float:
     """A tendon's length in the unloaded arm, ∫ |e1 + κ⁰ × r + r'| ds over the pieces it
     runs through (Gauss–Legendre, 24 nodes per piece and per quarter turn of a helix)."""
     _, routing, active, _ = actuator
-    return _unloaded_length_cached(routing, active.tobytes(), pieces[0].tobytes(),
-                                   pieces[1].tobytes(), pieces[3].tobytes())
-
-
-_NODES, _WEIGHTS = np.polynomial.legendre.leggauss(24)
-
-
-@functools.lru_cache(maxsize=256)
-def _unloaded_length_cached(routing, active, starts, lengths, f0) -> float:
-    on = np.flatnonzero(np.frombuffer(active))
-    starts, lengths = np.frombuffer(starts)[on], np.frombuffer(lengths)[on]
-    f0 = np.frombuffer(f0).reshape(-1, 6)[on]
+    on = np.flatnonzero(active)
+    starts, lengths, f0 = pieces[0][on], pieces[1][on], pieces[3][on]
     total = 0.0
     for j in range(starts.size):
         parts = max(1, int(np.ceil(4 * abs(routing.helix[1]) * lengths[j])))
@@ -903,8 +923,13 @@ def _unloaded_length_cached(routing, active, starts, lengths, f0) -> float:
     return total
 
 
+_NODES, _WEIGHTS = np.polynomial.legendre.leggauss(24)
+
+
 def _largest(vector) -> float:
-    return float(np.max(np.abs(vector), initial=0.0))
+    """max |vector|, 0 if empty (``np.max(..., initial=0.0)`` costs twice as much)."""
+    vector = np.asarray(vector)
+    return float(np.abs(vector).max()) if vector.size else 0.0
 
 
 def _recut(old_starts, old_piece, new_starts) -> np.ndarray:
@@ -921,13 +946,6 @@ def _recut(old_starts, old_piece, new_starts) -> np.ndarray:
     out[same, k.JD:k.FB] = old_piece[inside[same], k.JD:k.FB]
     out[:, k.FB:] = old_piece[inside, k.FB:]  # the field and the actuators: distributed
     return out
-
-
-def _tendon_rows(channels) -> np.ndarray:
-    """The actuator columns (in the kernel's order) that are tendons, in the order given."""
-    k = channels.k
-    return np.array([a for a, actuator in enumerate(channels.actuators)
-                     if actuator[0] == k.TENDON], dtype=np.int64)
 
 
 def _compliances(jac, motion, shape, tendons):
