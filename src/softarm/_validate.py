@@ -11,6 +11,7 @@ while Python ints and floats and numpy integer and floating scalars and arrays o
 
 from __future__ import annotations
 
+import functools
 import math
 import os
 from numbers import Integral, Real
@@ -227,9 +228,11 @@ def format_bytes(size: float) -> str:
     raise AssertionError("unreachable")  # pragma: no cover
 
 
+@functools.cache
 def memory_limit() -> int:
     """The most one result may take, in bytes: half the physical memory of this machine (the
-    solver's work arrays and an export need room too), or 2⁴⁰ where that is unknown."""
+    solver's work arrays and an export need room too), or 2⁴⁰ where that is unknown. Read
+    once per process."""
     try:
         return int(os.sysconf("SC_PAGE_SIZE")) * int(os.sysconf("SC_PHYS_PAGES")) // 2
     except (AttributeError, ValueError, OSError):  # pragma: no cover - e.g. Windows

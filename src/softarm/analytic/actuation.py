@@ -110,7 +110,9 @@ def actuated(arm, loads, s=None):
     target = _Actuators(arm)
     for load in loads:
         load.apply(target)
-    if target.other or not target.actuators or not all(
+        if target.other:  # (most calls: gravity or an external load beside the actuators)
+            return None
+    if not target.actuators or not all(
             _is_straight(routing) for _, _, routing, _ in target.actuators):
         return None
     s = checked_stations(s, arm.length)

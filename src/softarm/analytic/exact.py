@@ -124,7 +124,9 @@ def closed_form(arm, loads: tuple, s: np.ndarray, shape: tuple):
     target = _TipWrench(arm, shape)
     for load in loads:
         load.apply(target)
-    if target.other or len(target.used) != 1:  # other loads, or dead and follower mixed
+        if target.other:  # a load other than a tip wrench
+            return None
+    if len(target.used) != 1:  # dead and follower mixed
         return None
     follower = target.used.pop()
     force, moment = target.wrench[follower][..., :3], target.wrench[follower][..., 3:]
