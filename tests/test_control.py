@@ -108,6 +108,9 @@ def test_tracking_a_circle_follows_every_target():
     np.testing.assert_array_equal(result.equilibrium.stability.index, np.zeros(12))
     assert result.equilibrium.stability.stable.shape == (12,)
     assert result.equilibrium.stability.stable.all()
+    # read-only like every Equilibrium's arrays (the stacked fields too)
+    for name in ("poses", "strains", "tendon_tensions", "tendon_lengths", "base_wrench"):
+        assert not getattr(result.equilibrium, name).flags.writeable, name
 
 
 def test_bad_input_is_named():

@@ -493,7 +493,11 @@ class InverseSolver:
         def stack(name):
             values = [getattr(r.equilibrium, name) for r in results]
             # (the Jacobian fields come only from targets the full-solve route answered)
-            return None if any(v is None for v in values) else np.stack(values)
+            if any(v is None for v in values):
+                return None
+            stacked = np.stack(values)
+            stacked.setflags(write=False)  # fresh: Equilibrium takes it without a copy
+            return stacked
 
         fields = {f.name: stack(f.name) for f in dataclasses.fields(Equilibrium)
                   if f.name not in ("s", "arm", "loads", "method", "exact", "residual",
