@@ -140,12 +140,20 @@ class InverseSolver:
         # displacement-controlled tendons are solved in their tensions (self._actuators)
         self._actuators, self._displaced = self._in_tensions(arm, s, solver_tol)
         self._shooter = None  # the fast route's prepared shooting (Solver.shooter)
+        self._first = sum(_input_count(load) for load in self.loads)  # the actuators' slot
+        # the task's weights, 1/L on positions and 1 on rotations (never written; writable:
+        # a read-only array is another type to numba)
+        self._weights = {t: np.array([1.0 / self.length] * 3 + [1.0] * (t - 3))
+                         for t in (3, 6)}
         self._warm = None  # the fast route's last answer (_Warm)
         self._slots = []  # (actuator index, field, component, is tension)
+        self._fields = []  # (actuator index, field, its shape, its slots): the inputs' home
         values = []
         for i, load in enumerate(self._actuators):
             for name in load.inputs:
                 value = np.atleast_1d(np.asarray(getattr(load, name), dtype=float))
+                self._fields.append((i, name, np.shape(getattr(load, name)),
+                                     np.arange(len(self._slots), len(self._slots) + value.size)))
                 for c in range(value.size):
                     self._slots.append((i, name, c, name == "tension"))
                     values.append(value[c])
@@ -209,6 +217,11 @@ class InverseSolver:
         """The actuators (default: in tensions) at the inputs q; ``trusted``: q is finite and
         within the bounds (the compiled iteration's answer), not checked again."""
         given = actuators is not None  # the slots of a displaced tendon are its tension's
+        if not given and trusted:  # the inner loop's: each field from its slots, as it is
+            out = list(self._actuators)
+            for i, name, shape, slots in self._fields:
+                out[i] = out[i]._with_checked(**{name: q[slots].reshape(shape)})
+            return out
         actuators = actuators if given else self._actuators
         fields: dict[tuple[int, str], np.ndarray] = {}
         for value, (i, name, c, _) in zip(q, self._slots, strict=True):
@@ -231,14 +244,11 @@ class InverseSolver:
     def _stacked_actuators(self, inputs) -> list:
         """The actuators (as given) with one case per row of ``inputs`` (N, n): loads of
         batch shape (N,), the loads of :meth:`track`'s batched equilibrium."""
-        columns: dict[tuple[int, str], list[int]] = {}
-        for k, (i, name, _, _) in enumerate(self._slots):
-            name = "displacement" if i in self._displaced else name
-            columns.setdefault((i, name), []).append(k)
         out = list(self.actuators)
-        for (i, name), cols in columns.items():
+        for i, name, _, slots in self._fields:
+            name = "displacement" if i in self._displaced else name
             shape = np.shape(getattr(self.actuators[i], name))
-            out[i] = out[i].replace(**{name: inputs[:, cols].reshape(len(inputs), *shape)})
+            out[i] = out[i].replace(**{name: inputs[:, slots].reshape(len(inputs), *shape)})
         return out
 
     def actuators_at(self, inputs) -> list:
@@ -276,15 +286,13 @@ class InverseSolver:
         """The weighted task error e and its weights w at the tip pose ``tip`` (4 × 4): the
         kernel's ``task_error``, which the fast route computes in its iteration."""
         t = 3 if orientation is None else 6
-        weights = np.full(t, 1.0 / self.length)
-        weights[3:] = 1.0
         e = np.empty(t)
         _kernels().task_error(np.concatenate([tip[:3, 3], tip[:3, :3].ravel()]),
                               np.array(target, dtype=np.float64),
                               _EYE3 if orientation is None else np.array(orientation,
                                                                          dtype=np.float64),
                               self.length, e)
-        return e, weights
+        return e, self._weights[t]
 
     def _singular(self, J) -> np.ndarray:
         """The singular values of the weighted task Jacobian J (task × inputs) in scaled
@@ -335,7 +343,7 @@ class InverseSolver:
         if last is None or self._displaced:  # (displacement answers need the full route's
             return None                     # Jacobians, per metre of displacement)
         x, N = last
-        first = sum(_input_count(load) for load in self.loads)
+        first = self._first
         if self._shooter is None:  # prepared once; each iteration sets the inputs only
             try:
                 self._shooter = self.solver.shooter([*self.loads, *self._actuators_at(q)])
@@ -344,18 +352,19 @@ class InverseSolver:
         shooter = self._shooter
         n, t = self.n_inputs, 3 if orientation is None else 6
         warm, self._warm = self._warm, None
-        if warm is not None and not (bool((warm.q == q).all()) and bool((warm.x == x).all())):
+        # (bytes: exact equality of a few numbers at a fifth of the cost; -0.0 against 0.0
+        # only costs the warm step)
+        if warm is not None and not (warm.q.tobytes() == q.tobytes()
+                                     and warm.x.tobytes() == x.tobytes()):
             warm = None  # the Solver or the inputs moved since
         k = _kernels()
         steps, base, arm, units = shooter.kernel_arrays(("solution", N))
         every = shooter.inputs.copy()  # every input of the loads, the actuators' at slots
         x, q = x.copy(), q.copy()
-        weights = np.full(t, 1.0 / self.length)
-        weights[3:] = 1.0
         # (copies: a read-only array is another type to numba, one more compiled version)
         goal = (np.array(target, dtype=np.float64),
                 _EYE3 if orientation is None else np.array(orientation, dtype=np.float64),
-                weights)
+                self._weights[t])
         settings = np.array([self.tol, self.max_iterations, self.length,
                              -1.0 if warm is None else float(warm.redundant)])
         miss = None if warm is None else warm.miss
