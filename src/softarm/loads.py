@@ -14,6 +14,7 @@ The solvers and tools never branch on load kinds: a new kind is a new class here
 from __future__ import annotations
 
 import abc
+import copy
 import dataclasses
 from dataclasses import dataclass, field
 from typing import ClassVar, Protocol
@@ -277,12 +278,15 @@ class Load(abc.ABC):
         validation*: for a caller that keeps the values in their domain itself (inverse
         statics: finite inputs clipped to bounds that keep tensions >= 0), in a loop where
         validating a new load each time was 5 % of a tracked target."""
-        new = object.__new__(type(self))  # (copy.copy's generic protocol: 3× the cost)
-        new.__dict__.update(self.__dict__)
+        if hasattr(self, "__dict__"):  # (a plain shallow copy: copy.copy's protocol costs 3×)
+            new = object.__new__(type(self))
+            new.__dict__.update(self.__dict__)
+        else:  # a subclass with __slots__
+            new = copy.copy(self)
         for name, value in arrays.items():
             array = np.array(value, dtype=np.float64)
             array.setflags(write=False)
-            new.__dict__[name] = array
+            object.__setattr__(new, name, array)
         return new
 
     def take(self, index) -> Load:
