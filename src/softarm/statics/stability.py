@@ -71,11 +71,7 @@ def verdict(channels, base, xs, Ns, shape, tips=None, factor=1, threads=1) -> St
                           Ns[a:b], tips[a:b] if tips.shape[0] else tips, factor, index[a:b],
                           theta0[a:b], flags[a:b])
 
-    if count == 1:  # (a control loop's call: no slices, no thread bookkeeping)
-        k.stability_cases(base, arm, (channels.piece, channels.tip_loads), xs, Ns, tips,
-                          factor, index, theta0, flags)
-    else:
-        in_threads(run, count, threads)
+    in_threads(run, count, threads)
     return make(index, flags, shape)
 
 
