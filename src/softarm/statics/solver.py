@@ -120,25 +120,24 @@ class _ArmData:
         # segment's distal end (material components)
         self.magnetization = np.array([_magnet(seg, "magnetization") for seg in segments])
         self.dipoles = np.array([_magnet(seg, "tip_magnet") for seg in segments])
-        # what solves of one load structure share (:meth:`remember`)
-        self._remembered, self._kinds = {}, {}
+        # what solves of one load structure share (:meth:`remember`): a dict per kind
+        self._remembered = {}
 
     def remembered(self, kind: str, key):
         """What :meth:`remember` stored under (kind, key), or None."""
-        return self._remembered.get((kind, key))
+        return self._remembered.get(kind, {}).get(key)
 
     def remember(self, kind: str, key, value, most: int = 8):
         """Store ``value`` under (kind, key), keeping at most ``most`` entries of that kind
         (the oldest go); returns it. Solvers in several threads may share an arm's data:
         every step is one dict operation, and a lost entry is only computed again."""
-        entries = self._kinds.setdefault(kind, [])
-        while len(entries) >= most:
+        store = self._remembered.setdefault(kind, {})
+        while len(store) >= most:
             try:
-                self._remembered.pop(entries.pop(0), None)
-            except IndexError:
+                store.pop(next(iter(store)), None)
+            except (StopIteration, RuntimeError):  # emptied or changed by another thread
                 break
-        entries.append((kind, key))
-        self._remembered[kind, key] = value
+        store[key] = value
         return value
 
     @functools.lru_cache(maxsize=16)  # noqa: B019 (per arm data, itself cached per arm)
