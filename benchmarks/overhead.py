@@ -2,13 +2,14 @@
 
 The calls the issues time one at a time: a solve of the Mattiasson cantilever (k = 5), the
 3-tendon robot's solve (benchmarks/actuation.py) with 101 stations and with the tip only, a
-warm solve with the tip compliance and three tendon columns, and a tracked target of inverse
-statics. Each call is timed whole, and the time inside the compiled kernels (``solve_cases``,
-``stability_cases``, ``inverse_newton``) is summed by wrappers around them (under a
-microsecond a call); the rest is Python: checking the loads, filling the load channels, the
-stability verdict's and the Equilibrium's arrays. The loads are built before each call, so
-the Python is softarm's own. Medians and minima over the repeats, wall time (``perf_counter``)
-and CPU time (``process_time``) side by side.
+warm solve with the tip compliance and three tendon columns (101 stations and the tip
+only), and a tracked target of inverse statics. Each call is timed whole, and the time
+inside the compiled kernels (``solve_cases``, ``stability_cases``, ``inverse_newton``) is
+summed by wrappers around them (under a microsecond a call); the rest is Python: checking
+the loads, filling the load channels, the stability verdict's and the Equilibrium's
+arrays. The loads are built before each call, so the Python is softarm's own. Medians and
+minima over the repeats, wall time (``perf_counter``) and CPU time (``process_time``) side
+by side.
 
 This is the measurement behind the Python trims of the round of 2026-11-30 (docs/solver.md):
 a speed target of a single call is met or missed by this Python as much as by the kernels.
@@ -86,6 +87,7 @@ def main(argv=None):
     arm = robot()
     near = np.array([2.0, 1.0, 0.5])
     control = softarm.statics.Solver(arm, tol=1e-6)
+    control_tip = softarm.statics.Solver(arm, tol=1e-6, s=[L])
     gravity = softarm.Gravity(GRAVITY)
     tendons = [softarm.Tendon(0.0, Straight(*o)) for o in OFFSETS]
     phase = np.linspace(0.0, 2 * np.pi, 1000, endpoint=False)
@@ -104,6 +106,9 @@ def main(argv=None):
          lambda case: softarm.solve(arm, case, tol=1e-6, s=2), lambda i: (loads(TENSIONS),)),
         ("warm solve + tip compliance + 3 tendon columns, tol 1e-6 L (new tensions each)",
          lambda case: control.solve(case, jacobians=True),
+         lambda i: (loads(near + 1e-3 * np.sin(0.1 * i + np.arange(3))),)),
+        ("the same, the tip only",
+         lambda case: control_tip.solve(case, jacobians=True),
          lambda i: (loads(near + 1e-3 * np.sin(0.1 * i + np.arange(3))),)),
         ("a tracked target along a circle, the tip only (InverseSolver.solve, warm)",
          tracker.solve, lambda i: (path[(20 + i) % len(path)],)),

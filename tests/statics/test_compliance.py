@@ -366,3 +366,30 @@ def test_jacobians_force_the_numerical_route():
     eq = softarm.solve(arm, load, jacobians=True)
     assert eq.method.startswith("numeric")
     assert eq.tip_compliance.shape == (6, 6)
+
+
+def test_kernel_implicit_function_theorem_against_numpy(rng):
+    """The kernel's in-place implicit function theorem (the compliance and actuation
+    Jacobians of every jacobians solve) against numpy's inverse and products on random
+    blocks, and a singular ∂r/∂x: False with the arrays untouched."""
+    from softarm.statics.solver import _kernels
+
+    k = _kernels()
+    n, A, S = 3, 2, 4
+    J = rng.normal(size=(6 + A, 6 + n))
+    E = rng.normal(size=(S, 6, 6 + n))
+    Jx_inv = np.linalg.inv(J[:6, :6])
+    through = Jx_inv @ J[:6, 6:]
+    expected_E = np.concatenate([E[..., :6] @ Jx_inv, E[..., 6:] - E[..., :6] @ through], -1)
+    expected_rows = np.concatenate([J[6:, :6] @ Jx_inv, J[6:, 6:] - J[6:, :6] @ through], -1)
+    J_out, E_out = J.copy(), E.copy()
+    assert k._implicit_function(J_out, E_out)
+    np.testing.assert_allclose(E_out, expected_E, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(J_out[6:], expected_rows, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(J_out[:6], np.concatenate([Jx_inv, through], -1), rtol=1e-12,
+                               atol=1e-12)
+    singular = J.copy()
+    singular[:6, 5] = 0.0  # (exactly: a rounded dependence leaves a tiny pivot)
+    J_out, E_out = singular.copy(), E.copy()
+    assert not k._implicit_function(J_out, E_out)
+    assert np.array_equal(J_out, singular) and np.array_equal(E_out, E)

@@ -78,6 +78,7 @@ TOO_MANY_STEPS = 2  # the error estimate stayed above tol up to the largest step
 PATH_FAILED = 3  # the loading path could not be followed past a load factor (a fold)
 BUDGET = 4  # the shooting budget ran out
 NOT_FINITE = 5  # the state became non-finite at an accepted point
+SINGULAR = 6  # jacobians: ∂r/∂x is singular at the solution (no compliance exists there)
 
 # Layout of the state y (18) and of each tangent row (12).
 _P, _R, _N, _M = 0, 3, 12, 15
@@ -1806,12 +1807,62 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
         for i in range(jac.shape[1] if nt_out else 0):
             for k in range(jac.shape[2]):
                 jac[b, i, k] = J_out[i, k] if n_inputs else J[i, k]
+        if nt_out and status[b] == OK and not _implicit_function(jac[b], out[6][b]):
+            status[b] = SINGULAR
         if chained:
             for i in range(6):
                 memory[_MXC + i] = x[i]
                 memory[_MXF + i] = x_f[i]
             memory[_MN] = N
             memory[_MVALID] = 1.0 if status[b] == OK else 0.0
+
+
+@_jit
+def _implicit_function(J, E):
+    """The implicit function theorem at a solution, in place. Given J (6 + A, 6 + n): rows
+    0:6 [J_x | J_q] (∂r/∂x, ∂r/∂inputs), rows 6 + a [E_ℓx | E_ℓq] (actuator a's length per
+    x and per input), and E (S, 6, 6 + n): each station's motion [E_x | E_q]. A dead tip
+    wrench δW moves x by J_x⁻¹ δW, an input change δq by -J_x⁻¹ J_q δq, so every row
+    e = [e_x | e_q] of E and of J's rows 6.. becomes [e_x J_x⁻¹ | e_q - e_x J_x⁻¹ J_q] (the
+    compliance, then the actuation Jacobian), and J's rows 0:6 become [J_x⁻¹ | J_x⁻¹ J_q].
+    False, nothing changed, if J_x is singular. (In Python, numpy's inverse and products on
+    these small arrays cost 45-60 µs a call: a control loop's Python, not its arithmetic.)"""
+    m = J.shape[1]
+    X = np.empty((6, 6 + m))  # [J_x | I | J_q] -> [· | J_x⁻¹ | J_x⁻¹ J_q]
+    for i in range(6):
+        for k in range(6):
+            X[i, k] = J[i, k]
+            X[i, 6 + k] = 1.0 if i == k else 0.0
+        for k in range(6, m):
+            X[i, 6 + k] = J[i, k]
+    if _eliminate_columns(X, m) == 0.0:
+        return False
+    row = np.empty(m)
+    for a in range(6, J.shape[0]):
+        _through_x(J[a], X, row)
+    for s in range(E.shape[0]):
+        for i in range(6):
+            _through_x(E[s, i], X, row)
+    for i in range(6):
+        for k in range(m):
+            J[i, k] = X[i, 6 + k]
+    return True
+
+
+@_jit
+def _through_x(e, X, row):
+    """e = [e_x | e_q] -> [e_x J_x⁻¹ | e_q - e_x J_x⁻¹ J_q] in place, X[:, 6:] = [J_x⁻¹ |
+    J_x⁻¹ J_q] (:func:`_implicit_function`); ``row`` scratch of e's size."""
+    m = e.size
+    for k in range(m):
+        acc = 0.0
+        for i in range(6):
+            acc += e[i] * X[i, 6 + k]
+        row[k] = acc
+    for k in range(6):
+        e[k] = row[k]
+    for k in range(6, m):
+        e[k] -= row[k]
 
 
 @_jit

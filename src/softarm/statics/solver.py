@@ -797,7 +797,10 @@ class Solver:
         if not any(load.inputs for load in loads):  # nothing to build, nothing to remember
             return _input_channels(loads, pieces, self._data, width)
         key = (pieces[0].tobytes(), width, tuple(_structure(load) for load in loads))
-        found = self._data.remembered("input channels", key)
+        try:
+            found = self._data.remembered("input channels", key)
+        except TypeError:  # a user's routing class that cannot be hashed: not remembered
+            return _input_channels(loads, pieces, self._data, width)
         if found is None:
             found = self._data.remember("input channels", key,
                                         _input_channels(loads, pieces, self._data, width))
@@ -951,38 +954,20 @@ def _recut(old_starts, old_piece, new_starts) -> np.ndarray:
 
 def _compliances(jac, motion, shape, tendons):
     """Tip and station compliances C(s) = E_x(s) J_x⁻¹ (dead tip wrench → (δp; δθ)
-    spatial): a dead tip wrench δW changes the residual by -δW, so the base reaction by
-    J_x⁻¹ δW. And the actuation Jacobians (implicit function theorem): an input change δq
-    moves the residual by J_q δq at fixed x, so x by -J_x⁻¹ J_q δq and the stations by
-    (E_q - E_x J_x⁻¹ J_q) δq; the tendons' lengths likewise by (E_ℓq - E_ℓx J_x⁻¹ J_q) δq
-    (``jac`` rows 6 + a: actuator a's length's tangents; ``tendons`` the actuators that
-    are tendons). Returns (tip compliance, station compliances, tip actuation Jacobian,
-    station actuation Jacobians, tendon length Jacobian (B..., T, n)); the last three None
+    spatial) and the actuation Jacobians E_q - E_x J_x⁻¹ J_q, as the kernel left them
+    (``_kernels._implicit_function``): ``motion`` (B, S, 6, 6 + n) per station, ``jac``
+    (B, 6 + A, 6 + n) rows 6 + a per actuator length (``tendons`` the actuators that are
+    tendons). Returns (tip compliance, station compliances, tip actuation Jacobian, station
+    actuation Jacobians, tendon length Jacobian (B..., T, n)), frozen; the last three None
     without inputs (the last also without tendons)."""
-    lengths = jac[:, 6 + tendons, :]
-    jac = jac[:, :6]
-    count, S, _, m = motion.shape
+    S, m = motion.shape[1], motion.shape[3]
     n = m - 6
-    inverse = np.linalg.inv(jac[:, :, :6])
-    through_x = inverse @ jac[:, :, 6:]  # J_x⁻¹ J_q, (B, 6, n)
-    # both at once, every station in one product per case: E (S·6 × m) times
-    # [[J_x⁻¹, -J_x⁻¹ J_q], [0, I]] (numpy's matmul over a stack of S small matrices cost
-    # most of this function)
-    M = np.zeros((count, m, m))
-    M[:, :6, :6] = inverse
-    M[:, :6, 6:] = -through_x
-    M[:, 6:, 6:] = np.eye(n)
-    both = (motion.reshape(count, S * 6, m) @ M).reshape(count, S, 6, m)
-    station = np.ascontiguousarray(both[..., :6])
+    station = motion if not n else np.ascontiguousarray(motion[..., :6])
     out = [station[:, -1].copy().reshape(*shape, 6, 6), station.reshape(*shape, S, 6, 6)]
     if n:
-        inputs = np.ascontiguousarray(both[..., 6:])
-        out += [inputs[:, -1].copy().reshape(*shape, 6, n), inputs.reshape(*shape, S, 6, n)]
-        if tendons.size:
-            out.append((lengths[..., 6:] - lengths[..., :6] @ through_x).reshape(
-                *shape, -1, n))
-        else:
-            out.append(None)
+        inputs = np.ascontiguousarray(motion[..., 6:])
+        out += [inputs[:, -1].copy().reshape(*shape, 6, n), inputs.reshape(*shape, S, 6, n),
+                jac[:, 6 + tendons, 6:].reshape(*shape, -1, n) if tendons.size else None]
     else:
         out += [None, None, None]
     for array in out:
@@ -992,11 +977,18 @@ def _compliances(jac, motion, shape, tendons):
 
 
 def _structure(load) -> tuple:
-    """What fixes a load's channels per unit input: its kind and its fields that are not
-    batchable (routing, span, area, anchor, ...), from its schema."""
-    batchable = {name for name, _, _ in load.arrays}
-    return (type(load), tuple((key.name, repr(getattr(load, key.name)))
-                              for key in load.schema if key.name not in batchable))
+    """What fixes a load's channels per unit input: its kind and the values of its fields
+    that are not batchable (routing, span, area, anchor, ...: numbers, tuples and frozen
+    routings, hashable; their repr cost 20 µs a solve)."""
+    kind = type(load)
+    return (kind, *(getattr(load, name) for name in _fixed_fields(kind)))
+
+
+@functools.cache
+def _fixed_fields(kind) -> tuple[str, ...]:
+    """The names of a load class's schema fields that are not batchable arrays."""
+    batchable = {name for name, _, _ in kind.arrays}
+    return tuple(key.name for key in kind.schema if key.name not in batchable)
 
 
 def _input_channels(loads, pieces, data, width) -> tuple[np.ndarray, np.ndarray]:
@@ -1055,6 +1047,10 @@ def _failure(k, b, shape, status, info, solver, near=False) -> ConvergenceError:
             f"the shooting budget max_shootings={solver.max_shootings} ran out{where} with the "
             f"loading path followed to load factor λ = {reached:.6g}", residual, tried,
             load_factor=float(reached))
+    if code == k.SINGULAR:
+        return ConvergenceError(
+            f"jacobians=True: ∂r/∂x is singular at the equilibrium{where} (a critical point, "
+            "where the compliance and the actuation Jacobians do not exist)", residual, tried)
     if code == k.NOT_FINITE:
         return ConvergenceError(f"the solution became non-finite{where}", residual, tried)
     return ConvergenceError(
