@@ -483,6 +483,33 @@ def test_solves_of_different_actuator_structures_on_one_arm_do_not_mix():
                                        rtol=0, atol=1e-11, err_msg=name)
 
 
+def test_a_users_unhashable_routing_solves_like_the_builtin_one():
+    # the arm's solver data remembers actuator structures keyed on their routings; a user's
+    # routing class that cannot be hashed is solved without that memory, to the same numbers
+    # (poses, compliance, actuation Jacobian) as the built-in routing of the same path
+    from softarm.routing import Routing
+
+    class Offset(Routing):
+        __hash__ = None  # (as for any class that defines __eq__ without __hash__)
+
+        def __init__(self, y, z):
+            self.y_coefficients, self.z_coefficients = (y,), (z,)
+
+    arm = Arm.from_stiffness(0.25, **STEEL, mass_per_length=0.02)
+
+    def solved(routing):
+        return softarm.solve(arm, [Gravity(), Tendon(1.2, routing)], s=5, tol=1e-8,
+                             jacobians=True)
+
+    builtin = solved(Straight(0.0, 0.006))
+    for _ in range(2):  # (the second time, the built-in structure is remembered)
+        users = solved(Offset(0.0, 0.006))
+        for name in ("poses", "tip_compliance", "actuation_jacobian", "tendon_length_jacobian"):
+            np.testing.assert_allclose(getattr(users, name), getattr(builtin, name), rtol=1e-12,
+                                       atol=1e-15, err_msg=name)
+    assert np.hypot(*builtin.tip_position[1:]) > 1e-2 * arm.length  # (bent: a real test)
+
+
 def test_no_closed_form_for_curved_paths_or_other_loads():
     arm = Arm.from_stiffness(0.2, **STEEL, mass_per_length=0.02)
     assert softarm.analytic.actuated(arm, [Tendon(1.0, Helix(0.01, 1.0))]) is None

@@ -615,7 +615,11 @@ def _check_tangent(obj, arm) -> None:
     (a tendon folded back along itself has no direction to pull in)."""
     start, end = obj.path_span(arm.length)
     key = (obj.routing, id(arm), start, end)
-    if key in _CHECKED_PATHS:
+    try:
+        if key in _CHECKED_PATHS:
+            return
+    except TypeError:  # a user's routing class that cannot be hashed: checked every time
+        _check_path(obj, arm, start, end)
         return
     _check_path(obj, arm, start, end)
     if len(_CHECKED_PATHS) >= 256:
