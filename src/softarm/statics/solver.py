@@ -124,20 +124,28 @@ class _ArmData:
         self._remembered = {}
 
     def remembered(self, kind: str, key):
-        """What :meth:`remember` stored under (kind, key), or None."""
-        return self._remembered.get(kind, {}).get(key)
+        """What :meth:`remember` stored under (kind, key), or None (also for a key that
+        cannot be hashed: a user's routing class without ``__hash__``)."""
+        try:
+            return self._remembered.get(kind, {}).get(key)
+        except TypeError:
+            return None
 
     def remember(self, kind: str, key, value, most: int = 8):
         """Store ``value`` under (kind, key), keeping at most ``most`` entries of that kind
         (the oldest go); returns it. Solvers in several threads may share an arm's data:
-        every step is one dict operation, and a lost entry is only computed again."""
+        every step is one dict operation, and a lost entry is only computed again. A key
+        that cannot be hashed is not stored (it is computed again each time)."""
         store = self._remembered.setdefault(kind, {})
         while len(store) >= most:
             try:
                 store.pop(next(iter(store)), None)
             except (StopIteration, RuntimeError):  # emptied or changed by another thread
                 break
-        store[key] = value
+        try:
+            store[key] = value
+        except TypeError:
+            pass
         return value
 
     @functools.lru_cache(maxsize=16)  # noqa: B019 (per arm data, itself cached per arm)
@@ -292,13 +300,9 @@ class _Channels:
         if mine is not None and mine[0] == len(self.actuators):
             return mine[1]
         key = (self.starts.tobytes(), self.signature())
-        try:
-            found = self.data.remembered("actuated arm", key)
-        except TypeError:  # a user's routing class that cannot be hashed: not remembered
-            found = self._build_actuated_arm()
-        else:
-            if found is None or found[0][0] is not self.pieces[0]:
-                found = self.data.remember("actuated arm", key, self._build_actuated_arm())
+        found = self.data.remembered("actuated arm", key)
+        if found is None or found[0][0] is not self.pieces[0]:
+            found = self.data.remember("actuated arm", key, self._build_actuated_arm())
         self._actuated = (len(self.actuators), found)
         return found
 
@@ -797,10 +801,7 @@ class Solver:
         if not any(load.inputs for load in loads):  # nothing to build, nothing to remember
             return _input_channels(loads, pieces, self._data, width)
         key = (pieces[0].tobytes(), width, tuple(_structure(load) for load in loads))
-        try:
-            found = self._data.remembered("input channels", key)
-        except TypeError:  # a user's routing class that cannot be hashed: not remembered
-            return _input_channels(loads, pieces, self._data, width)
+        found = self._data.remembered("input channels", key)
         if found is None:
             found = self._data.remember("input channels", key,
                                         _input_channels(loads, pieces, self._data, width))
