@@ -365,6 +365,71 @@ def test_every_new_tangent_term_matches_central_differences():
                                atol=1e-8 * np.abs(base.jacobian_load).max())
 
 
+def test_the_tendon_law_with_and_without_tangents_solves_the_law_equation():
+    # the compiled law alone, on a coupled (non-diagonal) stiffness with three tendons far
+    # from the tendons-along-d1 guess (large shear and torsion): the state-only route (chord
+    # steps after small Newton steps) and the tangent route (Newton throughout, H's Cholesky
+    # factor left for the tangents) against the law equation and its Jacobian in numpy
+    from softarm.statics.solver import _kernels
+
+    k = _kernels()
+    rng = np.random.default_rng(7)
+    A = rng.normal(size=(6, 6))
+    K = np.diag([40.0, 20.0, 25.0, 0.004, 0.006, 0.005])
+    K = K + 0.05 * np.sqrt(np.outer(np.diag(K), np.diag(K))) * (A + A.T) / 2
+    f0 = np.array([[1.0, 0.0, 0.0, 0.5, 1.0, 0.0]])
+    # (y, z) offsets with a helix on the second: bound, radius, 2π n, phase, y0, z0
+    routes = np.array([[0.01, 0.0, 0.0, 0.0, 0.0, 0.01],
+                       [0.012, 0.004, 2 * np.pi * 3.0, 0.4, 0.006, -0.004],
+                       [0.01, 0.0, 0.0, 0.0, -0.007, -0.004]])
+    arm = (np.zeros(1), np.array([0.3]), np.linalg.inv(K)[None], f0, np.zeros((1, 6)), False,
+           0.3, np.ones(6), K[None], routes, np.zeros(3, dtype=np.int64), np.ones((1, 3)),
+           np.zeros((1, 3)), np.zeros((2, 3)))
+    tension = np.array([4.0, 2.5, 1.0])
+    now = np.zeros((1, k.PIECE_LOADS + 3))
+    now[0, k.PIECE_LOADS:] = tension
+    s = 0.11
+    sigma = np.array([-3.0, 6.0, -5.0, 0.01, 0.02, -0.015])  # shear strain ~0.3, twist ~2.5
+
+    def route(a):  # r, r' in the section (material), as Straight + Helix define them
+        angle = routes[a, 3] + routes[a, 2] * s
+        c, sn = np.cos(angle), np.sin(angle)
+        r = np.array([0.0, routes[a, 4] + routes[a, 1] * c, routes[a, 5] + routes[a, 1] * sn])
+        dr = np.array([0.0, -routes[a, 1] * routes[a, 2] * sn, routes[a, 1] * routes[a, 2] * c])
+        return r, dr
+
+    def law_equation(eps):  # K (ε - f⁰) + Σ τ (t; r × t) - σ, and its Jacobian H
+        value, H = K @ (eps - f0[0]) - sigma, K.copy()
+        for a, tau in enumerate(tension):
+            r, dr = route(a)
+            w = eps[:3] + np.cross(eps[3:], r) + dr
+            t = w / np.linalg.norm(w)
+            J = np.hstack([np.eye(3), -hat(r)])
+            value = value + tau * J.T @ t
+            H += tau / np.linalg.norm(w) * J.T @ (np.eye(3) - np.outer(t, t)) @ J
+        return value, H
+
+    strains = {}
+    for tangents in (0, 6):
+        law = k._scratch(1, 3, 7)[8]
+        *eps, factored = k._law(arm, 0, s, now, law, np.int64(tangents), *sigma)
+        eps = np.array(eps)
+        value, H = law_equation(eps)
+        np.testing.assert_allclose(value, 0.0, atol=1e-12 * np.abs(sigma).max())
+        strains[tangents] = eps
+        if tangents:
+            assert factored == 1.0
+            L = np.tril(law[0][:, :6])
+            # H at the point before the last correction: within _LAW_TOL of H at the root
+            np.testing.assert_allclose(L @ L.T, H, rtol=0, atol=1e-8 * np.abs(H).max())
+    assert np.abs(strains[6] - strains[0]).max() < 1e-13 * np.abs(strains[6]).max()
+    # (the guess is far: the first Newton step is larger than a chord step may follow)
+    guess = f0[0] + np.linalg.solve(K, sigma + np.concatenate(
+        [-tension.sum() * np.eye(3)[0], -sum(tau * np.cross(route(a)[0], np.eye(3)[0])
+                                             for a, tau in enumerate(tension))]))
+    assert np.abs(guess - strains[6]).max() > 1e-2
+
+
 def test_tip_compliance_with_tendons_matches_finite_differences():
     arm = Arm.from_stiffness(0.3, EA=50.0, GAy=25.0, GAz=25.0, GJ=0.005, EIy=0.008,
                              EIz=0.008, mass_per_length=0.05)

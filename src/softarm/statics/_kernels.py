@@ -106,6 +106,8 @@ _RHO, _HR, _HW, _HP, _POLY = 0, 1, 2, 3, 4
 # of a correction (strain; curvature times L) below which the next would be at round-off.
 _LAW_ITER = 30
 _LAW_TOL = 1e-9
+# A Newton correction no larger than this may be followed by a chord step (_law).
+_LAW_CHORD = 1e-3
 # Tip channels (TIP_LOADS = 12): the dead tip wrench (spatial), the follower one (material).
 TD, TF = _TD, _TF = 0, 6
 TIP_LOADS = 12
@@ -186,7 +188,7 @@ def _route(routes, a, s):
 
 
 @_jit
-def _law(arm, j, s, now, law, s0, s1, s2, s3, s4, s5):
+def _law(arm, j, s, now, law, tangents, s0, s1, s2, s3, s4, s5):
     """The constitutive law of piece j at arc length s with its actuators (Rucker & Webster
     2011, in total-wrench form): the strains ε = (v; u) solving
 
@@ -197,12 +199,24 @@ def _law(arm, j, s, now, law, s0, s1, s2, s3, s4, s5):
     path in the section. For τ ≥ 0 the left side is the gradient of a strictly convex
     function, so Newton from the tendons-along-d1 guess (exact for straight tendons on a
     diagonal K) converges to the unique root, to round-off: the last correction is at most
-    ``_LAW_TOL`` (strain, curvature × L), so the error left is of its square. On return
-    ``law[0][:, :6]`` holds the Jacobian H = K + Σ τ Jᵀ (I - t tᵀ) J / |w|, J = [I, -r~]
-    (the tangents' linear map is H⁻¹) and ``law[1][a]`` = (t, |w|, y, z, dy, dz) of every
-    active actuator, both at the point before that last correction (so within ``_LAW_TOL``
-    relative of their values at the root). NaN strains if Newton fails (|w| → 0: a tendon
-    path folded onto itself).
+    ``_LAW_TOL`` (strain, curvature × L), so the error left is of its square.
+
+    With ``tangents`` > 0 (the caller maps that many tangent columns with H⁻¹), every
+    correction is a Newton step, and on return ``law[0][:, :6]`` holds
+    H = K + Σ τ Jᵀ (I - t tᵀ) J / |w|, J = [I, -r~], at the point before the last
+    correction (within ``_LAW_TOL`` relative of its value at the root): its Cholesky
+    factor L (lower triangle) when the 7th value returned is 1.0, else H itself (no
+    tendon, or a tension < 0: not definite).
+    ``law[1][a]`` = (t, |w|, y, z, dy, dz) of every active actuator at that same point.
+
+    With ``tangents`` = 0 (a state-only stage, a station), a correction that follows a
+    Newton step reuses that step's factor (a chord step: the residual only, no new H): its
+    own error is of the order of the two corrections' product, so after a small Newton
+    step (at most ``_LAW_CHORD``; from the tendons-along-d1 guess, about 1e-4) it converges
+    as a Newton step would; a chord step not yet below ``_LAW_TOL`` is followed by a Newton
+    step.
+    ``law[0]`` is then scratch. NaN strains if Newton fails (|w| → 0: a tendon path folded
+    onto itself).
     """
     f0, C, K = arm[3], arm[2], arm[8]
     routes, kinds, active = arm[9], arm[10], arm[11]
@@ -240,16 +254,22 @@ def _law(arm, j, s, now, law, s0, s1, s2, s3, s4, s5):
         for k in range(6):
             M[i, k] = K[j, i, k]
     if tendons == 0:
-        return eps[0], eps[1], eps[2], eps[3], eps[4], eps[5]
+        return eps[0], eps[1], eps[2], eps[3], eps[4], eps[5], 0.0
     F, H = vec[1], jw
+    factored = False  # M[:, :6] holds the Cholesky factor of the last Newton step's H
+    chord = False  # the next correction may reuse it
     for _ in range(_LAW_ITER):
+        newton = not chord
         v0, v1, v2, u0, u1, u2 = eps[0], eps[1], eps[2], eps[3], eps[4], eps[5]
         for i in range(6):
             acc = -rhs[i]
             for k in range(6):
                 acc += K[j, i, k] * (eps[k] - f0[j, k])
-                H[i, k] = K[j, i, k]
             F[i] = acc
+        if newton:
+            for i in range(6):
+                for k in range(6):
+                    H[i, k] = K[j, i, k]
         for a in range(routes.shape[0]):
             if active[j, a] == 0.0 or kinds[a] == CHAMBER:
                 continue
@@ -271,6 +291,8 @@ def _law(arm, j, s, now, law, s0, s1, s2, s3, s4, s5):
             F[3] += q * g3
             F[4] += q * g4
             F[5] += q * g5
+            if not newton:
+                continue
             # H += τ/|w| Jᵀ (I - t tᵀ) J = c (JᵀJ - g gᵀ), J = [I | N], N = -r~ =
             # (0 z -y; -z 0 0; y 0 0): JᵀJ = (I N; Nᵀ NᵀN), NᵀN = |r|² I - r rᵀ
             c = q / nw
@@ -295,27 +317,36 @@ def _law(arm, j, s, now, law, s0, s1, s2, s3, s4, s5):
                 ci = c * g[i]
                 for k in range(6):
                     H[i, k] -= ci * g[k]
-        if not _cholesky_correction(H, F, M):  # τ < 0 somewhere: not definite
+        if not newton:
+            _cholesky_solve(M, F)  # the chord step, with the factor of the step before
+        elif _cholesky_correction(H, F, M):
+            factored = True
+        else:  # τ < 0 somewhere: not definite
+            factored = False
             for i in range(6):
                 for k in range(6):
                     M[i, k] = H[i, k]
                 M[i, 6] = -F[i]
             if _eliminate_columns(M, np.int64(1)) == 0.0:
-                return np.nan, np.nan, np.nan, np.nan, np.nan, np.nan
+                return np.nan, np.nan, np.nan, np.nan, np.nan, np.nan, 0.0
         size = 0.0
         for i in range(6):
             eps[i] += M[i, 6]
             size = max(size, abs(M[i, 6]) * (length if i >= 3 else 1.0))
         if not math.isfinite(size):
-            return np.nan, np.nan, np.nan, np.nan, np.nan, np.nan
+            return np.nan, np.nan, np.nan, np.nan, np.nan, np.nan, 0.0
         if size <= _LAW_TOL:
             # converged (the next correction would be ~ size²); H is the Jacobian before
             # this last correction, within ~size of the one at ε (t and |w| likewise)
+            if factored:
+                return eps[0], eps[1], eps[2], eps[3], eps[4], eps[5], 1.0
             for i in range(6):
                 for k in range(6):
                     M[i, k] = H[i, k]
-            return eps[0], eps[1], eps[2], eps[3], eps[4], eps[5]
-    return np.nan, np.nan, np.nan, np.nan, np.nan, np.nan
+            return eps[0], eps[1], eps[2], eps[3], eps[4], eps[5], 0.0
+        # a chord step follows a small Newton step only, and is followed by a Newton step
+        chord = newton and factored and tangents == 0 and size <= _LAW_CHORD
+    return np.nan, np.nan, np.nan, np.nan, np.nan, np.nan, 0.0
 
 
 @_inline
@@ -337,17 +368,33 @@ def _cholesky_correction(H, F, M):
             for k in range(c):
                 acc -= M[i, k] * M[c, k]
             M[i, c] = acc / d
-    for i in range(6):  # L z = -F
-        acc = -F[i]
-        for k in range(i):
-            acc -= M[i, k] * M[k, 6]
-        M[i, 6] = acc / M[i, i]
-    for i in range(5, -1, -1):  # Lᵀ δ = z
-        acc = M[i, 6]
-        for k in range(i + 1, 6):
-            acc -= M[k, i] * M[k, 6]
-        M[i, 6] = acc / M[i, i]
+    _cholesky_solve(M, F)
     return True
+
+
+@_inline
+def _cholesky_solve(M, F):
+    """M[:, 6] = -(L Lᵀ)⁻¹ F, L the Cholesky factor in M[:, :6]'s lower triangle."""
+    for i in range(6):
+        M[i, 6] = -F[i]
+    _cholesky_substitute(M, np.int64(1))
+
+
+@_jit
+def _cholesky_substitute(M, k):
+    """Solve L Lᵀ X = M[:, 6:6+k] in place (X overwrites those k columns), L the Cholesky
+    factor in M[:, :6]'s lower triangle (kept)."""
+    for col in range(6, 6 + k):
+        for i in range(6):  # L z = b
+            acc = M[i, col]
+            for q in range(i):
+                acc -= M[i, q] * M[q, col]
+            M[i, col] = acc / M[i, i]
+        for i in range(5, -1, -1):  # Lᵀ x = z
+            acc = M[i, col]
+            for q in range(i + 1, 6):
+                acc -= M[q, i] * M[q, col]
+            M[i, col] = acc / M[i, i]
 
 
 @_jit
@@ -417,9 +464,11 @@ def _deriv(work, twork, nt, stage, s, arm, j, now, rate, law):
     s5 = R02 * mx + R12 * my + R22 * mz
     actuated = _actuated(arm, j)
     if actuated:
-        v0, v1, v2, u0, u1, u2 = _law(arm, j, s, now, law, s0, s1, s2, s3, s4, s5)
+        v0, v1, v2, u0, u1, u2, factored = _law(arm, j, s, now, law, nt, s0, s1, s2, s3,
+                                                s4, s5)
     else:
         v0, v1, v2, u0, u1, u2 = _strain(C, f0, j, diag, s0, s1, s2, s3, s4, s5)
+        factored = 0.0
     # follower loads in spatial components: R f_f, R l_f
     ff0, ff1, ff2 = now[j, _FF], now[j, _FF + 1], now[j, _FF + 2]
     lf0, lf1, lf2 = now[j, _LF], now[j, _LF + 1], now[j, _LF + 2]
@@ -461,9 +510,10 @@ def _deriv(work, twork, nt, stage, s, arm, j, now, rate, law):
     if nt == 0:
         return
     # δσ = (Rᵀδn + σ_n × δθ; Rᵀδm + σ_m × δθ), then δ(v; u) = dstrain δσ (+ the actuators'
-    # own change with λ), all columns at once: one factorisation of H when actuated
-    # (a passive arm's δ(v; u) are computed in the loop below, in registers: one loop, no
-    # round trip through memory; an actuated one's need one solve with H for all columns)
+    # own change with λ), all columns at once (a passive arm's δ(v; u) are computed in the
+    # loop below, in registers: one loop, no round trip through memory; an actuated one's
+    # need one solve with H for all columns, by substitution with the Cholesky factor the
+    # law left, or by elimination where it left H itself)
     M = law[0]
     for d in range(nt if actuated else 0):
         t = twork[Y, d]
@@ -482,7 +532,9 @@ def _deriv(work, twork, nt, stage, s, arm, j, now, rate, law):
             for i in range(6):
                 M[i, 6 + d] += law[2][4, i]
                 law[2][4, i] = 0.0
-        if _eliminate_columns(M, nt) == 0.0:
+        if factored > 0.0:  # H's Cholesky factor, from the law's last Newton step
+            _cholesky_substitute(M, nt)
+        elif _eliminate_columns(M, nt) == 0.0:
             for d in range(nt):
                 for i in range(6):
                     M[i, 6 + d] = np.nan
@@ -1110,13 +1162,14 @@ def _tangent(J, t):
 
 @_jit
 def _follow(x, steps, base, arm, case, scratch, scale, dscale, length, threshold,
-            max_iterations, max_load_step, max_shootings, open_end, r, J, tip, counter,
-            reached):
+            max_iterations, max_load_step, max_shootings, open_end, final, r, J, tip,
+            counter, reached):
     """Follow the equilibrium path from λ = 0 (x: the solution there, exact or close) to
     λ = 1 by predictor–corrector continuation. True on success, with x, r, J (7 columns) and
-    the tip position at λ = 1 (converged to ``_LOOSE``: the caller refines it); otherwise
-    ``reached[0]`` is the last load factor reached (a fold, or a point the path cannot be
-    followed past).
+    the tip position at λ = 1, converged as the caller's own corrector would leave them (a
+    last step no larger than ``final``, or the threshold: no refinement is needed on these
+    steps); otherwise ``reached[0]`` is the last load factor reached (a fold, or a point the
+    path cannot be followed past). Points on the way are converged to ``_LOOSE``.
 
     Predictor: the tangent dx/dλ = -J_x⁻¹ J_λ from the variational equations for the first
     step, then the cubic Hermite extrapolation of the last two points and their tangents.
@@ -1179,7 +1232,8 @@ def _follow(x, steps, base, arm, case, scratch, scale, dscale, length, threshold
         for i in range(6):
             dx[i] = x[i]  # the prediction
         ok = _corrector(x, target, nt, steps, base, arm, case, scratch, scale, dscale, length,
-                        threshold, max_iterations, _DIST_MAX, _LOOSE, r, J, tip, counter)
+                        threshold, max_iterations, _DIST_MAX,
+                        final if target == 1.0 else _LOOSE, r, J, tip, counter)
         if ok:
             for i in range(6):
                 dx[i] = x[i] - dx[i]  # the corrector's distance from the prediction
@@ -1239,8 +1293,8 @@ def _write(y, T, nt, j, s, arm, now, law, pose, strain, stress, E):
                          + y[_R + 6 + i] * y[_M + 2])
     if _actuated(arm, j):
         f0, K = arm[3], arm[8]
-        eps = _law(arm, j, s, now, law, stress[0], stress[1], stress[2], stress[3],
-                   stress[4], stress[5])
+        eps = _law(arm, j, s, now, law, np.int64(0), stress[0], stress[1], stress[2],
+                   stress[3], stress[4], stress[5])
         for i in range(6):
             strain[i] = eps[i] - f0[j, i]
         for i in range(6):
@@ -1697,8 +1751,8 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
                         x[i] = memory[_MXF + i]  # close: corrected at λ = 0
                 coarse = n_path < N  # the last step is corrected on the grid of N
                 if not _follow(x, steps, base, arm, case, scratch, scale, dscale, length,
-                               threshold, max_iterations, max_load_step, budget, coarse, r,
-                               J, tip_c, counter, reached):
+                               threshold, max_iterations, max_load_step, budget, coarse,
+                               final_step, r, J, tip_c, counter, reached):
                     if counter[0] > budget:
                         status[b] = BUDGET
                         break
@@ -1715,19 +1769,16 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
                         continue
                     status[b] = PATH_FAILED
                     break
-                # the coarse solution at N, from the end of the path (a checked Newton; from
-                # the last prediction when the path ran on the coarser grid)
+                # the coarse solution at N: the end of a path on N steps; from the last
+                # prediction of a path on a coarser grid, a checked Newton
                 _fill_steps(length, arm[1], N, np.int64(1), steps)
-                if not _corrector(x, 1.0, six, steps, base, arm, case, scratch, scale,
-                                  dscale, length, threshold, max_iterations,
-                                  _DIST_MAX if coarse else _REFINE_MAX, final_step, r, J,
-                                  tip_c, counter) or (
-                                      coarse and _det_sign(J) != reached[1]):
-                    if n_path < N:
-                        fine_path = True
-                        continue
-                    status[b] = NEWTON_FAILED
-                    break
+                if coarse and (not _corrector(x, 1.0, six, steps, base, arm, case, scratch,
+                                              scale, dscale, length, threshold,
+                                              max_iterations, _DIST_MAX, final_step, r, J,
+                                              tip_c, counter)
+                               or _det_sign(J) != reached[1]):
+                    fine_path = True
+                    continue
                 _copy(J, J_c)
             if counter[0] > budget:
                 status[b] = BUDGET
