@@ -368,8 +368,8 @@ def test_every_new_tangent_term_matches_central_differences():
 def test_the_tendon_law_with_and_without_tangents_solves_the_law_equation():
     # the compiled law alone, on a coupled (non-diagonal) stiffness with three tendons far
     # from the tendons-along-d1 guess (large shear and torsion): the state-only route (chord
-    # steps after small Newton steps) and the tangent route (Newton throughout, H's Cholesky
-    # factor left for the tangents) against the law equation and its Jacobian in numpy
+    # steps after small Newton steps) and the tangent route (Newton throughout, H's LDLᵀ
+    # factors left for the tangents) against the law equation and its Jacobian in numpy
     from softarm.statics.solver import _kernels
 
     k = _kernels()
@@ -419,9 +419,11 @@ def test_the_tendon_law_with_and_without_tangents_solves_the_law_equation():
         strains[tangents] = eps
         if tangents:
             assert factored == 1.0
-            L = np.tril(law[0][:, :6])
-            # H at the point before the last correction: within _LAW_TOL of H at the root
-            np.testing.assert_allclose(L @ L.T, H, rtol=0, atol=1e-8 * np.abs(H).max())
+            # L (unit diagonal) below the diagonal, 1/D on it: H = L D Lᵀ at the point
+            # before the last correction, within _LAW_TOL of H at the root
+            L = np.tril(law[0][:, :6], -1) + np.eye(6)
+            D = np.diag(1.0 / np.diag(law[0][:, :6]))
+            np.testing.assert_allclose(L @ D @ L.T, H, rtol=0, atol=1e-8 * np.abs(H).max())
     assert np.abs(strains[6] - strains[0]).max() < 1e-13 * np.abs(strains[6]).max()
     # (the guess is far: the first Newton step is larger than a chord step may follow)
     guess = f0[0] + np.linalg.solve(K, sigma + np.concatenate(
