@@ -619,9 +619,10 @@ def _check_tangent(obj, arm) -> None:
         if key in _CHECKED_PATHS:
             return
     except TypeError:  # a user's routing class that cannot be hashed: checked every time
-        _check_path(obj, arm, start, end)
-        return
+        key = None
     _check_path(obj, arm, start, end)
+    if key is None:
+        return
     if len(_CHECKED_PATHS) >= 256:
         _CHECKED_PATHS.pop(next(iter(_CHECKED_PATHS)))
     _CHECKED_PATHS[key] = arm
