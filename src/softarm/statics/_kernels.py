@@ -250,10 +250,10 @@ def _law(arm, j, s, now, law, tangents, s0, s1, s2, s3, s4, s5):
         for k in range(6):
             acc += C[j, i, k] * g[k]
         eps[i] = acc
-    for i in range(6):
-        for k in range(6):
-            M[i, k] = K[j, i, k]
-    if tendons == 0:
+    if tendons == 0:  # (else the factors or H itself overwrite M[:, :6])
+        for i in range(6):
+            for k in range(6):
+                M[i, k] = K[j, i, k]
         return eps[0], eps[1], eps[2], eps[3], eps[4], eps[5], 0.0
     F, H = vec[1], jw
     factored = False  # M[:, :6] holds the LDLᵀ factors of the last Newton step's H
