@@ -3,7 +3,8 @@
 The calls the issues time one at a time: a solve of the Mattiasson cantilever (k = 5), the
 3-tendon robot's solve (benchmarks/actuation.py) with 101 stations and with the tip only, a
 warm solve with the tip compliance and three tendon columns (101 stations and the tip
-only), and a tracked target of inverse statics. Each call is timed whole, and the time
+only; then the same by the prepared ``ForwardSolver``), and a tracked target of inverse
+statics. Each call is timed whole, and the time
 inside the compiled kernels (``solve_cases``, ``stability_cases``, ``inverse_newton``) is
 summed by wrappers around them (under a microsecond a call); the rest is Python: checking
 the loads, filling the load channels, the stability verdict's and the Equilibrium's
@@ -93,6 +94,8 @@ def main(argv=None):
     phase = np.linspace(0.0, 2 * np.pi, 1000, endpoint=False)
     pattern = 1.5 + 1.2 * np.cos(phase[:, None] - 2 * np.pi * np.arange(3) / 3)
     path = softarm.solve(arm, loads(pattern), tol=1e-10).tip_position
+    model = softarm.ForwardSolver(arm, tendons, [gravity], tol=1e-6)
+    model.solve(near)
     tracker = softarm.InverseSolver(arm, tendons, [gravity], s=[L])
     tracker.track(path[:20])
 
@@ -110,6 +113,8 @@ def main(argv=None):
         ("the same, the tip only",
          lambda case: control_tip.solve(case, jacobians=True),
          lambda i: (loads(near + 1e-3 * np.sin(0.1 * i + np.arange(3))),)),
+        ("the same by ForwardSolver.solve (prepared once; the tip only)",
+         model.solve, lambda i: (near + 1e-3 * np.sin(0.1 * i + np.arange(3)),)),
         ("a tracked target along a circle, the tip only (InverseSolver.solve, warm)",
          tracker.solve, lambda i: (path[(20 + i) % len(path)],)),
     ]

@@ -425,3 +425,101 @@ def test_the_compiled_rotation_log_equals_the_lie_module():
         R = so3.exp(angle * axis)
         k._rotation_log(np.ascontiguousarray(R), out)
         np.testing.assert_allclose(out, so3.log(R), rtol=0, atol=1e-12)
+
+
+# ---------------------------------------------------------------- ForwardSolver (the loop's call)
+
+
+def test_the_forward_solver_returns_the_solvers_answer_with_one_integration_fewer():
+    """ForwardSolver against Solver.solve(jacobians=True) at the same inputs in the same order
+    (the unprepared route, whose path starts with an integration at the last loads): the
+    same tip, actuation Jacobian, compliance, tendon lengths and their Jacobian, verdict.
+    A fixed-tension tendon among the other loads puts an input before the actuators'. On
+    small steps the prediction -J_x⁻¹ J_q Δq replaces that first integration (the kernel's
+    shooting count, against the same prepared call without Jacobians, which has no
+    prediction); a large jump is refused by it (its corrector moves too far from it) and
+    takes the path."""
+    arm = robot()
+    fixed = [GRAVITY, softarm.Tendon(0.3, Straight(0.0, -0.008)),
+             softarm.TipLoad(force=[0.0, 0.02, 0.0])]
+    base = np.array([2.0, 1.0, 0.5])
+    inputs = [base + 1e-3 * np.sin(0.3 * k + np.arange(3)) for k in range(12)]
+    jump = base + np.array([6.0, 0.0, 0.0])
+    inputs += [jump] + [jump + np.array([0.0, 0.0, 1e-3 * k]) for k in range(1, 4)]
+    model = softarm.ForwardSolver(arm, tendons(), fixed)
+    bare = softarm.statics.Solver(arm, s=[L], tol=1e-6).prepared(
+        [*fixed, *tendons()], jacobians=False)
+    solver = softarm.statics.Solver(arm, s=[L], tol=1e-6)
+    saved = []
+    for k, q in enumerate(inputs):
+        state = model.solve(q)
+        eq = solver.solve([*fixed, *tendons(q)], jacobians=True)
+        # (both converged to the kernel's residual threshold, 1e-12 of the load)
+        np.testing.assert_allclose(state.tip, eq.tip, rtol=0, atol=1e-10)
+        np.testing.assert_allclose(state.actuation_jacobian, eq.actuation_jacobian[:, 1:],
+                                   rtol=0, atol=1e-9 * np.abs(eq.actuation_jacobian).max())
+        np.testing.assert_allclose(state.tip_compliance, eq.tip_compliance, rtol=0,
+                                   atol=1e-9 * np.abs(eq.tip_compliance).max())
+        np.testing.assert_allclose(state.tendon_lengths, eq.tendon_lengths[1:], rtol=1e-13)
+        np.testing.assert_allclose(state.tendon_length_jacobian,
+                                   eq.tendon_length_jacobian[1:, 1:], rtol=0, atol=1e-12)
+        np.testing.assert_allclose(state.base_wrench, eq.base_wrench, rtol=0, atol=1e-9)
+        assert state.error_estimate <= 1e-6 * L
+        assert (state.stability.index, state.stability.stable) == (0, True)
+        assert eq.stability.index == 0
+        bare.solve([0.3, *q])
+        np.testing.assert_allclose(bare.poses[-1], eq.tip, rtol=0, atol=1e-10)
+        if k:
+            saved.append(bare.info[3] - model._prepared.info[3])
+    # the jump: the prediction is tried (an integration or two) and refused, the path runs
+    assert saved[:11] == [1] * 11 and saved[11] < 0 and min(saved[12:]) >= 1, saved
+
+
+def test_the_forward_solvers_equilibrium_is_the_solvers():
+    """ForwardSolver.equilibrium() (every station) against softarm.solve from the unloaded
+    arm, and the answer's fields against the Equilibrium's."""
+    arm = robot()
+    model = softarm.ForwardSolver(arm, tendons(), [GRAVITY], s=None)
+    for q in ([0.5, 1.0, 2.0], [0.6, 1.0, 2.0]):
+        state = model.solve(q)
+        eq = model.equilibrium()
+        ref = forward(arm, q)
+        assert eq.s.size == 101
+        np.testing.assert_allclose(eq.poses, ref.poses, rtol=0, atol=2e-6 * L)
+        np.testing.assert_allclose(eq.tendon_tensions, q, rtol=1e-15)
+        np.testing.assert_allclose(eq.tendon_lengths, ref.tendon_lengths, rtol=0, atol=2e-6 * L)
+        np.testing.assert_array_equal(state.tip, eq.tip)
+        np.testing.assert_array_equal(state.actuation_jacobian, eq.actuation_jacobian)
+        np.testing.assert_array_equal(state.tip_compliance, eq.tip_compliance)
+        assert eq.stability.stable and eq.error_estimate == state.error_estimate
+        np.testing.assert_array_equal(model.inputs, q)
+
+
+def test_the_forward_solver_warns_of_an_unstable_answer():
+    """The straight column under 1.5 times Euler's load with a slack tendon: Morse index 2
+    (both bending planes, buckling.json's Euler column), returned with a StabilityWarning."""
+    arm = softarm.Arm.from_stiffness(1.0, EA=1e6, GAy=1e6, GAz=1e6, GJ=1.0, EIy=1.0, EIz=1.0)
+    fixed = [softarm.TipLoad(force=[-1.5 * np.pi ** 2 / 4, 0.0, 0.0])]
+    model = softarm.ForwardSolver(arm, [softarm.Tendon(0.0, Straight(0.0, 0.01))], fixed)
+    with pytest.warns(softarm.StabilityWarning, match="Morse index 2"):
+        state = model.solve([0.0])
+    assert (state.stability.index, state.stability.stable) == (2, False)
+    np.testing.assert_allclose(state.tip_position, [1.0 - 1.5 * np.pi ** 2 / 4 / 1e6, 0, 0],
+                               atol=1e-9)
+
+
+def test_the_forward_solver_names_bad_input():
+    arm = robot()
+    model = softarm.ForwardSolver(arm, tendons(), [GRAVITY])
+    for bad in ([1.0, 2.0], [1.0, np.nan, 0.0], [1.0, -0.5, 0.0], [[1.0, 2.0, 3.0]]):
+        with pytest.raises(ValueError, match="inputs must be 3 finite numbers"):
+            model.solve(bad)
+    with pytest.raises(ValueError, match="no solution yet"):
+        model.equilibrium()
+    with pytest.raises(ValueError, match="tension-controlled"):
+        softarm.ForwardSolver(arm, [softarm.Tendon(displacement=0.001, routing=Straight(0, 0.008))])
+    with pytest.raises(TypeError, match="actuation inputs"):
+        softarm.ForwardSolver(arm, [GRAVITY])
+    model.solve([0.0, 0.0, 1.0])  # a refused call lost nothing
+    np.testing.assert_allclose(model.solve([0.0, 0.0, 1.0]).tip, forward(arm, [0, 0, 1.0]).tip,
+                               atol=2e-6 * L)

@@ -8,7 +8,7 @@ __version__ = "0.1.0"  # first, so that submodules may import it
 
 from . import analytic, routing, sweep
 from .case import Case, CaseError, load_case
-from .control import InverseResult, InverseSolver, inverse
+from .control import ForwardResult, ForwardSolver, InverseResult, InverseSolver, inverse
 from .dispatch import solve
 from .equilibrium import Equilibrium, Stability
 from .errors import ApproximationWarning, ConvergenceError, StabilityWarning
@@ -40,6 +40,8 @@ __all__ = [
     "DistributedForce",
     "DistributedMoment",
     "Equilibrium",
+    "ForwardResult",
+    "ForwardSolver",
     "Gravity",
     "InverseResult",
     "InverseSolver",

@@ -27,28 +27,56 @@ import numpy as np
 
 from ._bounded import regularised_step
 from ._validate import count, real
-from .dispatch import warn_unstable
+from .dispatch import warn_unstable, warn_verdict
 from .equilibrium import Equilibrium, Stability
 from .errors import ConvergenceError
 from .loads import as_loads
 from .statics import Solver
-from .statics.solver import _kernels
+from .statics.solver import Snapshot, _kernels
 
-__all__ = ["InverseResult", "InverseSolver", "inverse"]
+__all__ = ["ForwardResult", "ForwardSolver", "InverseResult", "InverseSolver", "inverse"]
 
 _EYE3 = np.eye(3)
 
 
 class _Warm(NamedTuple):
-    """The fast route's last answer, where the next target's warm step starts."""
+    """The fast route's last answer, where the next target's warm step starts (with the
+    actuation Jacobian A (6, n) and J_x⁻¹ [r | J_q] (6, 1 + n) of the last integration,
+    left in the fast route's arrays, ``_FastArrays``)."""
 
     q: np.ndarray  # the inputs
     x: np.ndarray  # the base reaction (N, N m, spatial)
     tip: np.ndarray  # the tip state (12,): p, then R row-major
-    A: np.ndarray  # the actuation Jacobian (6, n) of the last integration
-    G: np.ndarray  # J_x⁻¹ [r | J_q] (6, 1 + n) of the last integration
     miss: tuple | None  # what the linear warm step missed: (in q, in x, its task step)
     redundant: bool  # whether the task is redundant there
+
+
+class _FastArrays(NamedTuple):
+    """The arrays of the kernel's ``inverse_newton`` for n inputs and a task of size t,
+    allocated once (a tracked target's Python is its cost, not its arithmetic)."""
+
+    target: np.ndarray  # (3,)
+    weights: np.ndarray  # (t,)
+    settings: np.ndarray  # (4,)
+    on: np.ndarray  # [1.0]
+    off: np.ndarray  # [0.0]
+    zeros: tuple  # a warm tip (12,), miss q (n,), miss x (6,), miss task step (t,)
+    A: np.ndarray  # (6, n), read by the next warm step
+    G: np.ndarray  # (6, 1 + n), likewise
+    J: np.ndarray  # (t, n)
+    linear: tuple  # x (6,), q (n,), its linear prediction (n,), G (6, 1 + n), e (t,)
+    singular: np.ndarray  # (min(t, n),)
+    info: np.ndarray  # (4,)
+
+    @classmethod
+    def of(cls, n, t, weights, A, G):
+        """The arrays for a task of size t, sharing A and G with the other task size's (the
+        warm step may follow an answer of either)."""
+        return cls(np.empty(3), weights, np.empty(4), np.ones(1), np.zeros(1),
+                   (np.zeros(12), np.zeros(n), np.zeros(6), np.zeros(t)),
+                   A, G, np.empty((t, n)),
+                   (np.empty(6), np.empty(n), np.empty(n), np.empty((6, 1 + n)),
+                    np.empty(t)), np.empty(min(t, n)), np.zeros(4))
 
 
 @dataclass(frozen=True)
@@ -87,6 +115,193 @@ class InverseResult:
     iterations: int | np.ndarray
     at_bound: np.ndarray
     condition: float | np.ndarray
+
+
+class ForwardResult(NamedTuple):
+    """One answer of :meth:`ForwardSolver.solve`: what a controller reads, as arrays of its
+    own (not views of the solver's buffers). A named tuple: immutable, and built in half a
+    microsecond (a frozen dataclass costs several, in a call of a quarter millisecond).
+
+    Attributes
+    ----------
+    inputs : ndarray, shape (n,)
+        The actuation inputs solved at (the actuators' input fields in order: each tendon's
+        tension in N, each chamber's pressure in Pa, each field's B0 components in T).
+    tip : ndarray, shape (4, 4)
+        The tip pose (spatial).
+    actuation_jacobian : ndarray, shape (6, n) or None
+        The tip's (δp; δθ), spatial components, per unit change of each input (the
+        implicit function theorem, as ``Equilibrium.actuation_jacobian``); None without
+        ``jacobians``.
+    tip_compliance : ndarray, shape (6, 6) or None
+        The tip's (δp; δθ) per dead tip wrench (δn; δm), all spatial
+        (``Equilibrium.tip_compliance``); None without ``jacobians``.
+    tendon_lengths : ndarray, shape (T,)
+        Each actuator tendon's length (m), in the order of the actuators.
+    tendon_length_jacobian : ndarray, shape (T, n) or None
+        ∂(tendon lengths)/∂(inputs) (m per input unit); None without ``jacobians``.
+    base_wrench : ndarray, shape (6,)
+        The total wrench at the clamp (N, N m, spatial).
+    error_estimate : float
+        The tip position error estimate (m), ≤ tol · L.
+    stability : Stability or None
+        The verdict (``Equilibrium.stability``); None if the solver was made with
+        ``stability=False``.
+    """
+
+    inputs: np.ndarray
+    tip: np.ndarray
+    actuation_jacobian: np.ndarray | None
+    tip_compliance: np.ndarray | None
+    tendon_lengths: np.ndarray
+    tendon_length_jacobian: np.ndarray | None
+    base_wrench: np.ndarray
+    error_estimate: float
+    stability: Stability | None
+
+    @property
+    def tip_position(self) -> np.ndarray:
+        """The tip position (m, spatial), shape (3,)."""
+        return self.tip[:3, 3]
+
+
+class ForwardSolver:
+    """The forward model of an actuated arm for a control loop: the equilibrium, tip
+    compliance and actuation Jacobian at given actuation inputs, solved quasi-statically
+    from the last call's equilibrium, in a fraction of a millisecond.
+
+    A prepared :meth:`Solver.solve <softarm.statics.Solver.solve>`: the same kernels and the
+    same answer (tol, error estimate, stability verdict and its warning), with the loads
+    prepared once and only the inputs changing between calls (``Solver.prepared``), and
+    one more saving where only the inputs changed: the last answer's exact tangent
+    -J_x⁻¹ J_q Δq predicts the new base reaction, so the loading path takes one correction
+    instead of an integration at its start and a correction at its end (docs/control.md).
+
+    Parameters
+    ----------
+    arm : Arm or SegmentedArm
+    actuators : sequence of loads with actuation inputs (``Tendon``, ``Chamber``,
+        ``MagneticField``), unbatched, tension-controlled; their current values are where
+        the first call starts from (the arm is at rest before it).
+    loads : sequence of loads, optional
+        The other loads (gravity, a payload), held fixed.
+    tol : float
+        Tip position tolerance relative to L.
+    s : stations (default: the tip only, ``[L]``; None for 101 uniform stations), read from
+        :meth:`equilibrium`.
+    jacobians : bool
+        Return the actuation Jacobian, the tip compliance and the tendon length Jacobian
+        (default True).
+    stability : bool
+        Compute each answer's stability verdict (default True), with a
+        :class:`~softarm.StabilityWarning` for an unstable one.
+
+    Examples
+    --------
+    >>> import softarm
+    >>> from softarm.routing import Straight
+    >>> arm = softarm.Arm.from_stiffness(0.2, EA=1e4, GAy=1e4, GAz=1e4, GJ=0.01, EIy=0.01,
+    ...                                  EIz=0.01)
+    >>> model = softarm.ForwardSolver(arm, [softarm.Tendon(0.0, Straight(0.0, 0.01))])
+    >>> state = model.solve([0.5])
+    >>> # a straight tendon bends the arm into a circular arc of curvature r τ / EI and
+    >>> # shortens it by τ / EA (the closed form of docs/actuation.md)
+    >>> kappa, stretch = 0.01 * 0.5 / 0.01, 1.0 - 0.5 / 1e4
+    >>> bool(abs(state.tip_position[0] - stretch * np.sin(kappa * 0.2) / kappa) < 1e-6 * 0.2)
+    True
+    """
+
+    def __init__(self, arm, actuators, loads=(), *, tol=1e-6, s="tip", jacobians=True,
+                 stability=True):
+        self.arm = arm
+        self.actuators = as_loads(actuators)
+        for load in self.actuators:
+            if not load.inputs:
+                raise TypeError(f"actuators must be loads with actuation inputs (Tendon, "
+                                f"Chamber, MagneticField), got {load!r}")
+            if load.batch_shape != ():
+                raise ValueError(f"actuators must be single (unbatched) loads, got "
+                                 f"{type(load).__name__} of batch shape {load.batch_shape}")
+            if load.displacement_controlled:
+                raise ValueError("ForwardSolver takes tension-controlled tendons (a "
+                                 "displacement-controlled Tendon's tension is an unknown of "
+                                 "the problem, solved by softarm.solve or Solver.solve)")
+        self.loads = as_loads(loads)
+        if isinstance(s, str) and s == "tip":
+            s = [float(arm.length)]
+        self.solver = Solver(arm, s=s, tol=tol, stability=stability)
+        self._prepared = self.solver.prepared([*self.loads, *self.actuators],
+                                              jacobians=jacobians)
+        every = self._prepared.inputs
+        first = sum(_input_count(load) for load in self.loads)
+        self.n_inputs = every.size - first
+        self._every = every.copy()  # the fixed loads' inputs, then the actuators' slots
+        self._slots = slice(first, first + self.n_inputs)
+        self._columns = slice(6 + first, 6 + first + self.n_inputs)  # of the Jacobians
+        # the least value of each input: 0 for a tension, else -inf excluded (finite)
+        self._lowest = np.array([0.0 if name == "tension" else -np.finfo(float).max
+                                 for load in self.actuators for name in load.inputs
+                                 for _ in range(int(np.size(getattr(load, name))))])
+        # the actuator tendons' columns among the Solver's actuators (one column per
+        # tendon or chamber, in load order; the fixed loads' come first): of `lengths`
+        # and, after 6, of the Jacobian's rows
+        columns = [(i, load.kind) for i, load in enumerate([*self.loads, *self.actuators])
+                   if load.kind in ("tendon", "chamber")]
+        self._lengths = np.array([a for a, (i, kind) in enumerate(columns)
+                                  if kind == "tendon" and i >= len(self.loads)],
+                                 dtype=np.int64)
+        self._length_rows = 6 + self._lengths
+        self.jacobians = bool(jacobians)
+        self._stability = bool(stability)
+
+    @property
+    def inputs(self) -> np.ndarray:
+        """The actuators' inputs of the last call (at first their given values), (n,)."""
+        return self._every[self._slots].copy()
+
+    def solve(self, inputs) -> ForwardResult:
+        """The equilibrium at ``inputs`` (shape (n,): the actuators' input fields in order),
+        reached quasi-statically from the last call's. ValueError for inputs of another
+        shape, non-finite ones or a negative tension; ConvergenceError if the solver fails
+        (the next call then starts from the unloaded arm)."""
+        q = np.asarray(inputs, dtype=np.float64)
+        # (one comparison: NaN fails it, and so does -inf; +inf the second)
+        if q.shape != (self.n_inputs,) or not (
+                ((q >= self._lowest) & (q < np.inf)).all()):
+            raise ValueError(
+                f"inputs must be {self.n_inputs} finite numbers (the actuators' inputs in "
+                f"order), tensions >= 0, got {inputs!r}")
+        every = self._every
+        every[self._slots] = q
+        prepared = self._prepared
+        prepared.solve(every)
+        stability = None
+        if self._stability:
+            index, conservative = prepared.index, prepared.conservative
+            stability = Stability(index, conservative, index == 0 and conservative)
+            if index > 0 and (conservative or index % 2):  # Stability.unstable
+                warn_verdict(stability, 3)
+        if self.jacobians:
+            motion = prepared.motion[-1]
+            actuation, compliance = motion[:, self._columns].copy(), motion[:, :6].copy()
+            length_jacobian = prepared.jacobian[self._length_rows, self._columns]
+        else:
+            actuation = compliance = length_jacobian = None
+        return ForwardResult(q.copy(), prepared.poses[-1].copy(), actuation, compliance,
+                             prepared.lengths[self._lengths], length_jacobian,
+                             prepared.base_wrench.copy(), float(prepared.info[1]), stability)
+
+    def equilibrium(self) -> Equilibrium:
+        """The full :class:`~softarm.Equilibrium` of the last call (every station of ``s``,
+        strains, stresses, tendon fields, Jacobians)."""
+        if self._prepared._last is None:
+            raise ValueError("ForwardSolver.equilibrium: no solution yet (call solve first, "
+                             "or the last call failed)")
+        return self._prepared.equilibrium()
+
+    def reset(self) -> None:
+        """Return to the unloaded arm (the next call's path starts there)."""
+        self._prepared.reset()
 
 
 class InverseSolver:
@@ -140,12 +355,14 @@ class InverseSolver:
         # displacement-controlled tendons are solved in their tensions (self._actuators)
         self._actuators, self._displaced = self._in_tensions(arm, s, solver_tol)
         self._shooter = None  # the fast route's prepared shooting (Solver.shooter)
+        self._confirm = None  # and its prepared confirming solve (Solver.prepared)
         self._first = sum(_input_count(load) for load in self.loads)  # the actuators' slot
         # the task's weights, 1/L on positions and 1 on rotations (never written; writable:
         # a read-only array is another type to numba)
         self._weights = {t: np.array([1.0 / self.length] * 3 + [1.0] * (t - 3))
                          for t in (3, 6)}
         self._warm = None  # the fast route's last answer (_Warm)
+        self._fast_arrays = {}  # per task size t: _FastArrays
         self._slots = []  # (actuator index, field, component, is tension)
         self._fields = []  # (actuator index, field, its shape, its slots): the inputs' home
         values = []
@@ -311,7 +528,7 @@ class InverseSolver:
         null space and moves the task solution by ~1e-12 relative."""
         return regularised_step(J, b, q, self.scales, mu, self.lower, self.upper)
 
-    def _shooting_newton(self, q, target, orientation):
+    def _shooting_newton(self, q, target, orientation, snapshot=False):
         """The fast route: Newton on the base reaction x and the inputs q together, one
         integration per iteration (the shooting primitive with the input columns, prepared
         once by ``Solver.shooter``, on the grid of the last solution), from the Solver's last
@@ -346,10 +563,13 @@ class InverseSolver:
         first = self._first
         if self._shooter is None:  # prepared once; each iteration sets the inputs only
             try:
-                self._shooter = self.solver.shooter([*self.loads, *self._actuators_at(q)])
+                loads = [*self.loads, *self._actuators_at(q)]
+                self._shooter = self.solver.shooter(loads)
+                # the confirming solve, prepared too (no Jacobians: the iteration has them)
+                self._confirm = self.solver.prepared(loads, jacobians=False)
             except ValueError:
                 return None
-        shooter = self._shooter
+        shooter, confirm = self._shooter, self._confirm
         n, t = self.n_inputs, 3 if orientation is None else 6
         warm, self._warm = self._warm, None
         # (bytes: exact equality of a few numbers at a fifth of the cost; -0.0 against 0.0
@@ -361,41 +581,48 @@ class InverseSolver:
         steps, base, arm, units = shooter.kernel_arrays(("solution", N))
         every = shooter.inputs.copy()  # every input of the loads, the actuators' at slots
         x, q = x.copy(), q.copy()
+        # the kernel's arrays, allocated once per task size (every one is written before it
+        # is read; the warm step reads A and G as given, the buffers the last call wrote)
+        work = self._fast_arrays.get(t)
+        if work is None:
+            shared = self._fast_arrays.get(9 - t)  # (the other task size's: 3 + 6 = 9)
+            A, G = (np.zeros((6, n)), np.zeros((6, 1 + n))) if shared is None \
+                else (shared.A, shared.G)
+            work = self._fast_arrays[t] = _FastArrays.of(n, t, self._weights[t], A, G)
         # (copies: a read-only array is another type to numba, one more compiled version)
-        goal = (np.array(target, dtype=np.float64),
-                _EYE3 if orientation is None else np.array(orientation, dtype=np.float64),
-                self._weights[t])
-        settings = np.array([self.tol, self.max_iterations, self.length,
-                             -1.0 if warm is None else float(warm.redundant)])
+        np.copyto(work.target, target)
+        goal = (work.target, _EYE3 if orientation is None else
+                np.array(orientation, dtype=np.float64), work.weights)
+        work.settings[:] = (self.tol, self.max_iterations, self.length,
+                            -1.0 if warm is None else float(warm.redundant))
         miss = None if warm is None else warm.miss
         if miss is not None and miss[2].size != t:
             miss = None
-        warm_in = (np.array([0.0 if warm is None else 1.0]),
-                   np.zeros(12) if warm is None else warm.tip,
-                   np.zeros((6, n)) if warm is None else warm.A,
-                   np.zeros((6, 1 + n)) if warm is None else warm.G,
-                   np.array([0.0 if miss is None else 1.0]),
-                   np.zeros(n) if miss is None else miss[0],
-                   np.zeros(6) if miss is None else miss[1],
-                   np.zeros(t) if miss is None else miss[2])
-        A, G, J = np.empty((6, n)), np.empty((6, 1 + n)), np.empty((t, n))
-        linear = (np.empty(6), np.empty(n), np.empty(n), np.empty((6, 1 + n)), np.empty(t))
-        singular = np.empty(min(t, n))
-        info = np.zeros(4)
+        zeros = work.zeros
+        warm_in = (work.on if warm is not None else work.off,
+                   zeros[0] if warm is None else warm.tip, work.A, work.G,
+                   work.off if miss is None else work.on,
+                   zeros[1] if miss is None else miss[0],
+                   zeros[2] if miss is None else miss[1],
+                   zeros[3] if miss is None else miss[2])
+        info = work.info
         k.inverse_newton(x, q, every, first, steps, base, arm, units, goal,
-                         (self.lower, self.upper, self.scales), settings, warm_in,
-                         (A, G, J, linear, singular), info)
+                         (self.lower, self.upper, self.scales), work.settings, warm_in,
+                         (work.A, work.G, work.J, work.linear, work.singular), info)
         if info[0] != k.NEWTON_DONE:
             return None  # diverging, or the cap: the full-solve route, damped, from q
         try:
             every[first:first + n] = q
-            eq = shooter.solve_near([*self.loads, *self._actuators_at(q, trusted=True)], x,
-                                    2 * N, every)
+            confirm.solve(every, near=(x, 2 * N))
         except ConvergenceError:
             self.solver.reset()
             return None
-        e, _ = self._task(eq, target, orientation)
-        size = _size(e)
+        tip_pose = confirm.poses[-1]
+        if orientation is None:  # the kernel's task_error, for a position
+            e = (target - tip_pose[:3, 3]) / self.length
+            size = math.sqrt(float(e @ e))
+        else:
+            size = _size(self._pose_task(tip_pose, target, orientation)[0])
         if size > self.tol:
             return None
         self.q = q
@@ -403,14 +630,17 @@ class InverseSolver:
         if last is not None:
             miss = None
             if info[3]:  # what the linear warm step missed (the kernel adds it next time)
-                x0, q0, q_linear, G0, e0 = linear
-                miss = (q - q_linear, last[0] - (x0 - G0[:, 1:] @ (q - q0)), e0)
-            tip = np.concatenate([eq.tip[:3, 3], eq.tip[:3, :3].ravel()])
-            self._warm = _Warm(q.copy(), last[0], tip, A, G, miss, bool(info[2]))
+                x0, q0, q_linear, G0, e0 = work.linear
+                miss = (q - q_linear, last[0] - (x0 - G0[:, 1:] @ (q - q0)), e0.copy())
+            tip = np.empty(12)
+            tip[:3], tip[3:] = tip_pose[:3, 3], tip_pose[:3, :3].ravel()
+            self._warm = _Warm(q.copy(), last[0], tip, miss, bool(info[2]))
+        singular = work.singular
         condition = float(singular[0] / singular[-1]) if singular[-1] > 0 else np.inf
         at_bound = (q <= self.lower) | (q >= self.upper)
-        return InverseResult(q.copy(), eq, True, float(size), int(info[1]), at_bound,
-                             condition)
+        # (track builds one batched Equilibrium from its targets' snapshots at the end)
+        eq = confirm.snapshot() if snapshot else confirm.equilibrium()
+        return InverseResult(q.copy(), eq, True, size, int(info[1]), at_bound, condition)
 
     def solve(self, target, orientation=None) -> InverseResult:
         """The inputs that bring the tip to ``target`` (m, spatial, shape (3,)) or, with
@@ -421,8 +651,10 @@ class InverseSolver:
         warn_unstable(result.equilibrium, 3)
         return result
 
-    def _solve(self, target, orientation) -> InverseResult:
-        """:meth:`solve` without the warning (:meth:`track` warns once for its path)."""
+    def _solve(self, target, orientation, snapshot=False) -> InverseResult:
+        """:meth:`solve` without the warning (:meth:`track` warns once for its path);
+        ``snapshot``: a fast-route answer's ``equilibrium`` is its confirming solve's
+        :class:`~softarm.statics.solver.Snapshot` (track's), not an Equilibrium."""
         target = np.asarray(target, dtype=float)
         if target.shape != (3,) or not np.all(np.isfinite(target)):
             raise ValueError(f"target must be a position (3 finite numbers, m), got {target!r}")
@@ -431,7 +663,7 @@ class InverseSolver:
             if orientation.shape != (3, 3) or not np.allclose(
                     orientation @ orientation.T, np.eye(3), atol=1e-9):
                 raise ValueError("orientation must be a 3 × 3 rotation matrix")
-        q = np.clip(self.q, self.lower, self.upper)
+        q = np.minimum(np.maximum(self.q, self.lower), self.upper)  # (np.clip: 3× the cost)
         if self.solver.last_solution() is None and not self._displaced:
             # cold: one solve at the current inputs (its memory only: tip station, no
             # verdict) puts the fast route in reach (a cold inverse of the nitinol robot:
@@ -441,7 +673,7 @@ class InverseSolver:
                 self.solver._settle([*self.loads, *self._actuators_at(q)])
             except ConvergenceError:
                 self.solver.reset()
-        fast = self._shooting_newton(q, target, orientation)
+        fast = self._shooting_newton(q, target, orientation, snapshot)
         if fast is not None:
             return fast
         eq, A = self._forward(q)
@@ -495,12 +727,31 @@ class InverseSolver:
         if targets.ndim != 2 or targets.shape[1] != 3:
             raise ValueError(f"targets must have shape (N, 3) or (N, 4, 4), got "
                              f"{targets.shape}")
-        results = [self._solve(t, None if orientations is None else orientations[k])
+        results = [self._solve(t, None if orientations is None else orientations[k], True)
                    for k, t in enumerate(targets)]
-        first = results[0].equilibrium
+        inputs = np.array([r.inputs for r in results])
+        answers = [r.equilibrium for r in results]
+        if all(isinstance(a, Snapshot) for a in answers):  # every target by the fast route
+            equilibrium = self._confirm.equilibrium(
+                answers, (*self.loads, *self._stacked_actuators(inputs)))
+        else:
+            equilibrium = self._stacked([
+                self._confirm.equilibrium(a) if isinstance(a, Snapshot) else a
+                for a in answers], inputs)
+        warn_unstable(equilibrium, 3)
+        return InverseResult(
+            inputs, equilibrium,
+            np.array([r.reached for r in results]), np.array([r.error for r in results]),
+            np.array([r.iterations for r in results]),
+            np.array([r.at_bound for r in results]), np.array([r.condition for r in results]))
+
+    def _stacked(self, equilibria, inputs) -> Equilibrium:
+        """The equilibria of a tracked path, one per target, batched along it (the
+        Jacobian fields only if every one has them: targets the full route answered)."""
+        first = equilibria[0]
 
         def stack(name):
-            values = [getattr(r.equilibrium, name) for r in results]
+            values = [getattr(eq, name) for eq in equilibria]
             # (the Jacobian fields come only from targets the full-solve route answered)
             if any(v is None for v in values):
                 return None
@@ -511,22 +762,14 @@ class InverseSolver:
         fields = {f.name: stack(f.name) for f in dataclasses.fields(Equilibrium)
                   if f.name not in ("s", "arm", "loads", "method", "exact", "residual",
                                     "error_estimate", "stability")}
-        verdicts = [r.equilibrium.stability for r in results]
+        verdicts = [eq.stability for eq in equilibria]
         stability = None if any(v is None for v in verdicts) else Stability.of(
             np.array([v.index for v in verdicts]), np.array([v.conservative for v in verdicts]),
-            (len(results),))
-        inputs = np.array([r.inputs for r in results])
-        equilibrium = dataclasses.replace(
+            (len(equilibria),))
+        return dataclasses.replace(
             first, **fields, loads=(*self.loads, *self._stacked_actuators(inputs)),
-            stability=stability,
-            residual=np.array([r.equilibrium.residual for r in results]),
-            error_estimate=np.array([r.equilibrium.error_estimate for r in results]))
-        warn_unstable(equilibrium, 3)
-        return InverseResult(
-            inputs, equilibrium,
-            np.array([r.reached for r in results]), np.array([r.error for r in results]),
-            np.array([r.iterations for r in results]),
-            np.array([r.at_bound for r in results]), np.array([r.condition for r in results]))
+            stability=stability, residual=np.array([eq.residual for eq in equilibria]),
+            error_estimate=np.array([eq.error_estimate for eq in equilibria]))
 
 
 def _size(e) -> float:

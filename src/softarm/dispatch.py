@@ -146,12 +146,16 @@ def solve(arm, loads, *, method="auto", s=None, tol=1e-8, base=None, jacobians=F
 
 def warn_unstable(eq: Equilibrium, stacklevel: int = 3) -> Equilibrium:
     """``eq``, after a :class:`~softarm.StabilityWarning` if any of its cases is unstable."""
-    verdict = eq.stability
-    if verdict is None:
-        return eq
+    if eq.stability is not None:
+        warn_verdict(eq.stability, stacklevel + 1)
+    return eq
+
+
+def warn_verdict(verdict, stacklevel: int = 3) -> None:
+    """A :class:`~softarm.StabilityWarning` if any case of the verdict is unstable."""
     unstable = verdict.unstable
     if unstable is False or not np.any(unstable):
-        return eq
+        return
     unstable = np.asarray(unstable)
     index = np.asarray(verdict.index)
     first = tuple(int(i) for i in np.unravel_index(
@@ -163,7 +167,6 @@ def warn_unstable(eq: Equilibrium, stacklevel: int = 3) -> Equilibrium:
         "arm would move away from it. Use solve(..., branch='stable') for a stable "
         "equilibrium under the same loads, or softarm.critical_load to find where stability "
         "is lost.", StabilityWarning, stacklevel=stacklevel)
-    return eq
 
 
 #: The solver options that are numbers: real (float) or integer ones.

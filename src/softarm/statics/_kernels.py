@@ -118,9 +118,12 @@ TIP_LOADS = 12
 OPTIONS = 10
 
 # The memory of a chained (quasi-static) solve, in and out (MEMORY long): x at the coarse
-# step count N (6), x at 2N (6), N, valid (1 if the memory holds a solved case).
-_MXC, _MXF, _MN, _MVALID = 0, 6, 12, 13
-MEMORY = 14
+# step count N (6), x at 2N (6), N, valid (1 if the memory holds a solved case), the sign of
+# det ∂r/∂x at that solution (N), and in only: a predicted step of x to the next case's
+# loads (6) and whether it is given (PreparedSolve: -J_x⁻¹ J_q Δq, see solve_cases).
+_MXC, _MXF, _MN, _MVALID, _MSIGN, _MSTEP, _MPREDICTED = 0, 6, 12, 13, 14, 15, 21
+MEMORY = 22
+MSTEP, MPREDICTED = _MSTEP, _MPREDICTED
 
 # Continuation: largest first-corrector distance accepted, the distance aimed at by the step
 # control, largest contraction of successive corrector steps, smallest load-factor step.
@@ -1629,7 +1632,9 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
         (0/1: case 0's start loads are its own and ``memory`` holds a solution on its fine
         grid, :meth:`Solver.solve_near`; its coarse solution is corrected from there, the
         path only if that fails).
-    memory : (MEMORY,) the chained start (x at N, x at 2N, N, valid), read and rewritten.
+    memory : (MEMORY,) the chained start (x at N, x at 2N, N, valid, sign of det ∂r/∂x at
+        N), read and rewritten; with a predicted step (``memory[_MPREDICTED]``, consumed),
+        case 0 tries it before its path.
     inputs : (piece (n, P, PIECE_LOADS + A), tip (n, TIP_LOADS)): the load channels per unit
         of each actuation input (n = 0: none); with jacobians the output pass integrates
         one more tangent column per input, J and E then have 6 + n columns.
@@ -1674,6 +1679,8 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
     tip_f = np.empty(3)
     dscale = np.empty(6)
     six = nt_out * 0 + 6  # not a literal: one compiled version
+    seven = six + 1
+    t_end = np.empty(6)
     # a Newton step of this size at N leaves an error of about its square: far below tol
     final_step = min(1e-3, math.sqrt(0.01 * tol / length)) if math.isfinite(tol) else 1e-9
     reached = np.zeros(2)  # the load factor reached, the sign of det ∂r/∂x there
@@ -1742,6 +1749,34 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
                                                             or n_fixed > 0):
                     estimate = math.sqrt(d2) / 15.0
                     recorded = True
+        if (warm and b == 0 and not near and memory[_MPREDICTED] > 0.0
+                and N == int(memory[_MN])):
+            # The path in one step whose tangent is given: the caller knows that only the
+            # actuation inputs changed, by Δq, and the last solution's -J_x⁻¹ J_q (its output
+            # pass), so the step x(1) - x(0) ≈ -J_x⁻¹ J_q Δq needs no integration at λ = 0.
+            # One corrector from that prediction at λ = 1, accepted only as _follow accepts a
+            # single step from λ = 0 to 1: near the prediction (within _REFINE_MAX, a third
+            # of _follow's _DIST_MAX: a poor prediction costs little), the whole step
+            # small enough to be one step (_FIRST_MOTION), det ∂r/∂x of the same sign, the
+            # path's tangent turned by less than 60° (in x scaled by the bending scale).
+            # Otherwise the path, from the last solution, as without a prediction.
+            _fill_steps(length, arm[1], N, np.int64(1), steps)
+            for i in range(6):
+                x[i] = memory[_MXC + i] + memory[_MSTEP + i]
+            if (_corrector(x, 1.0, seven, steps, base, arm, case, scratch, scale, dscale,
+                           length, threshold, max_iterations, _REFINE_MAX, final_step, r, J,
+                           tip_c, counter)
+                    and _det_sign(J) == memory[_MSIGN] and _tangent(J, t_end)):
+                aa = bb = ab = 0.0
+                for i in range(6):
+                    x_f[i] = x[i] - memory[_MXC + i]  # the step taken
+                    a = memory[_MSTEP + i] / scale[i]
+                    c = t_end[i] / scale[i]
+                    aa, bb, ab = aa + a * a, bb + c * c, ab + a * c
+                if (_distance(x_f, scratch[1], dscale, length) <= _FIRST_MOTION
+                        and ab >= 0.5 * math.sqrt(aa * bb)):
+                    _copy(J, J_c)
+                    path = False
         while not recorded:
             if path:
                 # the path on a coarse grid (N / coarse_ratio steps) unless that failed
@@ -1846,7 +1881,7 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
             info[b, 0] = _norm_scaled(r, scale)
             info[b, 3] = counter[0]
             if chained:
-                memory[_MVALID] = 0.0
+                memory[_MVALID] = memory[_MPREDICTED] = 0.0
             continue
         if not recorded:
             _fill_steps(length, arm[1], N, np.int64(2), steps)
@@ -1872,6 +1907,8 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
                 memory[_MXF + i] = x_f[i]
             memory[_MN] = N
             memory[_MVALID] = 1.0 if status[b] == OK else 0.0
+            memory[_MSIGN] = _det_sign(J_c)
+            memory[_MPREDICTED] = 0.0
 
 
 @_jit

@@ -12,18 +12,20 @@ import dataclasses
 import functools
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
 from .._threads import in_threads, threads_for
 from .._validate import check_allocation, count, real, rigid_transform, stations
-from ..equilibrium import Equilibrium
+from ..equilibrium import Equilibrium, Stability
 from ..errors import ConvergenceError
 from ..loads import as_loads, batch_shape
 from ..model import Arm, SegmentedArm
 from .stability import verdict
 
-__all__ = ["METHOD", "ShootResult", "Shooter", "Solver", "check_base", "check_tol", "solve_numeric"]
+__all__ = ["METHOD", "PreparedSolve", "ShootResult", "Shooter", "Snapshot", "Solver",
+           "check_base", "check_tol", "solve_numeric"]
 
 #: Equilibrium.method of every result of this solver.
 METHOD = "numeric.shooting"
@@ -325,11 +327,17 @@ class _Channels:
     def single(self, piece, tip) -> _Channels:
         """A copy of these channels (the same pieces and actuators) holding the single case
         ``piece`` (P, PIECE_LOADS + A), ``tip`` (TIP_LOADS,)."""
+        return self.cases(piece[None], tip[None], ())
+
+    def cases(self, piece, tip, shape) -> _Channels:
+        """A copy of these channels (the same pieces and actuators) holding the cases
+        ``piece`` (B, P, PIECE_LOADS + A), ``tip`` (B, TIP_LOADS) of batch shape ``shape``."""
         out = object.__new__(_Channels)  # (a shallow copy; copy.copy's protocol: 3× the cost)
         out.__dict__.update(self.__dict__)
-        out.shape, out.count = (), 1
-        out.piece, out.tip_loads = piece[None], tip[None]
-        out._piece, out._tip = piece, tip
+        out.shape, out.count = shape, piece.shape[0]
+        out.piece, out.tip_loads = piece, tip
+        out._piece = piece.reshape(*shape, *piece.shape[1:])
+        out._tip = tip.reshape(*shape, tip.shape[-1])
         return out
 
     def signature(self) -> tuple:
@@ -449,6 +457,239 @@ class Shooter:
         """The piece and tip channels (one case) at inputs q."""
         return (self._piece0 + (q @ self._unit_flat).reshape(self._piece0.shape),
                 self._tip0 + q @ self._unit_tip)
+
+
+class Snapshot(NamedTuple):
+    """One answer of a :class:`PreparedSolve`, copied out of its buffers (their names)."""
+
+    inputs: np.ndarray
+    poses: np.ndarray
+    strains: np.ndarray
+    stresses: np.ndarray
+    info: np.ndarray
+    base_wrench: np.ndarray
+    lengths: np.ndarray
+    jacobian: np.ndarray | None
+    motion: np.ndarray | None
+    index: int
+    conservative: bool
+
+
+class PreparedSolve:
+    """:meth:`Solver.solve` (chained, quasi-static) of one load structure whose only changing
+    values are the actuation inputs q, prepared once (:meth:`Solver.prepared`): the control
+    loop's call, 1000 times a second.
+
+    The same kernels as :meth:`Solver.solve`, with the same answer to the bit, without the
+    Python around them that each call of it pays: the loads are not validated or written
+    into channels again (the channels are affine in q, ``piece(q) = piece0 + Σᵢ qᵢ unitᵢ``,
+    as for :class:`Shooter`), the outputs and the stability verdict's arrays are allocated
+    once and overwritten by every call, and no :class:`Equilibrium` is built unless asked
+    for (:meth:`equilibrium`). It shares the Solver's quasi-static state: a call continues
+    from the Solver's last equilibrium, and a later :meth:`Solver.solve` from this one's.
+
+    Attributes (the buffers, after :meth:`solve`: views, overwritten by the next call)
+    ----------
+    inputs : (n,) every actuation input of the loads in load order (the columns of
+        ``Equilibrium.actuation_jacobian``), the last call's.
+    poses : (S, 4, 4); strains, stresses : (S, 6) (material); info : (5,) residual, tip
+        error estimate (m), load factor reached, shootings, N (the solution is on 2N steps).
+    base_wrench : (6,) the total wrench at the clamp (spatial); lengths : (A,) each
+        actuator's length (m; a chamber's 0).
+    jacobian : (6 + A, 6 + n), with ``jacobians``: rows 0:6 [J_x⁻¹ | J_x⁻¹ J_q], rows 6 + a
+        [∂ℓ_a/∂W | ∂ℓ_a/∂q] (actuator a's length per dead tip wrench and per input).
+    motion : (S, 6, 6 + n), with ``jacobians``: per station [compliance | actuation
+        Jacobian], (δp; δθ) spatial.
+    index, conservative : int, bool
+        The stability verdict (Morse index; whether the loads are conservative), when the
+        Solver computes verdicts.
+    """
+
+    def __init__(self, solver, loads, *, jacobians: bool):
+        k = _kernels()
+        loads, shape, _, pieces, channels = solver._prepare(loads)
+        if shape != ():
+            raise ValueError(f"Solver.prepared takes a single load case, got batch shape "
+                             f"{shape}")
+        self._solver, self._k, self.loads = solver, k, loads
+        self._pieces, self._channels = pieces, channels
+        self._signature = channels.signature()
+        W = channels.piece.shape[2]
+        unit_piece, unit_tip = solver._input_channels(loads, pieces, W)
+        self.inputs = np.array([v for load in loads for name in load.inputs
+                                for v in np.ravel(np.asarray(getattr(load, name), dtype=float))])
+        n, P, A = self.inputs.size, pieces[0].size, len(channels.actuators)
+        self._unit = (unit_piece, unit_tip) if jacobians else (
+            solver._unused((0, P, W)), solver._unused((0, k.TIP_LOADS)))
+        self._unit_flat, self._unit_tip = unit_piece.reshape(n, P * W), unit_tip
+        # the channels at q = 0, and the case's own (one row each), rewritten by every call
+        self._piece0 = channels.piece[0] - (self.inputs @ self._unit_flat).reshape(P, W)
+        self._tip0 = channels.tip_loads[0] - self.inputs @ unit_tip
+        self._piece, self._tip = channels.piece.copy(), channels.tip_loads.copy()
+        self._start = (np.zeros((P, W)), np.zeros(k.TIP_LOADS))  # the path's start loads
+        self._arm = channels.arm_tuple()
+        self._jacobians = bool(jacobians)
+        self._options = {near: solver._options(True, jacobians, near) for near in (False, True)}
+        S = solver._s_kernel.size
+        self._outs = (np.empty((1, S, 4, 4)), np.empty((1, S, 6)), np.empty((1, S, 6)),
+                      np.zeros((1, 5)), np.zeros(1, dtype=np.int64),
+                      np.zeros((1, 6 + A, 6 + n)) if jacobians else solver._unused((0, 6, 6)),
+                      np.zeros((1, S, 6, 6 + n)) if jacobians else solver._unused((1, S, 6, 6)),
+                      np.empty((1, 6)), np.empty((1, A)))
+        poses, strains, stresses, info, _, jac, motion, base_wrench, lengths = self._outs
+        self.poses, self.strains, self.stresses = poses[0], strains[0], stresses[0]
+        self.info, self.base_wrench, self.lengths = info[0], base_wrench[0], lengths[0]
+        self.jacobian = jac[0] if jacobians else None
+        self.motion = motion[0] if jacobians else None
+        # the verdict's arrays (writable and C-contiguous: one compiled version)
+        self._tips = np.empty((1, 4, 4)) if solver.s[-1] == solver.length \
+            else np.zeros((0, 4, 4))
+        self._Ns = np.zeros(1)
+        self._index, self._theta0 = np.zeros(1, dtype=np.int64), np.zeros((1, 6, 6))
+        self._flags = np.zeros(1, dtype=np.bool_)
+        self.index, self.conservative = 0, True
+        self._last = None  # what this object last wrote as the Solver's _last
+        self._q_last, self._dq = np.empty(n), np.empty(n)  # its inputs; their change
+
+    def solve(self, q, *, near=None) -> None:
+        """Solve at the inputs q (every input, in :attr:`inputs`' order; not validated: the
+        caller keeps them finite and tensions >= 0) from the Solver's last equilibrium, or
+        with ``near`` = (x, steps) from the solution x on ``steps`` RK4 steps of these very
+        loads (:meth:`Solver.solve_near`). Writes the buffers; a ConvergenceError if the
+        kernel fails (the Solver then returns to the unloaded arm)."""
+        k, solver = self._k, self._solver
+        np.copyto(self.inputs, q)
+        piece, tip = self._piece, self._tip
+        np.dot(self.inputs, self._unit_flat, out=piece.reshape(-1))
+        piece += self._piece0
+        np.dot(self.inputs, self._unit_tip, out=tip[0])
+        tip += self._tip0
+        start_piece, start_tip = self._start
+        if near is not None:
+            memory = solver._memory = np.zeros(k.MEMORY)
+            memory[0:6] = memory[6:12] = near[0]
+            memory[12], memory[13] = max(1, int(near[1]) // 2), 1.0
+            np.copyto(start_piece, piece[0])
+            np.copyto(start_tip, tip[0])
+        else:
+            last = solver._last
+            if last is not self._last:  # the Solver moved since (or never came here)
+                if last is not None and last[3] == self._signature \
+                        and last[0] is self._pieces[0]:
+                    np.copyto(start_piece, last[1])
+                    np.copyto(start_tip, last[2])
+                else:  # from the unloaded arm
+                    solver.reset()
+                    start_piece[:] = 0.0
+                    start_tip[:] = 0.0
+            if solver._memory is None:
+                solver._memory = np.zeros(k.MEMORY)
+            memory = solver._memory
+            if self._jacobians and last is self._last and self._last is not None:
+                # from this object's own last solution, whose output pass gave J_x⁻¹ J_q:
+                # the step of x along the inputs' tangent, for the kernel's one-step path
+                np.subtract(self.inputs, self._q_last, out=self._dq)
+                np.dot(self.jacobian[:6, 6:], self._dq, out=memory[k.MSTEP:k.MSTEP + 6])
+                np.negative(memory[k.MSTEP:k.MSTEP + 6], out=memory[k.MSTEP:k.MSTEP + 6])
+                memory[k.MPREDICTED] = 1.0
+        status = self._outs[4]
+        k.solve_cases(solver._base_kernel, self._arm, (piece, tip), self._start,
+                      self._options[near is not None], solver._s_kernel, memory, self._unit,
+                      self._outs)
+        if status[0] != k.OK:
+            solver.reset()
+            self._last = None
+            raise _failure(k, 0, (), status, self._outs[3], solver, near is not None)
+        np.copyto(start_piece, piece[0])
+        np.copyto(start_tip, tip[0])
+        np.copyto(self._q_last, self.inputs)
+        self._last = solver._last = (self._pieces[0], start_piece, start_tip, self._signature)
+        if solver.stability:
+            if self._tips.shape[0]:
+                np.copyto(self._tips[0], self.poses[-1])
+            self._Ns[0] = self.info[4]
+            k.stability_cases(solver._base_kernel, self._arm, (piece, tip), self._outs[7],
+                              self._Ns, self._tips, 1, self._index, self._theta0, self._flags)
+            self.index, self.conservative = int(self._index[0]), bool(self._flags[0])
+
+    def loads_at(self, q) -> tuple:
+        """The loads with the inputs q (:attr:`inputs`' order), values not validated again."""
+        out, at = [], 0
+        for load in self.loads:
+            changes = {}
+            for name in load.inputs:
+                shape = np.shape(getattr(load, name))
+                size = math.prod(shape)
+                changes[name] = np.reshape(q[at:at + size], shape).copy() if shape \
+                    else float(q[at])
+                at += size
+            out.append(load._with_checked(**changes) if changes else load)
+        return tuple(out)
+
+    def snapshot(self) -> Snapshot:
+        """The last call's answer, copied (what :meth:`equilibrium` builds from)."""
+        jacobians = self._jacobians
+        return Snapshot(self.inputs.copy(), self.poses.copy(), self.strains.copy(),
+                        self.stresses.copy(), self.info.copy(), self.base_wrench.copy(),
+                        self.lengths.copy(), self.jacobian.copy() if jacobians else None,
+                        self.motion.copy() if jacobians else None, self.index,
+                        self.conservative)
+
+    def equilibrium(self, snapshots=None, loads=None) -> Equilibrium:
+        """The :class:`Equilibrium` of the last call (copies of the buffers), as
+        :meth:`Solver.solve` would have returned it; of one :meth:`snapshot`; or, given a
+        list of B snapshots, of those B answers batched (B,), with ``loads`` their loads
+        (default: :attr:`loads` at the answer's inputs, for one answer)."""
+        solver = self._solver
+        single = snapshots is None or isinstance(snapshots, Snapshot)
+        snapshots = [self.snapshot() if snapshots is None else snapshots] if single \
+            else snapshots
+        B, S = len(snapshots), solver.s.size
+        shape = () if single else (B,)
+
+        def stacked(name):  # (fresh arrays: frozen below where Equilibrium takes them)
+            if single:  # (np.stack costs 8 µs a field)
+                value = getattr(snapshots[0], name)
+                value.setflags(write=False)  # (the snapshot's own copy: its views frozen)
+                return value[None]
+            return np.stack([getattr(snap, name) for snap in snapshots])
+
+        poses, strains, stresses, info, base_wrench, lengths = (stacked(name) for name in (
+            "poses", "strains", "stresses", "info", "base_wrench", "lengths"))
+        inputs = stacked("inputs")
+        P, W = self._piece0.shape
+        piece = (inputs @ self._unit_flat).reshape(B, P, W) + self._piece0
+        tip = inputs @ self._unit_tip + self._tip0
+        actuation = _actuation(self._channels.cases(piece, tip, shape), base_wrench, lengths,
+                               shape)
+        tip_compliance = compliance = None
+        if self._jacobians:
+            tip_compliance, compliance, tip_inputs, station_inputs, lengths_inputs = \
+                _compliances(stacked("jacobian"), stacked("motion"), shape, self.tendons)
+            actuation.update(actuation_jacobian=tip_inputs,
+                             station_actuation_jacobian=station_inputs,
+                             tendon_length_jacobian=lengths_inputs)
+        if solver.stability:
+            actuation["stability"] = Stability.of(
+                np.array([snap.index for snap in snapshots]),
+                np.array([snap.conservative for snap in snapshots]), shape)
+        for array in (poses, strains, stresses, info):
+            array.setflags(write=False)
+        residual, estimate = info[:, 0], info[:, 1]
+        return Equilibrium(
+            s=solver.s, poses=poses.reshape(*shape, S, 4, 4),
+            strains=strains.reshape(*shape, S, 6), stresses=stresses.reshape(*shape, S, 6),
+            arm=solver.arm, loads=self.loads_at(inputs[0]) if loads is None else loads,
+            method=METHOD, exact=True,
+            residual=float(residual[0]) if single else residual,
+            error_estimate=float(estimate[0]) if single else estimate,
+            tip_compliance=tip_compliance, compliance=compliance, **actuation)
+
+    @property
+    def tendons(self) -> np.ndarray:
+        """The actuator columns (of :attr:`lengths`, of :attr:`jacobian`'s rows 6..) that
+        are tendons."""
+        return self._channels.tendons()[0]
 
 
 def _shoot(k, x, lam, counts, base, arm, case, actuators) -> ShootResult:
@@ -864,6 +1105,20 @@ class Solver:
                            for v in np.ravel(np.asarray(getattr(load, name), dtype=float))])
         return Shooter(self, (loads, shape, 1, pieces, channels), channels.arm_tuple(), values,
                        unit_piece, unit_tip)
+
+    def prepared(self, loads, *, jacobians: bool = True) -> PreparedSolve:
+        """:meth:`solve` of the single case ``loads`` prepared once for many calls that change
+        only its actuation inputs (tensions, pressures, field components): a
+        :class:`PreparedSolve`. The answer is :meth:`solve`'s, without its per-call Python
+        (validation, load channels, the Equilibrium): the control loop's call."""
+        if not isinstance(jacobians, (bool, np.bool_)):
+            raise TypeError(f"jacobians must be True or False, got {jacobians!r}")
+        loads = as_loads(loads)
+        if any(load.displacement_controlled for load in loads):
+            raise ValueError("Solver.prepared takes tension-controlled tendons only (the "
+                             "tension of a displacement-controlled Tendon is an unknown of "
+                             "the problem: Solver.solve)")
+        return PreparedSolve(self, loads, jacobians=jacobians)
 
     def _step_counts(self, piece_lengths, steps) -> np.ndarray:
         """RK4 steps per piece as the kernel's ``_fill_steps`` spreads them: factor × the
