@@ -523,3 +523,32 @@ def test_the_forward_solver_names_bad_input():
     model.solve([0.0, 0.0, 1.0])  # a refused call lost nothing
     np.testing.assert_allclose(model.solve([0.0, 0.0, 1.0]).tip, forward(arm, [0, 0, 1.0]).tip,
                                atol=2e-6 * L)
+
+
+def test_a_tracked_paths_equilibrium_is_each_targets_own():
+    """track's batched Equilibrium (made from its targets' confirming solves, or, when one
+    target takes the full route, from every target's Equilibrium) against independent
+    forward solves of the returned tensions: poses, tendon fields, base wrench, verdict."""
+    arm = robot()
+    phase = np.linspace(0.0, 0.3, 6)
+    pattern = 1.5 + 1.2 * np.cos(phase[:, None] - 2 * np.pi * np.arange(3) / 3)
+    reachable = forward(arm, pattern).tip_position
+    unreachable = reachable.copy()
+    unreachable[3, 2] += 0.2  # off the surface the three tendons reach: the full route
+    for targets, all_reached in ((reachable, True), (unreachable, False)):
+        result = InverseSolver(arm, tendons(), [GRAVITY], s=5).track(targets)
+        assert bool(result.reached.all()) == all_reached and result.reached.sum() >= 5
+        eq = result.equilibrium
+        ref = softarm.solve(arm, [GRAVITY, *[softarm.Tendon(result.inputs[:, i], Straight(*o))
+                                             for i, o in enumerate(OFFSETS)]], s=5, tol=1e-10)
+        assert eq.poses.shape == (6, 5, 4, 4) and eq.residual.shape == (6,)
+        np.testing.assert_allclose(eq.poses, ref.poses, rtol=0, atol=1e-6 * L)
+        np.testing.assert_array_equal(eq.tendon_tensions, result.inputs)
+        np.testing.assert_array_equal(eq.tendon_slack, result.inputs == 0.0)
+        np.testing.assert_allclose(eq.tendon_lengths, ref.tendon_lengths, rtol=0, atol=1e-6 * L)
+        np.testing.assert_allclose(eq.tendon_length_changes, ref.tendon_length_changes,
+                                   rtol=0, atol=1e-6 * L)
+        np.testing.assert_allclose(eq.base_wrench, ref.base_wrench, rtol=1e-6,
+                                   atol=1e-6 * np.abs(ref.base_wrench).max())
+        np.testing.assert_array_equal(eq.stability.index, ref.stability.index)
+        assert np.all(eq.error_estimate <= 1e-7 * L)
