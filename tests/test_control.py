@@ -246,8 +246,8 @@ def test_tracking_a_dense_path_takes_one_integration_a_target():
 def test_a_prepared_shooter_equals_shooting_the_rebuilt_loads():
     """``Solver.shooter`` recombines channels prepared once (they are affine in the inputs);
     against ``Solver.shoot`` of the loads rebuilt with the same new inputs (each load's own
-    channels, prepared again), for a tendon, a chamber and a magnetic field (6 inputs), and
-    its ``solve_near`` against the Solver's."""
+    channels, prepared again), for a tendon, a chamber and a magnetic field (6 inputs); and
+    ``Solver.prepared`` against ``Solver.solve_near`` and ``Solver.solve``."""
     material = softarm.Material(5.0e6, poisson_ratio=0.45, density=1100.0)
     arm = softarm.Arm(0.2, softarm.Circle(0.004), material, magnetization=(2.0, 0.0, 0.5))
 
@@ -273,11 +273,30 @@ def test_a_prepared_shooter_equals_shooting_the_rebuilt_loads():
     other = softarm.statics.Solver(arm, tol=1e-8)
     other.solve(loads(q1))
     x1, N1 = other.last_solution()
-    near = shooter.solve_near(loads(q1), x1, 2 * N1, q1)
+    confirm = solver.prepared(loads(q0), jacobians=False)  # (inverse statics' confirmation)
+    confirm.solve(q1, near=(x1, 2 * N1))
+    near = confirm.equilibrium()
     again = softarm.statics.Solver(arm, tol=1e-8).solve_near(loads(q1), x1, 2 * N1)
     assert np.allclose(near.poses, again.poses, rtol=0, atol=1e-13)
     assert int(near.stability.index) == int(again.stability.index) == 0
     assert bool(near.stability.stable) and bool(again.stability.stable)
+    np.testing.assert_array_equal(near.tendon_tensions, again.tendon_tensions)
+    np.testing.assert_allclose(near.tendon_lengths, again.tendon_lengths, rtol=0, atol=1e-13)
+    np.testing.assert_array_equal(near.loads[3].field, q1[2:5])
+    # chained, with Jacobians (the predicted path start), against Solver.solve: every kind
+    # of input through the prediction -J_x⁻¹ J_q Δq
+    plain = softarm.statics.Solver(arm, tol=1e-8)
+    prepared = softarm.statics.Solver(arm, tol=1e-8).prepared(loads(q0))
+    unpredicted = softarm.statics.Solver(arm, tol=1e-8).prepared(loads(q0), jacobians=False)
+    for k, q in enumerate((q0, q0 + 0.01 * (q1 - q0), q0 + 0.02 * (q1 - q0))):
+        prepared.solve(q)
+        unpredicted.solve(q)
+        a, b = prepared.equilibrium(), plain.solve(loads(q), jacobians=True)
+        np.testing.assert_allclose(a.poses, b.poses, rtol=0, atol=1e-10)
+        np.testing.assert_allclose(a.actuation_jacobian, b.actuation_jacobian, rtol=0,
+                                   atol=1e-8 * np.abs(b.actuation_jacobian).max(axis=0))
+        if k:  # the path's integrations (the kernel's count) saved by the prediction
+            assert prepared.info[3] < unpredicted.info[3]
     with pytest.raises(ValueError, match="inputs must have shape"):
         shooter(x, q1[:3])
     # loads without inputs: no input columns, the same integration as Solver.shoot

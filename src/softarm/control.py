@@ -430,15 +430,9 @@ class InverseSolver:
     def n_inputs(self) -> int:
         return self.q.size
 
-    def _actuators_at(self, q, actuators=None, *, trusted=False) -> list:
-        """The actuators (default: in tensions) at the inputs q; ``trusted``: q is finite and
-        within the bounds (the compiled iteration's answer), not checked again."""
+    def _actuators_at(self, q, actuators=None) -> list:
+        """The actuators (default: in tensions) at the inputs q."""
         given = actuators is not None  # the slots of a displaced tendon are its tension's
-        if not given and trusted:  # the inner loop's: each field from its slots, as it is
-            out = list(self._actuators)
-            for i, name, shape, slots in self._fields:
-                out[i] = out[i]._with_checked(**{name: q[slots].reshape(shape)})
-            return out
         actuators = actuators if given else self._actuators
         fields: dict[tuple[int, str], np.ndarray] = {}
         for value, (i, name, c, _) in zip(q, self._slots, strict=True):
@@ -449,8 +443,8 @@ class InverseSolver:
         out = list(actuators)
         # the inner loop's own inputs (finite, clipped to the bounds: tensions >= 0) need no
         # validation; the public actuators_at validates
-        trusted = not given and (trusted or (bool(np.isfinite(q).all()) and bool(
-            np.all((q >= self.lower) & (q <= self.upper)))))
+        trusted = not given and bool(np.isfinite(q).all()) and bool(
+            np.all((q >= self.lower) & (q <= self.upper)))
         for (i, name), value in fields.items():
             shape = np.shape(getattr(actuators[i], name))
             value = value.reshape(shape)
@@ -533,7 +527,8 @@ class InverseSolver:
         integration per iteration (the shooting primitive with the input columns, prepared
         once by ``Solver.shooter``, on the grid of the last solution), from the Solver's last
         equilibrium, compiled whole (the kernel's ``inverse_newton``); then one solve at the
-        answer (``solve_near``: refined to tol, with its stability verdict) that must
+        answer (``Solver.prepared`` from the iteration's base reaction, as
+        ``Solver.solve_near``: refined to tol, with its stability verdict) that must
         confirm the task error. None (the caller takes the full-solve route) when there is
         no last equilibrium, displacement-controlled tendons are among the actuators, or the
         iteration does not converge or the confirmation fails.

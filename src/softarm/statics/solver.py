@@ -444,15 +444,6 @@ class Shooter:
                 self._counts[key] = counts
         return counts
 
-    def solve_near(self, loads, x, steps: int, inputs) -> Equilibrium:
-        """:meth:`Solver.solve_near` for ``loads``, the prepared loads with ``inputs``
-        (given for the result's ``loads``; not validated again), without preparing them."""
-        _, shape, count, pieces, channels = self._prepared
-        loads = as_loads(loads)
-        prepared = (loads, shape, count, pieces,
-                    channels.single(*self._at(np.asarray(inputs, dtype=np.float64))))
-        return self._solver._solve_near(loads, x, steps, prepared)
-
     def _at(self, q):
         """The piece and tip channels (one case) at inputs q."""
         return (self._piece0 + (q @ self._unit_flat).reshape(self._piece0.shape),
