@@ -170,12 +170,14 @@ class ForwardSolver:
     compliance and actuation Jacobian at given actuation inputs, solved quasi-statically
     from the last call's equilibrium, in a fraction of a millisecond.
 
-    A prepared :meth:`Solver.solve <softarm.statics.Solver.solve>`: the same kernels and the
-    same answer (tol, error estimate, stability verdict and its warning), with the loads
+    A prepared :meth:`Solver.solve <softarm.statics.Solver.solve>`: the same kernels and
+    guarantees (tol, error estimate, stability verdict and its warning), with the loads
     prepared once and only the inputs changing between calls (``Solver.prepared``), and
-    one more saving where only the inputs changed: the last answer's exact tangent
+    two more savings where only the inputs changed: the last answer's exact tangent
     -J_x⁻¹ J_q Δq predicts the new base reaction, so the loading path takes one correction
-    instead of an integration at its start and a correction at its end (docs/control.md).
+    instead of an integration at its start and a correction at its end, and the fine
+    solution is predicted too, its output pass accepted within 1 % of tol of the converged
+    answer (docs/control.md).
 
     Parameters
     ----------

@@ -1681,6 +1681,7 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
     six = nt_out * 0 + 6  # not a literal: one compiled version
     seven = six + 1
     t_end = np.empty(6)
+    dx_f = np.empty(6)
     # a Newton step of this size at N leaves an error of about its square: far below tol
     final_step = min(1e-3, math.sqrt(0.01 * tol / length)) if math.isfinite(tol) else 1e-9
     reached = np.zeros(2)  # the load factor reached, the sign of det ∂r/∂x there
@@ -1769,14 +1770,40 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
                     and _det_sign(J) == memory[_MSIGN] and _tangent(J, t_end)):
                 aa = bb = ab = 0.0
                 for i in range(6):
-                    x_f[i] = x[i] - memory[_MXC + i]  # the step taken
+                    dx_f[i] = x[i] - memory[_MXC + i]  # the step taken
                     a = memory[_MSTEP + i] / scale[i]
                     c = t_end[i] / scale[i]
                     aa, bb, ab = aa + a * a, bb + c * c, ab + a * c
-                if (_distance(x_f, scratch[1], dscale, length) <= _FIRST_MOTION
+                if (_distance(dx_f, scratch[1], dscale, length) <= _FIRST_MOTION
                         and ab >= 0.5 * math.sqrt(aa * bb)):
                     _copy(J, J_c)
                     path = False
+                    if nt_out > 0:
+                        # The fine solution predicted too: the coarse one plus the last
+                        # case's x_2N - x_N (the discretisation's offset, which the inputs'
+                        # small change moves by O(h⁴ Δq)). The output pass from it is also
+                        # the fine check: accepted, as near's, if it is converged, or if its
+                        # Newton step would move the arm by under 1 % of tol (its error is
+                        # then that step's size: the residual reported says how far);
+                        # otherwise the chord from it, as without the prediction.
+                        for i in range(6):
+                            x_f[i] = x[i] + memory[_MXF + i] - memory[_MXC + i]
+                        resume = True
+                        _fill_steps(length, arm[1], N, np.int64(2), steps)
+                        _output(x_f, nt_out, steps, base, arm, case, piece_loads[b],
+                                tip_loads[b], inputs, scratch, s_out, out, b, r, J, J_out)
+                        counter[0] += 1
+                        d2 = 0.0
+                        for i in range(3):
+                            d2 += (scratch[0][_P + i] - tip_c[i]) ** 2
+                        converged = _norm_scaled(r, scale) <= threshold or (
+                            math.isfinite(tol)
+                            and _newton_step(J_out if n_inputs > 0 else J, r, dx_f)
+                            and _distance(dx_f, scratch[1], dscale, length) * length
+                            <= 0.01 * tol)
+                        if converged and math.sqrt(d2) / 15.0 <= tol:
+                            estimate = math.sqrt(d2) / 15.0
+                            recorded = True
         while not recorded:
             if path:
                 # the path on a coarse grid (N / coarse_ratio steps) unless that failed
