@@ -165,6 +165,30 @@ def test_the_tracking_example_runs(tmp_path, capsys):
     assert (tmp_path / "track.png").stat().st_size > 10_000
 
 
+def test_the_jacobian_control_example_tracks_its_circle(tmp_path, capsys):
+    """examples/jacobian_control.py: a resolved-rate loop on ForwardSolver. Its tips against
+    independent solves from the unloaded arm at the tensions it commanded (1e-6 L), and
+    its tracking error after the first periods (the damped step's second-order lag)."""
+    import runpy
+    import sys
+    from pathlib import Path
+
+    script = Path(__file__).resolve().parents[1] / "examples" / "jacobian_control.py"
+    argv = sys.argv
+    sys.argv = [str(script), str(tmp_path / "control.png")]
+    try:
+        run = runpy.run_path(str(script), run_name="__main__")
+    finally:
+        sys.argv = argv
+    assert "1000 periods" in capsys.readouterr().out
+    assert (tmp_path / "control.png").stat().st_size > 10_000
+    some = [0, 1, 500, 999]
+    again = forward(run["arm"], run["commanded"][some]).tip_position
+    np.testing.assert_allclose(run["tips"][some], again, rtol=0, atol=1e-6 * L)
+    assert np.max(run["error"][10:]) <= 1e-5  # m: 4e-5 L
+    assert np.all(run["commanded"] >= 0.0)
+
+
 def test_shoot_input_columns_match_differences_and_the_solver_jacobian():
     """``Solver.shoot(..., inputs=True)`` (the fast inverse route's linearisation): its input
     columns against central differences of shoot itself at fixed steps, and the actuation
