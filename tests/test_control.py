@@ -571,6 +571,11 @@ def test_the_forward_solver_names_bad_input():
     model.solve([0.0, 0.0, 1.0])  # a refused call lost nothing
     np.testing.assert_allclose(model.solve([0.0, 0.0, 1.0]).tip, forward(arm, [0, 0, 1.0]).tip,
                                atol=2e-6 * L)
+    model.reset()  # back to the unloaded arm: no answer to return, the next from rest
+    with pytest.raises(ValueError, match="no solution yet"):
+        model.equilibrium()
+    np.testing.assert_allclose(model.solve([1.0, 0.0, 0.0]).tip, forward(arm, [1.0, 0, 0]).tip,
+                               atol=2e-6 * L)
 
 
 def test_a_tracked_paths_equilibrium_is_each_targets_own():

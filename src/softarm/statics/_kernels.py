@@ -143,6 +143,9 @@ _DLAM_CROSS = 1e-3
 # Refinement of a solution under a change of step count: distances are of the order of the
 # discretisation error, far below this.
 _REFINE_MAX = 0.05
+# A predicted fine solution's output pass is accepted when its Newton step would move the
+# arm by less than this fraction of tol (the answer is then that step from the converged one).
+_PREDICTED_FINE = 0.01
 
 
 @_inline
@@ -1800,7 +1803,7 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
                             math.isfinite(tol)
                             and _newton_step(J_out if n_inputs > 0 else J, r, dx_f)
                             and _distance(dx_f, scratch[1], dscale, length) * length
-                            <= 0.01 * tol)
+                            <= _PREDICTED_FINE * tol)
                         if converged and math.sqrt(d2) / 15.0 <= tol:
                             estimate = math.sqrt(d2) / 15.0
                             recorded = True

@@ -568,15 +568,16 @@ class PreparedSolve:
             np.copyto(start_tip, tip[0])
         else:
             last = solver._last
-            if last is not self._last:  # the Solver moved since (or never came here)
-                if last is not None and last[3] == self._signature \
-                        and last[0] is self._pieces[0]:
-                    np.copyto(start_piece, last[1])
-                    np.copyto(start_tip, last[2])
-                else:  # from the unloaded arm
-                    solver.reset()
-                    start_piece[:] = 0.0
-                    start_tip[:] = 0.0
+            if last is not None and last is not self._last and (
+                    last[3] == self._signature and last[0] is self._pieces[0]):
+                # another call of the Solver moved it since, with these actuators on this
+                # cut: its path starts from there
+                np.copyto(start_piece, last[1])
+                np.copyto(start_tip, last[2])
+            elif last is None or last is not self._last:  # from the unloaded arm
+                solver.reset()
+                start_piece[:] = 0.0
+                start_tip[:] = 0.0
             if solver._memory is None:
                 solver._memory = np.zeros(k.MEMORY)
             memory = solver._memory
@@ -606,6 +607,12 @@ class PreparedSolve:
             k.stability_cases(solver._base_kernel, self._arm, (piece, tip), self._outs[7],
                               self._Ns, self._tips, 1, self._index, self._theta0, self._flags)
             self.index, self.conservative = int(self._index[0]), bool(self._flags[0])
+
+    def reset(self) -> None:
+        """Back to the unloaded arm: the Solver's quasi-static state, and this object's last
+        answer (no prediction from it)."""
+        self._solver.reset()
+        self._last = None
 
     def loads_at(self, q) -> tuple:
         """The loads with the inputs q (:attr:`inputs`' order), values not validated again."""
