@@ -216,18 +216,11 @@ class ForwardSolver:
     def __init__(self, arm, actuators, loads=(), *, tol=1e-6, s="tip", jacobians=True,
                  stability=True):
         self.arm = arm
-        self.actuators = as_loads(actuators)
-        for load in self.actuators:
-            if not load.inputs:
-                raise TypeError(f"actuators must be loads with actuation inputs (Tendon, "
-                                f"Chamber, MagneticField), got {load!r}")
-            if load.batch_shape != ():
-                raise ValueError(f"actuators must be single (unbatched) loads, got "
-                                 f"{type(load).__name__} of batch shape {load.batch_shape}")
-            if load.displacement_controlled:
-                raise ValueError("ForwardSolver takes tension-controlled tendons (a "
-                                 "displacement-controlled Tendon's tension is an unknown of "
-                                 "the problem, solved by softarm.solve or Solver.solve)")
+        self.actuators = _actuator_loads(actuators)
+        if any(load.displacement_controlled for load in self.actuators):
+            raise ValueError("ForwardSolver takes tension-controlled tendons (a "
+                             "displacement-controlled Tendon's tension is an unknown of the "
+                             "problem, solved by softarm.solve or Solver.solve)")
         self.loads = as_loads(loads)
         if isinstance(s, str) and s == "tip":
             s = [float(arm.length)]
@@ -339,14 +332,7 @@ class InverseSolver:
     def __init__(self, arm, actuators, loads=(), *, bounds=None, scales=None, tol=1e-6,
                  max_iterations=10, s=None, solver_tol=None):
         self.arm = arm
-        self.actuators = as_loads(actuators)
-        for load in self.actuators:
-            if not load.inputs:
-                raise TypeError(f"actuators must be loads with actuation inputs (Tendon, "
-                                f"Chamber, MagneticField), got {load!r}")
-            if load.batch_shape != ():
-                raise ValueError(f"actuators must be single (unbatched) loads, got "
-                                 f"{type(load).__name__} of batch shape {load.batch_shape}")
+        self.actuators = _actuator_loads(actuators)
         self.loads = as_loads(loads)
         self.tol = real(tol, "tol")
         if not self.tol > 0.0:
@@ -767,6 +753,19 @@ class InverseSolver:
             first, **fields, loads=(*self.loads, *self._stacked_actuators(inputs)),
             stability=stability, residual=np.array([eq.residual for eq in equilibria]),
             error_estimate=np.array([eq.error_estimate for eq in equilibria]))
+
+
+def _actuator_loads(actuators) -> tuple:
+    """The actuators as loads, each checked: loads with actuation inputs, single (unbatched)."""
+    actuators = as_loads(actuators)
+    for load in actuators:
+        if not load.inputs:
+            raise TypeError(f"actuators must be loads with actuation inputs (Tendon, "
+                            f"Chamber, MagneticField), got {load!r}")
+        if load.batch_shape != ():
+            raise ValueError(f"actuators must be single (unbatched) loads, got "
+                             f"{type(load).__name__} of batch shape {load.batch_shape}")
+    return actuators
 
 
 def _size(e) -> float:
