@@ -324,11 +324,6 @@ class _Channels:
         unloaded = np.array([_unloaded_length(pieces, self.actuators[a]) for a in columns])
         return arm, columns, unloaded
 
-    def single(self, piece, tip) -> _Channels:
-        """A copy of these channels (the same pieces and actuators) holding the single case
-        ``piece`` (P, PIECE_LOADS + A), ``tip`` (TIP_LOADS,)."""
-        return self.cases(piece[None], tip[None], ())
-
     def cases(self, piece, tip, shape) -> _Channels:
         """A copy of these channels (the same pieces and actuators) holding the cases
         ``piece`` (B, P, PIECE_LOADS + A), ``tip`` (B, TIP_LOADS) of batch shape ``shape``."""
@@ -388,7 +383,7 @@ class Shooter:
     """
 
     def __init__(self, solver, prepared, arm, inputs, unit_piece, unit_tip):
-        self._solver, self._prepared, self._arm = solver, prepared, arm
+        self._solver, self._arm = solver, arm
         _, _, _, pieces, channels = prepared
         self._piece_lengths, self._actuators = pieces[1], len(channels.actuators)
         piece, tip = channels.piece[0], channels.tip_loads[0]
@@ -398,10 +393,8 @@ class Shooter:
         # row, and its column is dropped from the result
         self._rates = (unit_piece, unit_tip) if inputs.size else (
             np.zeros((1, *piece.shape)), np.zeros((1, tip.size)))
-        self._unit_flat = unit_piece.reshape(inputs.size, piece.size)  # (n = 0 too)
-        # the channels at q = 0
-        self._piece0 = piece - (inputs @ self._unit_flat).reshape(piece.shape)
-        self._tip0 = tip - inputs @ unit_tip
+        self._piece0, self._unit_flat, self._tip0 = _at_zero_inputs(piece, tip, inputs,
+                                                                     unit_piece, unit_tip)
         self._counts = {}  # step counts per `steps` argument
 
     def __call__(self, x, inputs=None, *, load_factor=1.0, steps=None) -> ShootResult:
@@ -516,10 +509,10 @@ class PreparedSolve:
         n, P, A = self.inputs.size, pieces[0].size, len(channels.actuators)
         self._unit = (unit_piece, unit_tip) if jacobians else (
             solver._unused((0, P, W)), solver._unused((0, k.TIP_LOADS)))
-        self._unit_flat, self._unit_tip = unit_piece.reshape(n, P * W), unit_tip
-        # the channels at q = 0, and the case's own (one row each), rewritten by every call
-        self._piece0 = channels.piece[0] - (self.inputs @ self._unit_flat).reshape(P, W)
-        self._tip0 = channels.tip_loads[0] - self.inputs @ unit_tip
+        self._piece0, self._unit_flat, self._tip0 = _at_zero_inputs(
+            channels.piece[0], channels.tip_loads[0], self.inputs, unit_piece, unit_tip)
+        self._unit_tip = unit_tip
+        # the case's own channels (one row each), rewritten by every call
         self._piece, self._tip = channels.piece.copy(), channels.tip_loads.copy()
         self._start = (np.zeros((P, W)), np.zeros(k.TIP_LOADS))  # the path's start loads
         self._arm = channels.arm_tuple()
@@ -692,6 +685,15 @@ class PreparedSolve:
         """The actuator columns (of :attr:`lengths`, of :attr:`jacobian`'s rows 6..) that
         are tendons."""
         return self._channels.tendons()[0]
+
+
+def _at_zero_inputs(piece, tip, inputs, unit_piece, unit_tip) -> tuple:
+    """The load channels of one case, affine in its actuation inputs q (piece(q) = piece0 +
+    Σᵢ qᵢ unitᵢ, likewise the tip's), at q = 0: (piece0 (P, W), the unit pieces flattened
+    (n, P W), tip0 (TIP_LOADS,)), from the case at ``inputs`` (n,)."""
+    unit_flat = unit_piece.reshape(inputs.size, piece.size)  # (n = 0 too)
+    return (piece - (inputs @ unit_flat).reshape(piece.shape), unit_flat,
+            tip - inputs @ unit_tip)
 
 
 def _shoot(k, x, lam, counts, base, arm, case, actuators) -> ShootResult:
@@ -907,19 +909,16 @@ class Solver:
         return self._solve(loads, chained=False, jacobians=jacobians)
 
     def _solve(self, loads, *, chained: bool, jacobians: bool, near: bool = False,
-               prepared=None, outputs: bool = True, checked: bool = False
-               ) -> Equilibrium | None:
+               outputs: bool = True, checked: bool = False) -> Equilibrium | None:
         """``near``: a single case whose path starts at its own loads, from the memory
-        :meth:`solve_near` wrote (λ = 0 and λ = 1 the same loads); ``prepared``: what
-        :meth:`_prepare` returns for these loads (a :class:`Shooter`'s); ``outputs=False``:
-        only the memory of a chained solve (the tip its one station, no verdict), None;
+        :meth:`solve_near` wrote (λ = 0 and λ = 1 the same loads); ``outputs=False``: only
+        the memory of a chained solve (the tip its one station, no verdict), None;
         ``checked``: ``loads`` is what :meth:`check_loads` returned."""
         if not isinstance(jacobians, (bool, np.bool_)):
             raise TypeError(f"jacobians must be True or False, got {jacobians!r}")
         if not checked:
             loads = as_loads(loads)
-        # (prepared loads are a Shooter's: tension-controlled, or it would not exist)
-        if prepared is None and any(load.displacement_controlled for load in loads):
+        if any(load.displacement_controlled for load in loads):
             # the tensions are unknowns: a bounded Newton method over tension-controlled
             # solves from the unloaded arm (statics/displacement.py); a chained Solver
             # restarts from the unloaded arm after it
@@ -930,7 +929,7 @@ class Solver:
             return solve_displaced(self, loads, jacobians=jacobians)
         k = _kernels()
         last = self._last if chained else None
-        loads, shape, count, pieces, channels = prepared or self._prepare(
+        loads, shape, count, pieces, channels = self._prepare(
             loads, () if last is None else tuple(last[0]), checked=checked)
         if near:
             if shape != ():
@@ -1055,9 +1054,9 @@ class Solver:
         ``x`` (N, N m, spatial), a solution on ``steps`` RK4 steps over the arm (from
         continuation), refined to tol like any solve: the branch x is on, not the one
         connected to the unloaded arm. Leaves this Solver at that equilibrium."""
-        return self._solve_near(loads, x, steps, None)
+        return self._solve_near(loads, x, steps)
 
-    def _solve_near(self, loads, x, steps, prepared) -> Equilibrium:
+    def _solve_near(self, loads, x, steps) -> Equilibrium:
         k = _kernels()
         self.reset()
         memory = np.zeros(k.MEMORY)
@@ -1065,7 +1064,7 @@ class Solver:
         memory[12] = max(1, int(steps) // 2)
         memory[13] = 1.0
         self._memory = memory
-        return self._solve(loads, chained=True, jacobians=False, near=True, prepared=prepared)
+        return self._solve(loads, chained=True, jacobians=False, near=True)
 
     def shoot(self, loads, x, load_factor=1.0, *, steps=None, inputs=False) -> ShootResult:
         """One integration from the base reaction ``x`` = (n(0); m(0)) (N, N m, spatial) at
