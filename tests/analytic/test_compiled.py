@@ -7,6 +7,7 @@ test_elastica_math.py (test_one_load_route_equals_batch_route).
 
 from __future__ import annotations
 
+import math
 import subprocess
 import sys
 
@@ -51,6 +52,25 @@ def test_carlson_rd_against_mpmath(rng):
         for args in ((x, 1.0, z), (x, y + 1e-3, 1.0), (z, z, z)):
             want = float(mp.elliprd(*(mp.mpf(float(v)) for v in args)))
             assert _compiled.carlson_rd(*args) == pytest.approx(want, rel=2e-15, abs=0.0)
+
+
+def test_carlson_integrals_diverge_where_two_arguments_vanish():
+    """R_F with two zero arguments, R_D with x = y = 0 or z = 0: +inf, their limit (mpmath's
+    value there), returned at once; the duplication never ended there (a tip-condition
+    Newton step that left the range, cosh ρ overflowing, hung the planar elastica). Beside
+    those points both stay finite and equal mpmath's, growing as the arguments vanish."""
+    for args in ((0.0, 0.0, 1.0), (0.0, 2.0, 0.0), (3.0, 0.0, 0.0)):
+        assert _compiled.carlson_rf(*args) == math.inf == float(mp.elliprf(*args))
+    for args in ((0.0, 0.0, 1.0), (1.0, 2.0, 0.0)):
+        assert _compiled.carlson_rd(*args) == math.inf == float(mp.elliprd(*args))
+    previous = 0.0
+    for tiny in (1e-10, 1e-100, 1e-300, 5e-324):
+        value = _compiled.carlson_rf(tiny, tiny, 1.0)
+        assert value == pytest.approx(float(mp.elliprf(tiny, tiny, 1.0)), rel=2e-15)
+        assert previous < value < math.inf
+        previous = value
+        assert _compiled.carlson_rd(tiny, tiny, 1.0) == pytest.approx(
+            float(mp.elliprd(tiny, tiny, 1.0)), rel=2e-15)
 
 
 @pytest.mark.parametrize("mc", [1.0, 0.5, 1e-3, 1e-9, 1e-16, 0.0])

@@ -59,7 +59,11 @@ _jit = jit(what="softarm's compiled closed forms", error_model="numpy", fastmath
 
 @_jit
 def carlson_rf(x, y, z):
-    """Carlson's R_F(x, y, z) for x, y, z ≥ 0, at most one of them zero (DLMF §19.36)."""
+    """Carlson's R_F(x, y, z) for x, y, z ≥ 0, at most one of them zero (DLMF §19.36); +inf
+    where two are zero (its limit there; the duplication below would never stop: the two
+    zeros stay zero while the mean and the spread shrink alike)."""
+    if x + y == 0.0 or x + z == 0.0 or y + z == 0.0:
+        return math.inf
     a0 = (x + y + z) / 3.0
     q = _Q_RF * max(abs(a0 - x), abs(a0 - y), abs(a0 - z))
     a, scale = a0, 1.0  # scale = 4^-n
@@ -82,7 +86,10 @@ def carlson_rf(x, y, z):
 
 @_jit
 def carlson_rd(x, y, z):
-    """Carlson's R_D(x, y, z) for x, y ≥ 0 (at most one zero), z > 0 (DLMF §19.36)."""
+    """Carlson's R_D(x, y, z) for x, y ≥ 0 (at most one zero), z > 0 (DLMF §19.36); +inf
+    where x and y are both zero or z is (its limit there, as for :func:`carlson_rf`)."""
+    if x + y == 0.0 or z == 0.0:
+        return math.inf
     a0 = (x + y + 3.0 * z) / 5.0
     q = _Q_RD * max(abs(a0 - x), abs(a0 - y), abs(a0 - z))
     a, scale, total = a0, 1.0, 0.0
