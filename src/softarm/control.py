@@ -567,10 +567,10 @@ class InverseSolver:
         # the kernel's arrays, allocated once per task size (every one is written before it
         # is read; the warm step reads A and G as given, the buffers the last call wrote)
         work = self._fast_arrays.get(t)
-        if work is None:
-            shared = self._fast_arrays.get(9 - t)  # (the other task size's: 3 + 6 = 9)
-            A, G = (np.zeros((6, n)), np.zeros((6, 1 + n))) if shared is None \
-                else (shared.A, shared.G)
+        if work is None:  # (A and G shared with the other task size's arrays, if made)
+            other = next(iter(self._fast_arrays.values()), None)
+            A, G = (np.zeros((6, n)), np.zeros((6, 1 + n))) if other is None \
+                else (other.A, other.G)
             work = self._fast_arrays[t] = _FastArrays.of(n, t, self._weights[t], A, G)
         # (copies: a read-only array is another type to numba, one more compiled version)
         np.copyto(work.target, target)
