@@ -8,6 +8,8 @@ CI that no local run had met: the example is now pinned in its test.)
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 import pytest
 from hypothesis import settings
@@ -16,6 +18,11 @@ from softarm.validation import reference_table as _packaged_table
 
 settings.register_profile("softarm", derandomize=True, database=None)
 settings.load_profile("softarm")
+
+# The one-line notice a kernel's first compile prints (softarm._jit) depends on what the
+# numba cache holds when a test runs: off for the suite and the commands it starts, on in
+# tests/test_compile.py, which tests it.
+os.environ["SOFTARM_COMPILE_NOTICE"] = "0"
 
 
 @pytest.fixture

@@ -589,7 +589,7 @@ class InverseSolver:
                    zeros[2] if miss is None else miss[1],
                    zeros[3] if miss is None else miss[2])
         info = work.info
-        k.inverse_newton(x, q, every, first, steps, base, arm, units, goal,
+        k.inverse_newton(x, q, every, first, steps, base, *arm, units, goal,
                          (self.lower, self.upper, self.scales), work.settings, warm_in,
                          (work.A, work.G, work.J, work.linear, work.singular), info)
         if info[0] != k.NEWTON_DONE:

@@ -55,6 +55,9 @@ _Q_RD = (0.25 * 2.0**-53) ** (-1.0 / 6.0)
 _STEP = 0.25
 
 _jit = jit(what="softarm's compiled closed forms", error_model="numpy", fastmath=False)
+#: The entry points (called from Python), announced when they compile (softarm._jit)
+_entry = jit(what="softarm's compiled closed forms", error_model="numpy", fastmath=False,
+             capability=lambda args: ("closed forms", "the closed forms' kernels"))
 
 
 @_jit
@@ -218,7 +221,7 @@ def _station(target, mc, rho_tip, start):
     return _sin_cos_from_rho(x)
 
 
-@_jit
+@_entry
 def solve(k, a, sign, a_r, g_r, s, cheb, weights, out):
     """The planar elastica for one load with 0 < a < π (rad) from the force to +x, k > 0.
 
@@ -355,7 +358,7 @@ def _taylor_start(h, sn, cn, mc):
     return math.nan
 
 
-@_jit
+@_entry
 def fields(by, bz, length, stiffness, solution, out):
     """Poses (flattened, 16 columns), strains (6) and stresses (6) of a planar solution.
 
@@ -403,7 +406,7 @@ def fields(by, bz, length, stiffness, solution, out):
         row[27] = (by / length * ei_z) * curvature
 
 
-@_jit
+@_entry
 def screw(u, omega, twist, s, extra, out):
     """Poses of H(s) = exp_SE3(s (u; ω)) · exp_SE3(s (0; τ e1)) and fields linear in ψ = τ s.
 

@@ -41,6 +41,7 @@ import math
 from functools import partial
 
 import numpy as np
+from numba.core import types
 
 from .._jit import jit
 
@@ -66,9 +67,46 @@ _jit = partial(jit, what="the shooting solver's kernels")
 #: 17 % faster but the cold compile 12 s longer). Measured cold compile of a first solve with
 #: its stability verdict (benchmarks/run.py's figure): 110 s -> 62 s on this 2-core machine.
 _inline = partial(jit, what="the shooting solver's kernels", inline="always")
-#: The batch entry points: they release the GIL, so that a batch runs in threads (chunks of
-#: independent cases: Solver's ``threads``)
-_batch = partial(jit, what="the shooting solver's kernels", nogil=True)
+
+
+def _entry(capability, **options):
+    """The decorator of an entry point (a kernel called from Python): compiled and announced
+    per capability (``capability``: argument types -> (key, text), softarm._jit). The batch
+    entry points take ``nogil=True``: a batch runs in threads (chunks of independent cases:
+    Solver's ``threads``)."""
+    return partial(jit, what="the shooting solver's kernels", capability=capability, **options)
+
+
+def _given(argument) -> bool:
+    """Whether an optional argument's type is given (not None): the capabilities of a compile
+    (None arguments prune their code, README.md)."""
+    return not isinstance(argument, types.NoneType)
+
+
+def _solver(args):
+    """solve_cases' capability: passive or actuated (``act``), chained (``memory``), with
+    Jacobians (``inputs``)."""
+    actuated, chained, jacobians = _given(args[2]), _given(args[7]), _given(args[8])
+    key = "+".join(["actuated" if actuated else "solve"] + ["chained"] * chained
+                   + ["jacobians"] * jacobians)
+    text = "the solver for " + ("actuated or magnetic arms" if actuated else "passive arms")
+    text += " (quasi-static, chained)" * chained + " with Jacobians" * jacobians
+    return key, text
+
+
+def _per_arm(key: str, text: str, act: int):
+    """The capability of an entry point that is compiled per kind of arm: ``act`` is the
+    index of its argument ``act``."""
+    def capability(args):
+        actuated = _given(args[act])
+        return (key + "+actuated" * actuated,
+                text + (" for actuated or magnetic arms" if actuated else " for passive arms"))
+    return capability
+
+
+def _fixed(key: str, text: str):
+    return lambda args: (key, text)
+
 
 
 # Status codes returned per load case.
@@ -113,9 +151,8 @@ TD, TF = _TD, _TF = 0, 6
 TIP_LOADS = 12
 
 # Solver options, one float array (OPTIONS long): see solve_cases.
-(_O_TOL, _O_ITER, _O_LOADSTEP, _O_NFIXED, _O_NMAX, _O_BUDGET, _O_CHAINED,
- _O_JACOBIANS, _O_COARSE, _O_NEAR) = range(10)
-OPTIONS = 10
+(_O_TOL, _O_ITER, _O_LOADSTEP, _O_NFIXED, _O_NMAX, _O_BUDGET, _O_COARSE, _O_NEAR) = range(8)
+OPTIONS = 8
 
 # The memory of a chained (quasi-static) solve, in and out (MEMORY long): x at the coarse
 # step count N (6), x at 2N (6), N, valid (1 if the memory holds a solved case), the sign of
@@ -194,7 +231,7 @@ def _route(routes, a, s):
 
 
 @_jit
-def _law(arm, j, s, now, law, tangents, s0, s1, s2, s3, s4, s5):
+def _law(arm, act, j, s, now, law, tangents, s0, s1, s2, s3, s4, s5):
     """The constitutive law of piece j at arc length s with its actuators (Rucker & Webster
     2011, in total-wrench form): the strains ε = (v; u) solving
 
@@ -225,7 +262,7 @@ def _law(arm, j, s, now, law, tangents, s0, s1, s2, s3, s4, s5):
     onto itself).
     """
     f0, C, K = arm[3], arm[2], arm[8]
-    routes, kinds, active = arm[9], arm[10], arm[11]
+    routes, kinds, active = act[0], act[1], act[2]
     M, tw, vec, jw = law
     length = arm[6]
     rhs, eps = vec[0], vec[2]
@@ -410,10 +447,10 @@ def _ldl_substitute(M, k):
 
 
 @_jit
-def _actuator_rates(arm, j, rate, law, ds):
+def _actuator_rates(act, j, rate, law, ds):
     """The actuators' own change with λ in the constitutive law, added to the λ column ds
     (material): Σ_chambers d(pA)/dλ (e1; r × e1) - Σ_tendons dτ/dλ (t; r × t)."""
-    routes, kinds, active = arm[9], arm[10], arm[11]
+    routes, kinds, active = act[0], act[1], act[2]
     tw = law[1]
     for a in range(routes.shape[0]):
         if active[j, a] == 0.0:
@@ -435,9 +472,9 @@ def _actuator_rates(arm, j, rate, law, ds):
 
 
 @_inline
-def _actuated(arm, j):
+def _actuated(act, j):
     """Whether actuators act on piece j (the constitutive law then is :func:`_law`)."""
-    active = arm[11]
+    active = act[2]
     for a in range(active.shape[1]):
         if active[j, a] != 0.0:
             return True
@@ -445,7 +482,7 @@ def _actuated(arm, j):
 
 
 @_inline
-def _deriv(work, twork, nt, stage, s, arm, j, now, rate, law):
+def _deriv(work, twork, nt, stage, s, arm, act, j, now, rate, law):
     """F(y) and the right-hand side of the first nt tangent columns, on piece j at arc
     length s.
 
@@ -460,7 +497,6 @@ def _deriv(work, twork, nt, stage, s, arm, j, now, rate, law):
     and at parity inlined. The actuated path's own work is in :func:`_law`.
     """
     C, f0, zero, diag = arm[2], arm[3], arm[4], arm[5]
-    mag = arm[12]
     Y = 4
     R00, R01, R02 = work[Y, _R], work[Y, _R + 1], work[Y, _R + 2]
     R10, R11, R12 = work[Y, _R + 3], work[Y, _R + 4], work[Y, _R + 5]
@@ -474,9 +510,11 @@ def _deriv(work, twork, nt, stage, s, arm, j, now, rate, law):
     s3 = R00 * mx + R10 * my + R20 * mz
     s4 = R01 * mx + R11 * my + R21 * mz
     s5 = R02 * mx + R12 * my + R22 * mz
-    actuated = _actuated(arm, j)
-    if actuated:
-        v0, v1, v2, u0, u1, u2, factored = _law(arm, j, s, now, law, nt, s0, s1, s2, s3,
+    # (every use of ``act`` is behind ``act is not None``: compiled for a passive arm, the
+    # actuated law, the tendons' lengths and the magnets are pruned before typing)
+    actuated = act is not None and _actuated(act, j)
+    if act is not None and actuated:
+        v0, v1, v2, u0, u1, u2, factored = _law(arm, act, j, s, now, law, nt, s0, s1, s2, s3,
                                                 s4, s5)
     else:
         v0, v1, v2, u0, u1, u2 = _strain(C, f0, j, diag, s0, s1, s2, s3, s4, s5)
@@ -508,17 +546,20 @@ def _deriv(work, twork, nt, stage, s, arm, j, now, rate, law):
     w[_M + 2] = -(px * ny - py * nx) - (now[j, _LD + 2] + R20 * lf0 + R21 * lf1 + R22 * lf2)
     # a hard magnetisation m (material, A m²/m) in B(x) = B0 + G x: force Gᵀ (R m), torque
     # (R m) × B(p) per unit length
-    ma0, ma1, ma2 = mag[j, 0], mag[j, 1], mag[j, 2]
+    ma0 = ma1 = ma2 = 0.0
+    if act is not None:
+        ma0, ma1, ma2 = act[3][j, 0], act[3][j, 1], act[3][j, 2]
     magnetic = ma0 != 0.0 or ma1 != 0.0 or ma2 != 0.0
-    if magnetic:
+    if act is not None and magnetic:
         _dipole(work[Y], twork[Y], np.int64(0), ma0, ma1, ma2, now[j], rate[0, j], law[2][3])
         for i in range(3):
             w[_N + i] -= law[2][3, i]
             w[_M + i] -= law[2][3, 3 + i]
     # the tendons' lengths: ℓ' = |w| where they run
-    for a in range(w.size - 18):
-        w[18 + a] = law[1][a, 3] if actuated and arm[11][j, a] != 0.0 and \
-            arm[10][a] == TENDON else 0.0
+    if act is not None:
+        for a in range(w.size - 18):
+            w[18 + a] = law[1][a, 3] if actuated and act[2][j, a] != 0.0 and \
+                act[1][a] == TENDON else 0.0
     if nt == 0:
         return
     # δσ = (Rᵀδn + σ_n × δθ; Rᵀδm + σ_m × δθ), then δ(v; u) = dstrain δσ (+ the actuators'
@@ -538,9 +579,9 @@ def _deriv(work, twork, nt, stage, s, arm, j, now, rate, law):
         M[3, 6 + d] = R00 * dm0 + R10 * dm1 + R20 * dm2 + s4 * th2 - s5 * th1
         M[4, 6 + d] = R01 * dm0 + R11 * dm1 + R21 * dm2 + s5 * th0 - s3 * th2
         M[5, 6 + d] = R02 * dm0 + R12 * dm1 + R22 * dm2 + s3 * th1 - s4 * th0
-    if actuated:
+    if act is not None and actuated:
         for d in range(LAM, nt):
-            _actuator_rates(arm, j, rate[d - LAM], law, law[2][4])
+            _actuator_rates(act, j, rate[d - LAM], law, law[2][4])
             for i in range(6):
                 M[i, 6 + d] += law[2][4, i]
                 law[2][4, i] = 0.0
@@ -554,7 +595,7 @@ def _deriv(work, twork, nt, stage, s, arm, j, now, rate, law):
         t = twork[Y, d]
         th0, th1, th2 = t[_TT], t[_TT + 1], t[_TT + 2]
         dn0, dn1, dn2 = t[_TN], t[_TN + 1], t[_TN + 2]
-        if actuated:
+        if act is not None and actuated:
             c0, c1, c2 = M[0, 6 + d], M[1, 6 + d], M[2, 6 + d]
             c3, c4, c5 = M[3, 6 + d], M[4, 6 + d], M[5, 6 + d]
         else:  # δσ = (Rᵀδn + σ_n × δθ; Rᵀδm + σ_m × δθ), then the constitutive step
@@ -602,7 +643,7 @@ def _deriv(work, twork, nt, stage, s, arm, j, now, rate, law):
             k0 -= rate[rr, j, _LD]
             k1 -= rate[rr, j, _LD + 1]
             k2 -= rate[rr, j, _LD + 2]
-        if magnetic:  # the magnetic force and torque densities' variations
+        if act is not None and magnetic:  # the magnetic force and torque densities' variations
             _dipole(work[Y], twork[Y], d + 1, ma0, ma1, ma2, now[j], rate[rr, j], law[2][3])
             g0 -= law[2][3, 0]
             g1 -= law[2][3, 1]
@@ -624,17 +665,17 @@ def _deriv(work, twork, nt, stage, s, arm, j, now, rate, law):
         o[_TM] = -(q1 * nz - q2 * ny) - (py * dn2 - pz * dn1) + k0
         o[_TM + 1] = -(q2 * nx - q0 * nz) - (pz * dn0 - px * dn2) + k1
         o[_TM + 2] = -(q0 * ny - q1 * nx) - (px * dn1 - py * dn0) + k2
-    if twork.shape[2] > NT:  # the tendons' lengths' tangents (actuated arms only)
-        _length_rates(twork[stage], nt, arm, j, actuated, law)
+    if act is not None and twork.shape[2] > NT:  # the tendons' lengths' tangents
+        _length_rates(twork[stage], nt, act, j, actuated, law)
 
 
 @_inline
-def _length_rates(out, nt, arm, j, actuated, law):
+def _length_rates(out, nt, act, j, actuated, law):
     """The tangent rates of the tendons' lengths, out[d, NT + a] = δ|w_a| = g_aᵀ δε for
     the first nt columns: δw = δv + δu × r = J δε (J = [I, -r~]), so δ|w| = tᵀ J δε with
     Jᵀ t = g = (t; r × t), t = w/|w| (from ``law[1]``), δε the columns' strain variations
     (``law[0][:, 6 + d]``); 0 where tendon a does not run, and for a chamber."""
-    kinds, active = arm[10], arm[11]
+    kinds, active = act[1], act[2]
     tw, M = law[1], law[0]
     for a in range(out.shape[1] - NT):
         if not (actuated and active[j, a] != 0.0 and kinds[a] == TENDON):
@@ -790,7 +831,7 @@ def _bjorck(y):
 
 
 @_jit
-def _steps(y, T, nt, h, s, n, arm, j, now, rate, work, twork, law):
+def _steps(y, T, nt, h, s, n, arm, act, j, now, rate, work, twork, law):
     """``n`` RK4 steps of length h (negative: towards the base) from arc length s on piece j,
     in place (the state and the first nt tangent columns of T), each followed by
     R ← R (3I - RᵀR)/2: one Björck step towards the nearest rotation. ``n`` < 0: |n| steps,
@@ -810,7 +851,7 @@ def _steps(y, T, nt, h, s, n, arm, j, now, rate, work, twork, law):
     Loops are written out (no slice assignment, no array expression): numba compiles those
     with shape checks whose error messages pull in its string machinery.
     """
-    lengths = T.shape[1] > NT  # the tendons' lengths' tangents (actuated arms only)
+    lengths = act is not None and T.shape[1] > NT  # the tendons' lengths' tangents
     for step in range(max(abs(n), 1)):
         at = s + step * h
         for stage in range(4):  # work rows 0-3: the stage derivatives; row 4: the stage state
@@ -823,11 +864,11 @@ def _steps(y, T, nt, h, s, n, arm, j, now, rate, work, twork, law):
             for d in range(nt):
                 for i in range(NT):
                     twork[4, d, i] = T[d, i] + a * twork[prev, d, i] if stage else T[d, i]
-            if lengths:
+            if act is not None and lengths:
                 for d in range(nt):
                     for i in range(NT, T.shape[1]):
                         twork[4, d, i] = T[d, i] + a * twork[prev, d, i] if stage else T[d, i]
-            _deriv(work, twork, nt, stage, at + a, arm, j, now, rate, law)
+            _deriv(work, twork, nt, stage, at + a, arm, act, j, now, rate, law)
             if n == 0:
                 return
         w = h / 6.0
@@ -837,7 +878,7 @@ def _steps(y, T, nt, h, s, n, arm, j, now, rate, work, twork, law):
             for i in range(NT):
                 T[d, i] += w * (twork[0, d, i] + 2.0 * twork[1, d, i] + 2.0 * twork[2, d, i]
                                 + twork[3, d, i])
-        if lengths:
+        if act is not None and lengths:
             for d in range(nt):
                 for i in range(NT, T.shape[1]):
                     T[d, i] += w * (twork[0, d, i] + 2.0 * twork[1, d, i]
@@ -846,11 +887,12 @@ def _steps(y, T, nt, h, s, n, arm, j, now, rate, work, twork, law):
 
 
 @_jit
-def _jump(y, T, nt, now, rate, j, arm, law):
+def _jump(y, T, nt, now, rate, j, arm, act, law):
     """The point wrench at the start of piece j: n and m drop by W_d + R W_f (and their
     tangents by R (δθ × W_f), plus ∂_λ W in the load-factor column), and by the wrench of a
     magnetic dipole there (a segment's ``tip_magnet``)."""
-    _dipole_jump(y, T, nt, arm[13], j, now[j], rate, j, law[2][5], y, T, -1.0)
+    if act is not None:
+        _dipole_jump(y, T, nt, act[4], j, now[j], rate, j, law[2][5], y, T, -1.0)
     for half in range(2):
         at = 3 * half
         W0, W1, W2 = now[j, _JF + at], now[j, _JF + at + 1], now[j, _JF + at + 2]
@@ -914,7 +956,7 @@ def _start(y, T, nt, base, x):
 
 
 @_jit
-def _tip_residual(y, T, nt, tip_now, tip_rate, r, J, arm, now, rate, law):
+def _tip_residual(y, T, nt, tip_now, tip_rate, r, J, arm, act, now, rate, law):
     """The boundary residual r at the tip and its Jacobian columns J[:, :nt]: the total
     wrench n(L), m(L) minus the tip loads (and the tip dipole's wrench)."""
     for half in range(2):
@@ -937,8 +979,9 @@ def _tip_residual(y, T, nt, tip_now, tip_rate, r, J, arm, now, rate, law):
                     y[_R + 3 * i] * c0 + y[_R + 3 * i + 1] * c1 + y[_R + 3 * i + 2] * c2)
                 if d >= LAM:
                     J[at + i, d] -= tip_rate[d - LAM, _TD + at + i]
-    last = now.shape[0] - 1
-    _dipole_jump(y, T, nt, arm[13], last + 1, now[last], rate, last, law[2][5], r, J, -1.0)
+    if act is not None:
+        last = now.shape[0] - 1
+        _dipole_jump(y, T, nt, act[4], last + 1, now[last], rate, last, law[2][5], r, J, -1.0)
 
 
 @_jit
@@ -953,7 +996,7 @@ def _set_loads(lam, case, now, tip_now):
 
 
 @_inline
-def _integrate(x, lam, nt, steps, base, arm, case, scratch, r, J):
+def _integrate(x, lam, nt, steps, base, arm, act, case, scratch, r, J):
     """Integrate base → tip from the base reaction x at load factor λ: the residual r (6) and
     the first nt Jacobian columns J[:, :nt] (6 by x, the 7th by λ). The tip state is left in
     scratch's y and its tangents in T (for the tip motion per unit x)."""
@@ -965,10 +1008,10 @@ def _integrate(x, lam, nt, steps, base, arm, case, scratch, r, J):
     piece_start, piece_len = arm[0], arm[1]
     _start(y, T, nt, base, x)
     for j in range(piece_len.size):
-        _jump(y, T, nt, now, rate, j, arm, law)
-        _steps(y, T, nt, piece_len[j] / steps[j], piece_start[j], steps[j], arm, j, now, rate,
+        _jump(y, T, nt, now, rate, j, arm, act, law)
+        _steps(y, T, nt, piece_len[j] / steps[j], piece_start[j], steps[j], arm, act, j, now, rate,
                work, twork, law)
-    _tip_residual(y, T, nt, tip_now, tip_rate, r, J, arm, now, rate, law)
+    _tip_residual(y, T, nt, tip_now, tip_rate, r, J, arm, act, now, rate, law)
 
 
 @_jit
@@ -1082,7 +1125,7 @@ def _distance(dx, T, scale, length):
 
 
 @_jit
-def _corrector(x, lam, nt, steps, base, arm, case, scratch, scale, dscale, length, threshold,
+def _corrector(x, lam, nt, steps, base, arm, act, case, scratch, scale, dscale, length, threshold,
                max_iterations, first_limit, loose, r, J, tip, counter):
     """Newton at fixed λ from the prediction x, accepted only if it stays near it.
 
@@ -1101,7 +1144,7 @@ def _corrector(x, lam, nt, steps, base, arm, case, scratch, scale, dscale, lengt
     travelled = 0.0
     y, T = scratch[0], scratch[1]
     for k in range(max_iterations + 1):
-        _integrate(x, lam, nt, steps, base, arm, case, scratch, r, J)
+        _integrate(x, lam, nt, steps, base, arm, act, case, scratch, r, J)
         counter[0] += 1
         for i in range(3):
             tip[i] = y[_P + i]
@@ -1173,7 +1216,7 @@ def _tangent(J, t):
 
 
 @_jit
-def _follow(x, steps, base, arm, case, scratch, scale, dscale, length, threshold,
+def _follow(x, steps, base, arm, act, case, scratch, scale, dscale, length, threshold,
             max_iterations, max_load_step, max_shootings, open_end, final, r, J, tip,
             counter, reached):
     """Follow the equilibrium path from λ = 0 (x: the solution there, exact or close) to
@@ -1196,7 +1239,7 @@ def _follow(x, steps, base, arm, case, scratch, scale, dscale, length, threshold
     """
     reached[0] = 0.0
     nt = J.shape[1]  # all 7 columns (a variable, not a literal: one compiled version)
-    if not _corrector(x, 0.0, nt, steps, base, arm, case, scratch, scale, dscale, length,
+    if not _corrector(x, 0.0, nt, steps, base, arm, act, case, scratch, scale, dscale, length,
                       threshold, max_iterations, _REFINE_MAX, _LOOSE, r, J, tip, counter):
         return False
     t = np.empty(6)
@@ -1243,7 +1286,7 @@ def _follow(x, steps, base, arm, case, scratch, scale, dscale, length, threshold
             return True
         for i in range(6):
             dx[i] = x[i]  # the prediction
-        ok = _corrector(x, target, nt, steps, base, arm, case, scratch, scale, dscale, length,
+        ok = _corrector(x, target, nt, steps, base, arm, act, case, scratch, scale, dscale, length,
                         threshold, max_iterations, _DIST_MAX,
                         final if target == 1.0 else _LOOSE, r, J, tip, counter)
         if ok:
@@ -1286,7 +1329,7 @@ def _follow(x, steps, base, arm, case, scratch, scale, dscale, length, threshold
 
 
 @_jit
-def _write(y, T, nt, j, s, arm, now, law, pose, strain, stress, E):
+def _write(y, T, nt, j, s, arm, act, now, law, pose, strain, stress, E):
     """One station's outputs: pose, the rod's own material strain ε - f⁰ and stress
     K (ε - f⁰) (with actuators, the total wrench less the tendons' and the fluid's share),
     and (nt >= 6) the station's motion per unit base reaction, E[:, :6] = ∂(δp; δθ)/∂x,
@@ -1303,9 +1346,9 @@ def _write(y, T, nt, j, s, arm, now, law, pose, strain, stress, E):
         stress[i] = y[_R + i] * y[_N] + y[_R + 3 + i] * y[_N + 1] + y[_R + 6 + i] * y[_N + 2]
         stress[3 + i] = (y[_R + i] * y[_M] + y[_R + 3 + i] * y[_M + 1]
                          + y[_R + 6 + i] * y[_M + 2])
-    if _actuated(arm, j):
+    if act is not None and _actuated(act, j):
         f0, K = arm[3], arm[8]
-        eps = _law(arm, j, s, now, law, np.int64(0), stress[0], stress[1], stress[2],
+        eps = _law(arm, act, j, s, now, law, np.int64(0), stress[0], stress[1], stress[2],
                    stress[3], stress[4], stress[5])
         for i in range(6):
             strain[i] = eps[i] - f0[j, i]
@@ -1329,7 +1372,7 @@ def _write(y, T, nt, j, s, arm, now, law, pose, strain, stress, E):
 
 
 @_jit
-def _record(x, nt, steps, base, arm, case, lam, scratch, s_out, out, b, r, J):
+def _record(x, nt, steps, base, arm, act, case, lam, scratch, s_out, out, b, r, J):
     """Integrate the solution x at load factor ``lam`` once more and write every station's
     outputs (the same steps as :func:`_integrate`, so the same numbers), the tip residual r
     and, with nt >= 6, the Jacobian J and the station tangents (columns 6.. along the
@@ -1357,7 +1400,7 @@ def _record(x, nt, steps, base, arm, case, lam, scratch, s_out, out, b, r, J):
     one = np.int64(1)  # not a literal 1: _steps is compiled once for every caller
     zero = one - one
     for j in range(npieces):
-        _jump(y, T, nt, now, rate, j, arm, law)
+        _jump(y, T, nt, now, rate, j, arm, act, law)
         h = piece_len[j] / steps[j]
         i = 0
         known = False  # work[0], twork[0] hold the derivatives at (y, T, this step's start)
@@ -1368,7 +1411,7 @@ def _record(x, nt, steps, base, arm, case, lam, scratch, s_out, out, b, r, J):
             if k < ns:
                 run = min(run, max(int((s_out[k] - piece_start[j]) / h) - 1 - i, 0))
             if run > 0:
-                _steps(y, T, nt, h, piece_start[j] + i * h, -run if known else run, arm, j,
+                _steps(y, T, nt, h, piece_start[j] + i * h, -run if known else run, arm, act, j,
                        now, rate, work, twork, law)
                 known = False
                 i += run
@@ -1379,7 +1422,7 @@ def _record(x, nt, steps, base, arm, case, lam, scratch, s_out, out, b, r, J):
                 piece_start[j + 1] if j < npieces - 1 else np.inf)
             inside = k < ns and s_out[k] < t1 and not (last and s_out[k] >= arm[6])
             if not inside:  # (the tip station is the tip state itself, below)
-                _steps(y, T, nt, h, t0, -one if known else one, arm, j, now, rate, work,
+                _steps(y, T, nt, h, t0, -one if known else one, arm, act, j, now, rate, work,
                        twork, law)
                 known = False
                 i += 1
@@ -1391,14 +1434,14 @@ def _record(x, nt, steps, base, arm, case, lam, scratch, s_out, out, b, r, J):
             for d in range(nt):
                 for a in range(T.shape[1]):
                     twork[5, d, a] = T[d, a]
-            _steps(y, T, nt, h, t0, -one if known else one, arm, j, now, rate, work, twork,
+            _steps(y, T, nt, h, t0, -one if known else one, arm, act, j, now, rate, work, twork,
                    law)
             _copy(work[0], work[6])
             for d in range(nt):
                 for a in range(T.shape[1]):
                     twork[6, d, a] = twork[0, d, a]
             # (at the next step's own start, to the bit: its first stage is this one)
-            _steps(y, T, nt, h, piece_start[j] + (i + 1) * h, zero, arm, j, now, rate, work,
+            _steps(y, T, nt, h, piece_start[j] + (i + 1) * h, zero, arm, act, j, now, rate, work,
                    twork, law)
             known = i + 1 < steps[j]
             while k < ns and s_out[k] < t1:
@@ -1416,14 +1459,14 @@ def _record(x, nt, steps, base, arm, case, lam, scratch, s_out, out, b, r, J):
                         Ts[d, a] = (c0 * twork[5, d, a] + c1 * twork[6, d, a] + c2 * T[d, a]
                                     + c3 * twork[0, d, a])
                 _station_rotation(work[5], work[6], y, work[0], u, h, ys)
-                _write(ys, Ts, nt, j, s_out[k], arm, now, law, poses[k], strains[k],
+                _write(ys, Ts, nt, j, s_out[k], arm, act, now, law, poses[k], strains[k],
                        stresses[k], E[k])
                 k += 1
             i += 1
     for i in range(k, ns):
-        _write(y, T, nt, npieces - 1, arm[6], arm, now, law, poses[i], strains[i],
+        _write(y, T, nt, npieces - 1, arm[6], arm, act, now, law, poses[i], strains[i],
                stresses[i], E[i])
-    _tip_residual(y, T, nt, tip_now, tip_rate, r, J, arm, now, rate, law)
+    _tip_residual(y, T, nt, tip_now, tip_rate, r, J, arm, act, now, rate, law)
     for a in range(J.shape[0] - 6):  # rows 6 + a (when given): tendon a's length's tangents
         for d in range(nt):
             J[6 + a, d] = T[d, NT + a]
@@ -1443,7 +1486,7 @@ def _fill_steps(length, piece_len, N, factor, out):
 
 
 @_jit
-def _load_size(arm, scale, start, end, tip_start, tip_end):
+def _load_size(arm, act, scale, start, end, tip_start, tip_end):
     """(w, turning): the case's largest load in units of the bending scale (EI/L² for
     forces, EI/L for moments; distributed loads times the piece length, at either end of
     the homotopy) and an upper estimate of the total turning of the arm (rad), the largest
@@ -1454,7 +1497,6 @@ def _load_size(arm, scale, start, end, tip_start, tip_end):
     on each piece it acts on; a magnetisation m as a moment |m| |B|
     per length, and a dipole as a moment |m| |B|, |B| bounded by |B0| + |G| (L + |p0|)."""
     piece_len, C = arm[1], arm[2]
-    routes, mag, dipoles = arm[9], arm[12], arm[13]
     L = arm[6]
     fs, ms = scale[0], scale[3]
     flexibility = 0.0  # ∫ ds / EI, with each piece's largest rotational compliance
@@ -1480,19 +1522,22 @@ def _load_size(arm, scale, start, end, tip_start, tip_end):
                 m += abs(loads[j, _LD + i]) + abs(loads[j, _LF + i])
                 jf += abs(loads[j, _JD + i]) + abs(loads[j, _JF + i])
                 jm += abs(loads[j, _JD + 3 + i]) + abs(loads[j, _JF + 3 + i])
-            field = 0.0
-            for i in range(3):
-                field += abs(loads[j, _FB + i])
-            for i in range(9):
-                field += abs(loads[j, _FG + i]) * 2.0 * L
-            dipole = abs(dipoles[j, 0]) + abs(dipoles[j, 1]) + abs(dipoles[j, 2])
-            if j == piece_len.size - 1:
-                dipole += abs(dipoles[j + 1, 0]) + abs(dipoles[j + 1, 1]) + abs(dipoles[j + 1, 2])
-            m += (abs(mag[j, 0]) + abs(mag[j, 1]) + abs(mag[j, 2])) * field
-            jm += dipole * field
             actuated = 0.0  # internal: a moment along the piece, no net force
-            for a in range(routes.shape[0]):
-                actuated += abs(loads[j, _ACT + a]) * routes[a, _RHO]
+            if act is not None:
+                routes, mag, dipoles = act[0], act[3], act[4]
+                field = 0.0
+                for i in range(3):
+                    field += abs(loads[j, _FB + i])
+                for i in range(9):
+                    field += abs(loads[j, _FG + i]) * 2.0 * L
+                dipole = abs(dipoles[j, 0]) + abs(dipoles[j, 1]) + abs(dipoles[j, 2])
+                if j == piece_len.size - 1:
+                    dipole += (abs(dipoles[j + 1, 0]) + abs(dipoles[j + 1, 1])
+                               + abs(dipoles[j + 1, 2]))
+                m += (abs(mag[j, 0]) + abs(mag[j, 1]) + abs(mag[j, 2])) * field
+                jm += dipole * field
+                for a in range(routes.shape[0]):
+                    actuated += abs(loads[j, _ACT + a]) * routes[a, _RHO]
             actuators = max(actuators, actuated)
             f_along += f * piece_len[j] + jf
             w = max(w, f_along / fs, m * piece_len[j] / ms, jm / ms, actuated / ms)
@@ -1517,7 +1562,7 @@ def _first_steps(arm, tol, turning):
 
 
 @_inline
-def _chord(x, J_c, steps, base, arm, case, scratch, scale, threshold, max_iterations,
+def _chord(x, J_c, steps, base, arm, act, case, scratch, scale, threshold, max_iterations,
            may_defer, r, J, tip, counter):
     """The solution at λ = 1 with another step count by chord iterations from x (a solution
     with a nearby step count) with that solution's Jacobian J_c, state only (no tangents).
@@ -1535,7 +1580,7 @@ def _chord(x, J_c, steps, base, arm, case, scratch, scale, threshold, max_iterat
     previous = np.inf
     none = J.shape[1] - 7  # no tangents (a variable, not a literal: one compiled version)
     for _ in range(max_iterations):
-        _integrate(x, 1.0, none, steps, base, arm, case, scratch, r, J)
+        _integrate(x, 1.0, none, steps, base, arm, act, case, scratch, r, J)
         counter[0] += 1
         for i in range(3):
             tip[i] = scratch[0][_P + i]
@@ -1589,29 +1634,37 @@ def _copy(src, dst):
 
 
 @_inline
-def _output(x, nt, steps, base, arm, case, piece_loads, tip_loads, inputs, scratch, s_out,
+def _output(x, nt, steps, base, arm, act, case, piece_loads, tip_loads, inputs, scratch, s_out,
             out, b, r, J, J_out):
     """The output pass of case b (:func:`_record` at λ = 1); with tangents (nt = 6) and
     actuation inputs, also one tangent column per input: the pass then runs on the case's
     final loads with the inputs as its rate rows (at λ = 0, the same loads), J_out gets the
-    6 + n columns."""
-    n_inputs = inputs[0].shape[0]
-    if nt == 0 or n_inputs == 0:
-        _record(x, nt, steps, base, arm, case, 1.0, scratch, s_out, out, b, r, J)
+    6 + n columns. (``inputs`` is None without Jacobians: that part is not compiled.)"""
+    if inputs is None or nt == 0 or inputs[0].shape[0] == 0:
+        _record(x, nt, steps, base, arm, act, case, 1.0, scratch, s_out, out, b, r, J)
         return
+    n_inputs = inputs[0].shape[0]
     at_inputs = (piece_loads, inputs[0], tip_loads, inputs[1])
-    _record(x, 6 + n_inputs, steps, base, arm, at_inputs, 0.0, scratch, s_out, out, b, r,
+    _record(x, 6 + n_inputs, steps, base, arm, act, at_inputs, 0.0, scratch, s_out, out, b, r,
             J_out)
 
 
-@_batch
-def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
+@_entry(_solver, nogil=True)
+def solve_cases(base, arm, act, loads, first, options, s_out, memory, inputs, out):
     """Solve every load case of a flattened batch.
 
     Each case follows its own homotopy from λ = 0 to 1 (see the module docstring): from the
-    unloaded arm (start loads 0, x = 0) unless ``options[_O_CHAINED]``, where case b starts
-    from case b - 1's loads and solution (case 0 from ``first`` and ``memory``): a slowly
-    driven arm. Per case, the stage machine of README.md: the path at N steps (continuation),
+    unloaded arm (start loads 0, x = 0) unless chained (``memory`` given), where case b
+    starts from case b - 1's loads and solution (case 0 from ``first`` and ``memory``): a
+    slowly driven arm.
+
+    Capabilities are compiled on first use (README.md, "Compiled per capability"): ``act``,
+    ``first`` and ``memory``, and ``inputs`` are None for a passive arm, an unchained batch
+    and a solve without Jacobians, and numba then prunes the code that uses them before
+    typing it: a first passive solve compiles neither the actuated law nor the chained
+    starts nor the input columns.
+
+    Per case, the stage machine of README.md: the path at N steps (continuation),
     the solution at 2N (chord iterations, else a checked Newton, else the path at 2N), the
     Richardson estimate |p_2N - p_N| / 15 against tol, N grown by the order-4 model (a
     checked Newton from the 2N solution, else the path again) until it is met, then the
@@ -1622,25 +1675,27 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
     base : (4, 4) base pose.
     arm : (piece_start (P,), piece_len (P,), C (P, 6, 6) compliance, f0 (P, 6) reference
         strain, zero (P, 6), diag (bool: every C diagonal), length, scale (6,) residual
-        scale, K (P, 6, 6) stiffness, routes (A, 4 + 2D) actuator paths, kinds (A,) TENDON or
-        CHAMBER, active (P, A) 1.0 where actuator a acts on piece j, mag (P, 3) magnetisation
-        (A m²/m, material), dipoles (P + 1, 3) dipole at each piece start and at the tip
-        (A m², material)); see README.md.
+        scale, K (P, 6, 6) stiffness); see README.md.
+    act : None for a passive arm (no actuator, no magnet), else (routes (A, 4 + 2D)
+        actuator paths, kinds (A,) TENDON or CHAMBER, active (P, A) 1.0 where actuator a
+        acts on piece j, mag (P, 3) magnetisation (A m²/m, material), dipoles (P + 1, 3)
+        dipole at each piece start and at the tip (A m², material)).
     loads : (piece (B, P, PIECE_LOADS + A), tip (B, TIP_LOADS)): each case's loads at λ = 1.
-    first : (piece (P, PIECE_LOADS + A), tip (TIP_LOADS,)): case 0's start loads when
-        chained.
+    first : None (every case from the unloaded arm), or with ``memory``: (piece
+        (P, PIECE_LOADS + A), tip (TIP_LOADS,)), case 0's start loads.
     options : (OPTIONS,) tol (m; inf with a fixed step count), max_iterations, max_load_step,
-        fixed step count (0: from tol), largest step count, shootings budget, chained (0/1),
-        jacobians (0/1), the ratio of the step counts of the solution and of the path, near
-        (0/1: case 0's start loads are its own and ``memory`` holds a solution on its fine
-        grid, :meth:`Solver.solve_near`; its coarse solution is corrected from there, the
-        path only if that fails).
-    memory : (MEMORY,) the chained start (x at N, x at 2N, N, valid, sign of det ∂r/∂x at
-        N), read and rewritten; with a predicted step (``memory[_MPREDICTED]``, consumed),
-        case 0 tries it before its path.
-    inputs : (piece (n, P, PIECE_LOADS + A), tip (n, TIP_LOADS)): the load channels per unit
-        of each actuation input (n = 0: none); with jacobians the output pass integrates
-        one more tangent column per input, J and E then have 6 + n columns.
+        fixed step count (0: from tol), largest step count, shootings budget, the ratio of
+        the step counts of the solution and of the path, near (0/1, chained only: case 0's
+        start loads are its own and ``memory`` holds a solution on its fine grid,
+        :meth:`Solver.solve_near`; its coarse solution is corrected from there, the path
+        only if that fails).
+    memory : None (unchained), or (MEMORY,) the chained start (x at N, x at 2N, N, valid,
+        sign of det ∂r/∂x at N), read and rewritten; with a predicted step
+        (``memory[_MPREDICTED]``, consumed), case 0 tries it before its path.
+    inputs : None (no Jacobians), or (piece (n, P, PIECE_LOADS + A), tip (n, TIP_LOADS)):
+        the load channels per unit of each actuation input (n = 0: none); the output pass
+        then integrates the tangents, with one more column per input: J and E have 6 + n
+        columns.
     out : (poses (B, S, 4, 4), strains (B, S, 6), stresses (B, S, 6), info (B, 5) [residual,
         error estimate, load factor reached, shootings, N], status (B,), J (B, 6, 6) at the
         solution (jacobians), E (B, S, 6, 6) station motion per unit x (jacobians), x (B, 6)
@@ -1658,13 +1713,14 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
     n_fixed = int(options[_O_NFIXED])
     n_max = int(options[_O_NMAX])
     budget = int(options[_O_BUDGET])
-    chained = options[_O_CHAINED] > 0.0
-    near = chained and options[_O_NEAR] > 0.0
-    nt_out = 6 if options[_O_JACOBIANS] > 0.0 else 0
+    near = memory is not None and options[_O_NEAR] > 0.0
+    # (nb - nb: a variable, not the literal 0, which would compile _record and everything
+    # below it a second time, for the type Literal[int](0))
+    nt_out = nb - nb if inputs is None else 6
     coarse_ratio = int(options[_O_COARSE])
     info, status, jac = out[3], out[4], out[5]
     width = piece_loads.shape[2]
-    n_inputs = inputs[0].shape[0]
+    n_inputs = 0 if inputs is None else inputs[0].shape[0]
     scratch = _scratch(npieces, width - PIECE_LOADS, 7 + n_inputs)
     start = np.zeros((npieces, width))
     rate = np.empty((1, npieces, width))
@@ -1693,7 +1749,7 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
     for b in range(nb):
         counter[0] = 0
         # the homotopy of this case: start loads and their rate of change with λ
-        if chained:
+        if first is not None:
             for j in range(npieces):
                 for i in range(width):
                     start[j, i] = first[0][j, i] if b == 0 else piece_loads[b - 1, j, i]
@@ -1704,14 +1760,14 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
                 rate[0, j, i] = piece_loads[b, j, i] - start[j, i]
         for i in range(TIP_LOADS):
             tip_rate[0, i] = tip_loads[b, i] - tip_start[i]
-        w, turning = _load_size(arm, scale, start, piece_loads[b], tip_start, tip_loads[b])
+        w, turning = _load_size(arm, act, scale, start, piece_loads[b], tip_start, tip_loads[b])
         threshold = 1e-12 * w + 1e-300
         for i in range(6):
             dscale[i] = scale[i] * (1.0 + w)
-        warm = chained and memory[_MVALID] > 0.0
+        warm = memory is not None and memory[_MVALID] > 0.0
         if n_fixed > 0:
             N = n_fixed // 2
-        elif warm:
+        elif memory is not None and warm:
             N = int(memory[_MN])
         else:
             N = _first_steps(arm, tol, turning)
@@ -1725,13 +1781,13 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
         recorded = False
         resume = False
         deferred_failed = False
-        if near and warm and b == 0:
+        if memory is not None and near and warm and b == 0:
             # a solution at 2N is known: its coarse partner at N is one correction away (the
             # distance between them is the discretisation error), no path needed
             _fill_steps(length, arm[1], N, np.int64(1), steps)
             for i in range(6):
                 x[i] = memory[_MXF + i]
-            if _corrector(x, 1.0, six, steps, base, arm, case, scratch, scale, dscale, length,
+            if _corrector(x, 1.0, six, steps, base, arm, act, case, scratch, scale, dscale, length,
                           threshold, max_iterations, _REFINE_MAX, final_step, r, J, tip_c,
                           counter):
                 _copy(J, J_c)
@@ -1743,7 +1799,7 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
                 # would repeat it without the stations): accepted if its residual is
                 # converged and the estimate meets tol, else the stages below go on
                 _fill_steps(length, arm[1], N, np.int64(2), steps)
-                _output(x_f, nt_out, steps, base, arm, case, piece_loads[b], tip_loads[b],
+                _output(x_f, nt_out, steps, base, arm, act, case, piece_loads[b], tip_loads[b],
                         inputs, scratch, s_out, out, b, r, J, J_out)
                 counter[0] += 1
                 d2 = 0.0
@@ -1753,8 +1809,8 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
                                                             or n_fixed > 0):
                     estimate = math.sqrt(d2) / 15.0
                     recorded = True
-        if (warm and b == 0 and not near and memory[_MPREDICTED] > 0.0
-                and N == int(memory[_MN])):
+        if (memory is not None and warm and b == 0 and not near
+                and memory[_MPREDICTED] > 0.0 and N == int(memory[_MN])):
             # The path in one step whose tangent is given: the caller knows that only the
             # actuation inputs changed, by Δq, and the last solution's -J_x⁻¹ J_q (its output
             # pass), so the step x(1) - x(0) ≈ -J_x⁻¹ J_q Δq needs no integration at λ = 0.
@@ -1767,7 +1823,7 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
             _fill_steps(length, arm[1], N, np.int64(1), steps)
             for i in range(6):
                 x[i] = memory[_MXC + i] + memory[_MSTEP + i]
-            if (_corrector(x, 1.0, seven, steps, base, arm, case, scratch, scale, dscale,
+            if (_corrector(x, 1.0, seven, steps, base, arm, act, case, scratch, scale, dscale,
                            length, threshold, max_iterations, _REFINE_MAX, final_step, r, J,
                            tip_c, counter)
                     and _det_sign(J) == memory[_MSIGN] and _tangent(J, t_end)):
@@ -1793,7 +1849,7 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
                             x_f[i] = x[i] + memory[_MXF + i] - memory[_MXC + i]
                         resume = True
                         _fill_steps(length, arm[1], N, np.int64(2), steps)
-                        _output(x_f, nt_out, steps, base, arm, case, piece_loads[b],
+                        _output(x_f, nt_out, steps, base, arm, act, case, piece_loads[b],
                                 tip_loads[b], inputs, scratch, s_out, out, b, r, J, J_out)
                         counter[0] += 1
                         d2 = 0.0
@@ -1814,14 +1870,14 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
                                                            // coarse_ratio)
                 _fill_steps(length, arm[1], n_path, np.int64(1), steps)
                 for i in range(6):
-                    if not warm:
-                        x[i] = 0.0
-                    elif n_path == int(memory[_MN]):
-                        x[i] = memory[_MXC + i]  # exact at this step count
-                    else:
-                        x[i] = memory[_MXF + i]  # close: corrected at λ = 0
+                    x[i] = 0.0
+                    if memory is not None and warm:
+                        if n_path == int(memory[_MN]):
+                            x[i] = memory[_MXC + i]  # exact at this step count
+                        else:
+                            x[i] = memory[_MXF + i]  # close: corrected at λ = 0
                 coarse = n_path < N  # the last step is corrected on the grid of N
-                if not _follow(x, steps, base, arm, case, scratch, scale, dscale, length,
+                if not _follow(x, steps, base, arm, act, case, scratch, scale, dscale, length,
                                threshold, max_iterations, max_load_step, budget, coarse,
                                final_step, r, J, tip_c, counter, reached):
                     if counter[0] > budget:
@@ -1843,7 +1899,7 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
                 # the coarse solution at N: the end of a path on N steps; from the last
                 # prediction of a path on a coarser grid, a checked Newton
                 _fill_steps(length, arm[1], N, np.int64(1), steps)
-                if coarse and (not _corrector(x, 1.0, six, steps, base, arm, case, scratch,
+                if coarse and (not _corrector(x, 1.0, six, steps, base, arm, act, case, scratch,
                                               scale, dscale, length, threshold,
                                               max_iterations, _DIST_MAX, final_step, r, J,
                                               tip_c, counter)
@@ -1859,13 +1915,13 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
             if not resume:
                 _copy(x, x_f)
             resume = False
-            fine = _chord(x_f, J_c, steps, base, arm, case, scratch, scale, threshold,
+            fine = _chord(x_f, J_c, steps, base, arm, act, case, scratch, scale, threshold,
                           max_iterations, not deferred_failed, r, J, tip_f, counter)
             if fine == 0:
                 _copy(x, x_f)
-                fine = _corrector(x_f, 1.0, six, steps, base, arm, case, scratch, scale, dscale,
-                                  length, threshold, max_iterations, _REFINE_MAX, 1e-9, r, J,
-                                  tip_f, counter)
+                fine = _corrector(x_f, 1.0, six, steps, base, arm, act, case, scratch, scale,
+                                  dscale, length, threshold, max_iterations, _REFINE_MAX, 1e-9,
+                                  r, J, tip_f, counter)
                 if not fine:
                     if 4 * N > n_max or n_fixed > 0:
                         status[b] = NEWTON_FAILED
@@ -1880,7 +1936,7 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
             if estimate <= tol or n_fixed > 0:
                 if fine == 2:
                     # the output pass integrates the last chord step: it must converge
-                    _output(x_f, nt_out, steps, base, arm, case, piece_loads[b], tip_loads[b],
+                    _output(x_f, nt_out, steps, base, arm, act, case, piece_loads[b], tip_loads[b],
                             inputs, scratch, s_out, out, b, r, J, J_out)
                     counter[0] += 1
                     if _norm_scaled(r, scale) <= threshold:
@@ -1899,7 +1955,7 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
             N = min(n_max // 2, max(N + 1, math.ceil(N * grow)))
             _fill_steps(length, arm[1], N, np.int64(1), steps)
             _copy(x_f, x)
-            path = not _corrector(x, 1.0, six, steps, base, arm, case, scratch, scale, dscale,
+            path = not _corrector(x, 1.0, six, steps, base, arm, act, case, scratch, scale, dscale,
                                   length, threshold, max_iterations, _REFINE_MAX, final_step, r, J,
                                   tip_c, counter)
             if not path:
@@ -1910,12 +1966,12 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
         if status[b] != OK:
             info[b, 0] = _norm_scaled(r, scale)
             info[b, 3] = counter[0]
-            if chained:
+            if memory is not None:
                 memory[_MVALID] = memory[_MPREDICTED] = 0.0
             continue
         if not recorded:
             _fill_steps(length, arm[1], N, np.int64(2), steps)
-            _output(x_f, nt_out, steps, base, arm, case, piece_loads[b], tip_loads[b],
+            _output(x_f, nt_out, steps, base, arm, act, case, piece_loads[b], tip_loads[b],
                     inputs, scratch, s_out, out, b, r, J, J_out)
             counter[0] += 1
         residual = 0.0
@@ -1926,12 +1982,13 @@ def solve_cases(base, arm, loads, first, options, s_out, memory, inputs, out):
         info[b, 3] = counter[0]
         if not math.isfinite(residual):
             status[b] = NOT_FINITE
-        for i in range(jac.shape[1] if nt_out else 0):
-            for k in range(jac.shape[2]):
-                jac[b, i, k] = J_out[i, k] if n_inputs else J[i, k]
-        if nt_out and status[b] == OK and not _implicit_function(jac[b], out[6][b]):
-            status[b] = SINGULAR
-        if chained:
+        if inputs is not None:
+            for i in range(jac.shape[1]):
+                for k in range(jac.shape[2]):
+                    jac[b, i, k] = J_out[i, k] if n_inputs else J[i, k]
+            if status[b] == OK and not _implicit_function(jac[b], out[6][b]):
+                status[b] = SINGULAR
+        if memory is not None:
             for i in range(6):
                 memory[_MXC + i] = x[i]
                 memory[_MXF + i] = x_f[i]
@@ -1989,8 +2046,8 @@ def _through_x(e, X, row):
         e[k] -= row[k]
 
 
-@_jit
-def shoot(x, lam, steps, base, arm, case, r, J, tip_state, tip_tangents):
+@_entry(_per_arm("shoot", "the shooting primitive (Solver.shoot)", 5))
+def shoot(x, lam, steps, base, arm, act, case, r, J, tip_state, tip_tangents):
     """The shooting primitive: integrate from the base reaction x (6) at load factor λ with
     ``steps`` RK4 steps per piece; returns in place the residual r (6), its Jacobian J
     (6, 6 + R) (columns: ∂r/∂x, then the derivative along each of the case's R rate rows:
@@ -1998,7 +2055,7 @@ def shoot(x, lam, steps, base, arm, case, r, J, tip_state, tip_tangents):
     tendon lengths) and the tip tangents (6 + R, 12) (per column: δp spatial, δθ material,
     δn, δm spatial)."""
     scratch = _scratch(arm[1].size, case[0].shape[1] - PIECE_LOADS, J.shape[1])
-    _integrate(x, lam, J.shape[1], steps, base, arm, case, scratch, r, J)
+    _integrate(x, lam, J.shape[1], steps, base, arm, act, case, scratch, r, J)
     _copy(scratch[0], tip_state)
     _copy(scratch[1], tip_tangents)
 
@@ -2119,7 +2176,7 @@ def _orthonormalise(T, nt, weights, A):
 
 
 @_inline
-def _sweep(x, lam, steps, base, arm, case, scratch, nt, r, J, states, fields, theta0, tip):
+def _sweep(x, lam, steps, base, arm, act, case, scratch, nt, r, J, states, fields, theta0, tip):
     """The backward sweep of one equilibrium (base reaction x at load factor λ, ``steps``
     RK4 steps per piece, the solution's own grid): the state integrated forward to the tip
     (state only), then the state and nt seeded tangent columns back to the base with the
@@ -2149,11 +2206,11 @@ def _sweep(x, lam, steps, base, arm, case, scratch, nt, r, J, states, fields, th
             y[_P + i] = tip[i, 3]
             for k2 in range(3):
                 y[_R + 3 * i + k2] = tip[i, k2]
-        _tip_residual(y, T, none, tip_now, tip_rate, r, J, arm, now, rate, law)
+        _tip_residual(y, T, none, tip_now, tip_rate, r, J, arm, act, now, rate, law)
         for i in range(6):
             y[_N + i] = -r[i]  # the total wrench at the tip equals the tip loads
     else:
-        _integrate(x.copy(), lam, none, steps, base, arm, case, scratch, r, J)
+        _integrate(x.copy(), lam, none, steps, base, arm, act, case, scratch, r, J)
     # seeds: unit rotations of the tip section (and translations with nt = 6), with the δn,
     # δm of the linearised tip loads (follower and dipole terms), so that δr(L) = 0
     for d in range(nt):
@@ -2165,7 +2222,7 @@ def _sweep(x, lam, steps, base, arm, case, scratch, nt, r, J, states, fields, th
             T[d, _TP + d] = 1.0
         else:
             T[d, _TT + d - 3] = 1.0
-    _tip_residual(y, T, nt, tip_now, tip_rate, r, J, arm, now, rate, law)
+    _tip_residual(y, T, nt, tip_now, tip_rate, r, J, arm, act, now, rate, law)
     for d in range(nt):
         for i in range(6):
             T[d, _TN + i] = -J[i, d]
@@ -2200,7 +2257,7 @@ def _sweep(x, lam, steps, base, arm, case, scratch, nt, r, J, states, fields, th
         h = piece_len[j] / steps[j]
         for i in range(steps[j] - 1, -1, -1):
             top = piece_start[j] + (i + 1) * h
-            _steps(y, T, nt, -h, top, one, arm, j, now, rate, work, twork, law)
+            _steps(y, T, nt, -h, top, one, arm, act, j, now, rate, work, twork, law)
             _block(T, nt, length, new)
             c = _crossings(old, new, nt, lu, M, _AT_CLAMP if j == 0 and i == 0 else 0.0)
             if c < 0:
@@ -2217,7 +2274,7 @@ def _sweep(x, lam, steps, base, arm, case, scratch, nt, r, J, states, fields, th
                         fields[k, d, i2] = T[d, i2]
                     for i2 in range(nt):
                         fields[k, nt + i2, d] = M[i2, d]
-        _jump(y, T, nt, undo, rate, j, arm, law)  # the point wrench there, undone
+        _jump(y, T, nt, undo, rate, j, arm, act, law)  # the point wrench there, undone
     for i in range(nt):
         for d in range(nt):
             theta0[i, d] = old[i, d]
@@ -2254,8 +2311,8 @@ def _conservative(piece, tip):
     return True
 
 
-@_batch
-def stability_cases(base, arm, loads, xs, Ns, tips, factor, index, theta0, conservative):
+@_entry(_per_arm("verdict", "the stability verdict", 2), nogil=True)
+def stability_cases(base, arm, act, loads, xs, Ns, tips, factor, index, theta0, conservative):
     """The Morse index of every solved case of a batch (loads at λ = 1 from zero, the
     solution x, as :func:`solve_cases` returns them), swept on ``factor`` × Ns[b] steps
     (the solution's coarse grid N: the count needs the Jacobi fields resolved, not the
@@ -2280,15 +2337,15 @@ def stability_cases(base, arm, loads, xs, Ns, tips, factor, index, theta0, conse
         conservative[b] = _conservative(piece_loads[b], tip_loads[b])
         _fill_steps(arm[6], arm[1], int(Ns[b]), factor, steps)
         t0 = np.zeros((nt, nt))
-        index[b] = _sweep(xs[b], 1.0, steps, base, arm, case, scratch, nt, r, J, none3,
+        index[b] = _sweep(xs[b], 1.0, steps, base, arm, act, case, scratch, nt, r, J, none3,
                           none4, t0, tips[b] if tips.shape[0] > b else none3)
         for i in range(nt):
             for d in range(nt):
                 theta0[b, i, d] = t0[i, d]
 
 
-@_jit
-def sweep_point(x, lam, steps, base, arm, case, theta0, states, fields):
+@_entry(_per_arm("branch", "the stability sweep of a branch (continuation)", 5))
+def sweep_point(x, lam, steps, base, arm, act, case, theta0, states, fields):
     """One backward sweep at (x, λ) of a homotopy ``case`` (continuation, critical loads):
     the Morse index (or -1), Θ(0) into ``theta0`` (nt × nt, nt = its size), and with
     ``states`` (K + 1, 18 + A), ``fields`` (K + 1, 2 nt, 12), K the total number of steps,
@@ -2297,12 +2354,12 @@ def sweep_point(x, lam, steps, base, arm, case, theta0, states, fields):
     scratch = _scratch(arm[1].size, case[0].shape[1] - PIECE_LOADS, np.int64(7))
     r = np.empty(6)
     J = np.empty((6, 7))
-    return _sweep(x, lam, steps, base, arm, case, scratch, theta0.shape[0], r, J, states,
+    return _sweep(x, lam, steps, base, arm, act, case, scratch, theta0.shape[0], r, J, states,
                   fields, theta0, np.empty((0, 1)))
 
 
-@_jit
-def record_points(base, arm, loads, xs, steps, s_out, out):
+@_entry(_per_arm("branch", "the stations of a branch (continuation)", 2))
+def record_points(base, arm, act, loads, xs, steps, s_out, out):
     """The outputs (stations) of equilibria given by their base reactions: case b has the
     loads (loads[0][b], loads[1][b]) and the solution xs[b] on ``steps`` RK4 steps per piece
     (continuation points); ``out`` as in :func:`solve_cases` (poses, strains, stresses,
@@ -2318,7 +2375,7 @@ def record_points(base, arm, loads, xs, steps, s_out, out):
     none = J.shape[1] - 7  # no tangents (a variable: one compiled version)
     for b in range(piece_loads.shape[0]):
         case = (start, piece_loads[b:b + 1], tip_start, tip_loads[b:b + 1])
-        _record(xs[b], none, steps, base, arm, case, 1.0, scratch, s_out, out, b, r, J)
+        _record(xs[b], none, steps, base, arm, act, case, 1.0, scratch, s_out, out, b, r, J)
         residual = 0.0
         for i in range(6):
             if not abs(r[i]) <= residual:
@@ -2398,7 +2455,7 @@ def _free_least_squares(A, b, x, fixed, z, work, rhs):
             c += 1
 
 
-@_jit
+@_entry(_fixed("bounded", "the bounded least squares"))
 def box_least_squares(A, b, lower, upper, iterations):
     """argmin |A x - b|² subject to lower <= x <= upper (A of full column rank; 0 feasible),
     by an active-set method (bounded-variable least squares, Stark & Parker 1995): the free
@@ -2459,7 +2516,7 @@ def box_least_squares(A, b, lower, upper, iterations):
     return x, converged
 
 
-@_jit
+@_entry(_fixed("bounded", "the bounded least squares"))
 def regularised_step(J, b, q, scales, mu, lower, upper, iterations):
     """The bounded Gauss–Newton step of inverse statics, in scaled inputs u = q / s:
     argmin |J' δu - b|² + μ σ² |δu|² + ε σ² |u + δu|² within the bounds, J' = J s (columns
@@ -2536,7 +2593,7 @@ def _rotation_log(Q, out):
     out[0], out[1], out[2] = f * w0, f * w1, f * w2
 
 
-@_jit
+@_entry(_fixed("inverse", "inverse statics"))
 def task_error(tip, target, orientation, length, e):
     """The weighted task error at the tip state ``tip`` (p, R row-major): e[:3] = (target - p)
     / L and, with a 6-row task, e[3:] = log(orientation Rᵀ) (spatial, rad)."""
@@ -2559,7 +2616,7 @@ def _task_size(e):
     return math.sqrt(max(p, r))
 
 
-@_jit
+@_entry(_fixed("inverse", "inverse statics"))
 def redundant_task(singular, n):
     """Whether a task Jacobian with these singular values (largest first) has a rank below
     its n inputs (values at most 1e-10 n σ₁ count as zero): the least-effort term then
@@ -2583,8 +2640,8 @@ def _scaled_singular_values(J, scales, out):
         out[i] = values[i]
 
 
-@_jit
-def inverse_newton(x, q, every, first, steps, base, arm, units, goal, bounds, settings, warm,
+@_entry(_fixed("inverse", "inverse statics"))
+def inverse_newton(x, q, every, first, steps, base, arm, act, units, goal, bounds, settings, warm,
                    out, info):
     """The fast route's iteration of inverse statics (softarm.control), in place on x (6)
     and q (n), from a solution of the same grid nearby.
@@ -2675,7 +2732,7 @@ def inverse_newton(x, q, every, first, steps, base, arm, units, goal, bounds, se
                     acc += every[k] * unit_tip[k, i]
                 tipv[i] = acc
             _copy(x, x_shot)
-            shoot(x_shot, 0.0, steps, base, arm, case, r, Jfull, y, T)
+            shoot(x_shot, 0.0, steps, base, arm, act, case, r, Jfull, y, T)
             for c in range(6 + m):  # the tip's motion per column, spatial
                 for i in range(3):
                     E[i, c] = T[c, _TP + i]

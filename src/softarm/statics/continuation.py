@@ -142,7 +142,7 @@ class Path:
 
     def residual(self, z):
         """r̃(z) (6) and its Jacobian J̃ (6 × 7), nondimensional."""
-        self.k.shoot(self.x(z), float(z[6]), self.steps, self.base, self.arm, self.case,
+        self.k.shoot(self.x(z), float(z[6]), self.steps, self.base, *self.arm, self.case,
                      self._r, self._J, self._y, self._T)
         self.shootings += 1
         r = self._r / self.xscale
@@ -158,7 +158,7 @@ class Path:
             fields = np.zeros((self.n + 1, 2 * self.nt, 12))
         else:
             states, fields = np.empty((0, 1)), np.empty((0, 1, 1))
-        index = self.k.sweep_point(self.x(z), float(z[6]), self.steps, self.base, self.arm,
+        index = self.k.sweep_point(self.x(z), float(z[6]), self.steps, self.base, *self.arm,
                                    self.case, theta0, states, fields)
         return int(index), theta0, states, fields
 
@@ -251,7 +251,7 @@ class Path:
         out = (poses, strains, stresses, info, np.zeros(B, dtype=np.int64),
                np.zeros((0, 6, 6)), np.zeros((1, S, 6, 6)), np.empty((B, 6)),
                np.empty((B, len(self.channels.actuators))))
-        k.record_points(self.base, self.arm, (np.ascontiguousarray(piece),
+        k.record_points(self.base, *self.arm, (np.ascontiguousarray(piece),
                                               np.ascontiguousarray(tip)),
                         xs, self.steps, solver._s_kernel, out)
         index = np.array([self.index(z)[0] for z in zs])

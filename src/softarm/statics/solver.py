@@ -285,7 +285,9 @@ class _Channels:
             self._piece[..., :, k.FG:k.FG + 9] += G[..., None, :]
 
     def arm_tuple(self) -> tuple:
-        """The kernel's arm tuple: the pieces and the actuators' paths (see _kernels)."""
+        """The kernel's (arm, act) pair, passed on as ``*arm_tuple()``: the pieces, and the
+        actuators' paths and the magnets, or None for a passive arm (see _kernels: a passive
+        arm's solve is compiled without them)."""
         return self._actuated_arm()[0]
 
     def tendons(self) -> tuple[np.ndarray, np.ndarray]:
@@ -319,7 +321,9 @@ class _Channels:
             routes[a] = routing.kernel_row(degree, self.length)
             kinds[a] = kind
             active[:, a] = rows
-        arm = (*pieces[:8], pieces[8], routes, kinds, active, pieces[9], pieces[10])
+        magnets, dipoles = pieces[9], pieces[10]
+        passive = A == 0 and not (np.any(magnets) or np.any(dipoles))
+        arm = (pieces[:9], None if passive else (routes, kinds, active, magnets, dipoles))
         columns = np.flatnonzero(kinds == self.k.TENDON)
         unloaded = np.array([_unloaded_length(pieces, self.actuators[a]) for a in columns])
         return arm, columns, unloaded
@@ -507,8 +511,7 @@ class PreparedSolve:
         self.inputs = np.array([v for load in loads for name in load.inputs
                                 for v in np.ravel(np.asarray(getattr(load, name), dtype=float))])
         n, P, A = self.inputs.size, pieces[0].size, len(channels.actuators)
-        self._unit = (unit_piece, unit_tip) if jacobians else (
-            solver._unused((0, P, W)), solver._unused((0, k.TIP_LOADS)))
+        self._unit = (unit_piece, unit_tip) if jacobians else None
         self._piece0, self._unit_flat, self._tip0 = _at_zero_inputs(
             channels.piece[0], channels.tip_loads[0], self.inputs, unit_piece, unit_tip)
         self._unit_tip = unit_tip
@@ -517,7 +520,7 @@ class PreparedSolve:
         self._start = (np.zeros((P, W)), np.zeros(k.TIP_LOADS))  # the path's start loads
         self._arm = channels.arm_tuple()
         self._jacobians = bool(jacobians)
-        self._options = {near: solver._options(True, jacobians, near) for near in (False, True)}
+        self._options = {near: solver._options(near) for near in (False, True)}
         S = solver._s_kernel.size
         self._outs = (np.empty((1, S, 4, 4)), np.empty((1, S, 6)), np.empty((1, S, 6)),
                       np.zeros((1, 5)), np.zeros(1, dtype=np.int64),
@@ -582,7 +585,7 @@ class PreparedSolve:
                 np.negative(memory[k.MSTEP:k.MSTEP + 6], out=memory[k.MSTEP:k.MSTEP + 6])
                 memory[k.MPREDICTED] = 1.0
         status = self._outs[4]
-        k.solve_cases(solver._base_kernel, self._arm, (piece, tip), self._start,
+        k.solve_cases(solver._base_kernel, *self._arm, (piece, tip), self._start,
                       self._options[near is not None], solver._s_kernel, memory, self._unit,
                       self._outs)
         if status[0] != k.OK:
@@ -597,7 +600,7 @@ class PreparedSolve:
             if self._tips.shape[0]:
                 np.copyto(self._tips[0], self.poses[-1])
             self._Ns[0] = self.info[4]
-            k.stability_cases(solver._base_kernel, self._arm, (piece, tip), self._outs[7],
+            k.stability_cases(solver._base_kernel, *self._arm, (piece, tip), self._outs[7],
                               self._Ns, self._tips, 1, self._index, self._theta0, self._flags)
             self.index, self.conservative = int(self._index[0]), bool(self._flags[0])
 
@@ -706,7 +709,7 @@ def _shoot(k, x, lam, counts, base, arm, case, actuators) -> ShootResult:
     ncols = 6 + case[1].shape[0]
     r, J = np.empty(6), np.empty((6, ncols))
     y, T = np.empty(18 + actuators), np.empty((ncols, 12 + actuators))  # with the lengths
-    k.shoot(x.copy(), lam, counts, base, arm, case, r, J, y, T)
+    k.shoot(x.copy(), lam, counts, base, *arm, case, r, J, y, T)
     R = y[3:12].reshape(3, 3)
     pose = np.eye(4)
     pose[:3, :3], pose[:3, 3] = R, y[:3]
@@ -869,13 +872,12 @@ class Solver:
                 f"times the bending scale (EI/L² = {fs:.3g} N, EI/L = {ms:.3g} N m), where "
                 "double precision cannot follow the shape")
 
-    def _options(self, chained: bool, jacobians: bool, near: bool = False) -> np.ndarray:
+    def _options(self, near: bool = False) -> np.ndarray:
         n_fixed = self.steps if self.steps is not None else 0
         n_max = max(self.max_steps, self.steps or 0)
         tol = math.inf if self.steps is not None else self.tol * self.length
         return np.array([tol, self.max_iterations, self.max_load_step, n_fixed, n_max,
-                         self.max_shootings, float(chained), float(jacobians),
-                         self._coarse_ratio, float(near)])
+                         self.max_shootings, self._coarse_ratio, float(near)])
 
     # ---------------------------------------------------------------- solving
 
@@ -940,18 +942,18 @@ class Solver:
             # other actuators than the last case's: no continuous path from it
             self.reset()
             last = None
-        if last is None:  # from the unloaded arm
-            first_piece, first_tip = np.zeros((pieces[0].size, channels.piece.shape[2])), \
-                np.zeros(k.TIP_LOADS)
-        elif near:
-            first_piece, first_tip = channels.piece[0].copy(), channels.tip_loads[0].copy()
-        else:
-            first_piece, first_tip = _recut(last[0], last[1], pieces[0]), last[2]
-        if self._memory is None or not chained:
-            memory = np.zeros(k.MEMORY)
-            if chained:
-                self._memory = memory
-        else:
+        # unchained: no first loads, no memory (that code is not even compiled, _kernels)
+        first = memory = None
+        if chained or near:
+            if last is None:  # from the unloaded arm
+                first = (np.zeros((pieces[0].size, channels.piece.shape[2])),
+                         np.zeros(k.TIP_LOADS))
+            elif near:
+                first = (channels.piece[0].copy(), channels.tip_loads[0].copy())
+            else:
+                first = (_recut(last[0], last[1], pieces[0]), last[2])
+            if self._memory is None:
+                self._memory = np.zeros(k.MEMORY)
             memory = self._memory
         s_kernel = self._s_kernel if outputs else np.array([self.length])
         S = s_kernel.size
@@ -961,9 +963,8 @@ class Solver:
         info = np.zeros((count, 5))
         status = np.zeros(count, dtype=np.int64)
         inputs = self._input_channels(loads, pieces, channels.piece.shape[2]) \
-            if jacobians else (self._unused((0, *channels.piece.shape[1:])),
-                               self._unused((0, k.TIP_LOADS)))
-        n_in = inputs[0].shape[0]
+            if jacobians else None
+        n_in = inputs[0].shape[0] if jacobians else 0
         # rows 6 + a: actuator a's length per column (a tendon's; 0 for a chamber)
         jac = np.zeros((count, 6 + len(channels.actuators), 6 + n_in)) if jacobians \
             else self._unused((0, 6, 6))
@@ -971,12 +972,13 @@ class Solver:
             else self._unused((1, S, 6, 6))
         base_wrench = np.empty((count, 6))
         lengths = np.empty((count, len(channels.actuators)))
-        arm, options = channels.arm_tuple(), self._options(chained, jacobians, near)
+        arm, options = channels.arm_tuple(), self._options(near)
         outs = (poses, strains, stresses, info, status, jac, motion, base_wrench, lengths)
 
         def run(a, b):  # cases [a, b): per-case arrays cut, the rest (placeholders) whole
-            k.solve_cases(self._base_kernel, arm, (channels.piece[a:b], channels.tip_loads[a:b]),
-                          (first_piece, first_tip), options, s_kernel, memory, inputs,
+            k.solve_cases(self._base_kernel, *arm, (channels.piece[a:b],
+                                                    channels.tip_loads[a:b]),
+                          first, options, s_kernel, memory, inputs,
                           tuple(x[a:b] if x.shape[0] == count else x for x in outs))
 
         # (a chained batch is one path, case after case; unchained cases are independent)

@@ -67,7 +67,7 @@ def verdict(channels, base, xs, Ns, shape, tips=None, factor=1, threads=1) -> St
     arm, Ns, factor = channels.arm_tuple(), np.array(Ns, dtype=np.float64), int(factor)
 
     def run(a, b):  # cases [a, b)
-        k.stability_cases(base, arm, (channels.piece[a:b], channels.tip_loads[a:b]), xs[a:b],
+        k.stability_cases(base, *arm, (channels.piece[a:b], channels.tip_loads[a:b]), xs[a:b],
                           Ns[a:b], tips[a:b] if tips.shape[0] else tips, factor, index[a:b],
                           theta0[a:b], flags[a:b])
 

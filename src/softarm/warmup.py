@@ -1,0 +1,202 @@
+"""Compile softarm's kernels ahead of time (``softarm compile [--all]``).
+
+softarm compiles its numerical kernels with numba the first time each capability is used on a
+machine (a first passive solve, Jacobians, actuated arms, inverse statics, ...) and caches the
+machine code. A container build, a cluster image or a course's setup pays that once, ahead of
+time, with :func:`compile_kernels` or ``softarm compile``: each step below runs a small
+problem that uses its capability (a cached capability costs a fraction of a second).
+
+Example
+-------
+>>> from softarm.warmup import STEPS
+>>> [step.name for step in STEPS if step.first]
+['solve', 'closed forms']
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import analytic
+from .control import ForwardSolver, inverse
+from .dispatch import solve
+from .loads import Chamber, DistributedForce, Gravity, Tendon, TipLoad
+from .model import Arm, Circle, Material
+from .routing import Straight
+from .stability import critical_load
+from .statics import Solver
+
+__all__ = ["STEPS", "Step", "compile_kernels"]
+
+
+def _arm() -> Arm:
+    return Arm(0.2, Circle(0.01), Material(youngs_modulus=1.5e6, poisson_ratio=0.49,
+                                           density=1070.0))
+
+
+def _tendons() -> list:
+    return [Tendon(0.2, Straight(0.0, 0.006)), Tendon(0.1, Straight(0.006, 0.0))]
+
+
+def _passive():
+    solve(_arm(), [Gravity(), TipLoad(force=[0.0, 0.01, 0.0])], method="numeric")
+
+
+def _closed_forms():
+    arm = _arm()
+    analytic.tip_moment(arm, moment=[0.0, 1e-3, 0.0])
+    solve(arm, [TipLoad(force=[0.0, 0.0, -0.05])])  # the elastica
+
+
+def _jacobians():
+    solve(_arm(), [Gravity(), TipLoad(force=[0.0, 0.01, 0.0])], method="numeric",
+          jacobians=True)
+
+
+def _chained():
+    solver = Solver(_arm())
+    for f in (0.005, 0.01):
+        solver.solve([Gravity(), TipLoad(force=[0.0, f, 0.0])])
+
+
+def _actuated():
+    solve(_arm(), [Gravity(), *_tendons(), Chamber(1e3, area=1e-5, routing=Straight(0.0, -0.005))],
+          method="numeric")
+
+
+def _actuated_jacobians():
+    solve(_arm(), [Gravity(), *_tendons()], method="numeric", jacobians=True)
+
+
+def _actuated_chained():
+    solver = Solver(_arm())
+    for tension in (0.1, 0.2):
+        solver.solve([Gravity(), Tendon(tension, Straight(0.0, 0.006))])
+
+
+def _control():
+    model = ForwardSolver(_arm(), _tendons(), [Gravity()])
+    model.solve([0.2, 0.1])
+    model.solve([0.25, 0.1])
+
+
+def _inverse():
+    arm, tendons = _arm(), _tendons()
+    target = solve(arm, [Gravity(), *tendons]).tip_position
+    inverse(arm, tendons, target, loads=[Gravity()])
+
+
+def _displacement():
+    solve(_arm(), [Gravity(), Tendon(routing=Straight(0.0, 0.006), displacement=-1e-4)])
+
+
+def _critical():
+    arm = Arm.from_stiffness(1.0, EA=1e6, GAy=1e6, GAz=1e6, GJ=1.0, EIy=1.0, EIz=1.0)
+    critical_load(arm, [TipLoad(force=[-1.0, 0.0, 0.0]), DistributedForce([0.0, 0.0, 0.0])],
+                  max_factor=4.0)
+
+
+@dataclass(frozen=True)
+class Step:
+    """One capability to compile: ``name`` (its keys in the compile record, see
+    ``softarm._jit.REFERENCE_SECONDS``), what it is for, the problem that uses it, and whether
+    a first solve needs it (``softarm compile`` without ``--all``)."""
+
+    name: str
+    text: str
+    keys: tuple[str, ...]
+    run: Callable[[], None]
+    first: bool = False
+
+
+STEPS: tuple[Step, ...] = (
+    Step("solve", "the solver and its stability verdict for passive arms",
+         ("solve", "verdict"), _passive, first=True),
+    Step("closed forms", "the closed forms", ("closed forms",), _closed_forms, first=True),
+    Step("jacobians", "Jacobians (tip and station compliance)", ("solve+jacobians",),
+         _jacobians),
+    Step("chained", "quasi-static solves (Solver.solve, softarm app)", ("solve+chained",),
+         _chained),
+    Step("actuated", "actuated and magnetic arms (tendons, chambers, magnets)",
+         ("actuated", "verdict+actuated"), _actuated),
+    Step("actuated jacobians", "actuation Jacobians", ("actuated+jacobians",),
+         _actuated_jacobians),
+    Step("actuated chained", "quasi-static solves of actuated arms",
+         ("actuated+chained",), _actuated_chained),
+    Step("control", "the control loop's forward call (ForwardSolver)",
+         ("actuated+chained+jacobians",), _control),
+    Step("inverse", "inverse statics", ("inverse",), _inverse),
+    Step("displacement", "displacement-controlled tendons", ("bounded",), _displacement),
+    Step("critical", "critical loads and continuation", ("shoot", "branch"), _critical),
+)
+
+
+def compile_kernels(all: bool = False, progress: Callable | None = None) -> list[tuple]:
+    """Compile (or load from the cache) every kernel a first solve needs, or with ``all``
+    every capability of :data:`STEPS`. ``progress(step, index, count, elapsed, estimate)``
+    is called about five times a second while a step runs and once when it ends (``elapsed``
+    None at the start). Returns [(step, seconds, compiled keys)] (compiled keys: what missed
+    the cache, with its time: ``[(key, text, seconds)]``)."""
+    from . import _jit  # the compiled modules' helper: imports numba (an optional heavy import)
+
+    steps = [step for step in STEPS if all or step.first]
+    done = []
+    quiet, _jit.notices = _jit.notices, progress is None and _jit.notices
+    try:
+        for index, step in enumerate(steps):
+            estimate = sum(_jit.compile_seconds(key, _dispatcher(key))[0] for key in step.keys)
+            before = len(_jit.COMPILED)
+            start = time.perf_counter()
+            with _Ticker(progress, (step, index, len(steps)), estimate):
+                with np.errstate(all="ignore"):
+                    step.run()
+            seconds = time.perf_counter() - start
+            if progress is not None:
+                progress(step, index, len(steps), seconds, -1.0)
+            done.append((step, seconds, list(_jit.COMPILED[before:])))
+    finally:
+        _jit.notices = quiet
+    return done
+
+
+class _Ticker:
+    """Calls ``progress(*what, elapsed, estimate)`` at the start and then five times a second
+    from a thread while the body runs (numba releases the GIL often enough for it)."""
+
+    def __init__(self, progress, what, estimate):
+        self.progress, self.what, self.estimate = progress, what, estimate
+        self.stop = threading.Event()
+        self.thread = None
+
+    def __enter__(self):
+        if self.progress is not None:
+            self.progress(*self.what, None, self.estimate)
+            self.start = time.perf_counter()
+            self.thread = threading.Thread(target=self._run, daemon=True)
+            self.thread.start()
+        return self
+
+    def _run(self):
+        while not self.stop.wait(0.2):
+            self.progress(*self.what, time.perf_counter() - self.start, self.estimate)
+
+    def __exit__(self, *exc):
+        self.stop.set()
+        if self.thread is not None:
+            self.thread.join()
+
+
+def _dispatcher(key: str):
+    """The compiled entry point whose cache folder holds ``key``'s record."""
+    if key == "closed forms":
+        from .analytic._elastica_math import compiled
+
+        return compiled().solve
+    from .statics.solver import _kernels
+
+    return _kernels().solve_cases

@@ -1,0 +1,124 @@
+"""The first minute: compiled per capability, announced once, paid ahead with ``softarm compile``.
+
+Each test here starts processes with an empty numba cache of their own (a cold start, as on a
+new machine), so the kernels really compile: a passive solve must compile the solver and the
+verdict for passive arms and nothing of the actuated law, the Jacobians' input columns, the
+chained starts or inverse statics; the notice must come once per capability with an estimate
+that, once measured, is this machine's own figure.
+"""
+
+from __future__ import annotations
+
+import ast
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+_PASSIVE_SOLVE = """
+import sys, numpy as np, softarm
+from softarm.statics.solver import _kernels
+arm = softarm.Arm(0.2, softarm.Circle(0.01), softarm.Material(1.5e6, 0.49, 1070.0))
+eq = softarm.solve(arm, [softarm.Gravity(), softarm.TipLoad(force=[0.0, 0.01, 0.0])],
+                   method="numeric")
+k = _kernels()
+# what this process compiled (a kernel loaded from the cache has no signature here)
+print({name: len(getattr(k, name).signatures) for name in sys.argv[1:]})
+print(repr(eq.tip_position.tolist()))
+"""
+
+#: kernels of other capabilities: a passive solve from the unloaded arm compiles none
+_NOT_PASSIVE = ("_law", "_dipole", "_actuator_rates", "_ldl_substitute", "_implicit_function",
+                "inverse_newton", "box_least_squares", "shoot", "sweep_point")
+
+
+def _python(code: str, *args: str, cache: Path, notice: bool = True):
+    """``python -c code args`` with its own numba cache and the compile notice on or off."""
+    return subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True,
+                          timeout=900, env=_env(cache, notice))
+
+
+def _softarm(*args: str, cache: Path, notice: bool = True):
+    return subprocess.run([sys.executable, "-m", "softarm", *args], capture_output=True,
+                          text=True, timeout=900, env=_env(cache, notice))
+
+
+def _env(cache: Path, notice: bool) -> dict:
+    return dict(os.environ, NUMBA_CACHE_DIR=str(cache),
+                SOFTARM_COMPILE_NOTICE="1" if notice else "0")
+
+
+@pytest.fixture(scope="module")
+def first_solve(tmp_path_factory):
+    """(cache, process): a passive solve in a process with an empty cache."""
+    cache = tmp_path_factory.mktemp("numba-cache")
+    return cache, _python(_PASSIVE_SOLVE, *_NOT_PASSIVE, "_steps", cache=cache)
+
+
+@pytest.mark.slow
+def test_a_passive_solve_compiles_its_capability_alone_and_says_so_once(first_solve):
+    cache, run = first_solve
+    assert run.returncode == 0, run.stderr
+    compiled = ast.literal_eval(run.stdout.splitlines()[0])
+    assert compiled.pop("_steps") == 1  # the RK4 step: one version, for passive arms
+    assert compiled == dict.fromkeys(_NOT_PASSIVE, 0)
+    notices = [line for line in run.stderr.splitlines() if line.startswith("softarm:")]
+    assert [line.split(",")[0] for line in notices] == [
+        "softarm: compiling the solver for passive arms",
+        "softarm: compiling the stability verdict for passive arms"]
+    assert all("on this machine" in line and "about " in line for line in notices)
+    # the times were measured and recorded beside the compiled code
+    records = list(cache.rglob("softarm-compile-seconds.json"))
+    assert len(records) == 1
+    record = json.loads(records[0].read_text())
+    assert set(record) == {"solve", "verdict"} and all(v > 0 for v in record.values())
+
+    # a second process loads everything from the cache: no notice, the same answer
+    again = _python(_PASSIVE_SOLVE, "_steps", cache=cache)
+    assert again.returncode == 0, again.stderr
+    assert "compiling" not in again.stderr
+    assert ast.literal_eval(again.stdout.splitlines()[0]) == {"_steps": 0}
+    assert again.stdout.splitlines()[1] == run.stdout.splitlines()[1]
+
+
+@pytest.mark.slow
+def test_the_estimate_is_this_machines_measurement_once_there_is_one(first_solve):
+    # the time recorded by the first compile is what the next estimate says; a capability
+    # not yet compiled here is estimated (the reference machine's time, scaled)
+    cache, first = first_solve
+    assert first.returncode == 0, first.stderr
+    code = """
+from softarm._jit import compile_seconds
+from softarm.statics.solver import _kernels
+print(compile_seconds("solve", _kernels().solve_cases))
+print(compile_seconds("solve+jacobians", _kernels().solve_cases))
+"""
+    run = _python(code, cache=cache)
+    assert run.returncode == 0, run.stderr
+    measured, unmeasured = (ast.literal_eval(line) for line in run.stdout.splitlines())
+    record = json.loads(next(cache.rglob("softarm-compile-seconds.json")).read_text())
+    assert measured == (record["solve"], True)
+    assert unmeasured[1] is False and unmeasured[0] > 0
+
+
+@pytest.mark.slow
+def test_softarm_compile_pays_the_first_solve_ahead(tmp_path):
+    cache = tmp_path / "cache"
+    run = _softarm("compile", cache=cache)
+    assert run.returncode == 0, run.stderr
+    lines = run.stdout.splitlines()
+    assert lines[0].startswith(" 1/2 the solver and its stability verdict for passive arms: ")
+    assert lines[1].startswith(" 2/2 the closed forms: ")
+    assert "kernels compiled in" in lines[-1]
+    assert "softarm: compiling" not in run.stderr  # the command shows its own progress
+    # then a first solve compiles nothing: no notice
+    solve = _python(_PASSIVE_SOLVE, "_steps", cache=cache)
+    assert solve.returncode == 0, solve.stderr
+    assert "compiling" not in solve.stderr
+    # and the command again: everything cached
+    again = _softarm("compile", cache=cache, notice=False)
+    assert again.returncode == 0
+    assert again.stdout.splitlines()[-1] == "every kernel was already compiled (numba's cache)"
