@@ -21,6 +21,7 @@ import os
 import re
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -48,6 +49,7 @@ from ._store import (
     need_store_packages,
     open_sweep,
     prepare_store,
+    recorded_options,
     variable_attrs,
     write_chunk,
 )
@@ -255,9 +257,9 @@ def design_of(case) -> Design:
 
 
 def run(case, design: Design | None = None, *, out=None, map: Callable | None = None,
-        chunk: int | None = None, fields: Iterable[str] = DEFAULT_FIELDS,
-        stations: int | None = None, dtype: str = "float64", method: str | None = None,
-        tol: float | None = None, resume: bool = False, path: bool = False,
+        chunk: int | None = None, fields: Iterable[str] | None = None,
+        stations: int | None = None, dtype: str | None = None, method: str | None = None,
+        tol: float | None = None, resume: bool = False, path: bool | None = None,
         progress: Callable | None = None, single_thread: bool | None = None):
     """Solve every case of a sweep design, in chunks, with any map-like executor.
 
@@ -274,22 +276,24 @@ def run(case, design: Design | None = None, *, out=None, map: Callable | None = 
         ``client.get_executor().map``.
     chunk : int, optional
         Cases per chunk (default up to 1000, at least 16 chunks for small designs).
-    fields : iterable of str
+    fields : iterable of str, optional
         Which outputs to keep: "tip", "positions", "orientations", "poses", "strains",
-        "stresses".
+        "stresses" (default "tip" and "positions").
     stations : int, optional
         Output stations (uniform on [0, L]); default the case's ``[solve] stations``.
-    dtype : {"float64", "float32"}
-        Of the stored outputs (status, residuals and parameters stay exact).
+    dtype : {"float64", "float32"}, optional
+        Of the stored outputs (default float64; status, residuals and parameters stay exact).
     method, tol : optional
         Override the case's ``[solve]`` options.
     resume : bool
         Finish a store written by an interrupted run of the same sweep (the chunks whose done
-        flag is set are kept).
-    path : bool
+        flag is set are kept). The options ``chunk``, ``fields``, ``stations``, ``dtype``,
+        ``method``, ``tol`` and ``path`` not given are those the store was started with;
+        one given that differs from the store's is a ValueError naming it.
+    path : bool, optional
         Follow a one-parameter load sweep quasi-statically, serially (a prepared Solver, as
         :meth:`softarm.statics.Solver.solve`), instead of solving each case from the unloaded
-        arm.
+        arm (default False).
     progress : callable, optional
         ``progress(cases_done, cases_total, cases_failed)`` after each chunk.
 
@@ -302,15 +306,23 @@ def run(case, design: Design | None = None, *, out=None, map: Callable | None = 
     ------
     ValueError
         A bad design (unknown key path, empty range, a value that makes the arm or a load
-        invalid: before any solve), a store that exists without ``resume``, or one that holds
-        another sweep.
+        invalid: before any solve), a store that exists without ``resume``, one that holds
+        another sweep (another case or design), or an option given with ``resume`` that
+        differs from the store's.
     """
     xarray, _ = need_store_packages()
     design = design_of(case) if design is None else design
     if not isinstance(design, Design):
         raise TypeError(f"design must be a softarm.sweep.Design, got {design!r}")
     options = case.solve
-    fields = tuple(fields)
+    given = {"chunk": chunk, "fields": fields, "stations": stations, "dtype": dtype,
+             "method": method, "tol": tol, "path": path}
+    recorded = recorded_options(out) if resume and out is not None else None
+    if recorded is not None:  # resuming: what is not given is what the store was started with
+        chunk, fields, stations, dtype, method, tol, path = (
+            recorded[name] if value is None else value for name, value in given.items())
+    fields = DEFAULT_FIELDS if fields is None else tuple(fields)
+    dtype = "float64" if dtype is None else dtype
     for f in fields:
         if f not in FIELDS:
             raise ValueError(f"fields must be among {', '.join(FIELDS)}, got {f!r}")
@@ -337,6 +349,10 @@ def run(case, design: Design | None = None, *, out=None, map: Callable | None = 
             raise ValueError("path=True is serial (each case starts from the previous one); "
                              "give no map")
         chunk = size
+    if recorded is not None:
+        _check_given(out, given, recorded, {
+            "chunk": chunk, "fields": fields, "stations": stations, "dtype": dtype,
+            "method": method, "tol": tol, "path": bool(path)})
     plan.check()  # every parameter value buildable, before any solve
     spec = Spec(case.to_dict(), str(case.source) if case.source else None, design,
                 method, stations, tol, fields, dtype, chunk,
@@ -345,7 +361,7 @@ def run(case, design: Design | None = None, *, out=None, map: Callable | None = 
     chunks = math.ceil(size / chunk)
     todo = list(range(chunks))
     if out is not None:
-        todo = prepare_store(spec, plan, case, resume, chunks)
+        todo = prepare_store(spec, plan, case, resume, chunks, out)
     total = size
     done = size - sum(min(size, (k + 1) * chunk) - k * chunk for k in todo)  # by a past run
     failed = 0
@@ -375,6 +391,24 @@ def run(case, design: Design | None = None, *, out=None, map: Callable | None = 
                  for name, array in data.items()}
     return xarray.Dataset(variables, coords=dataset_coords(spec, plan, values),
                           attrs=dataset_attrs(spec, case_text(case)))
+
+
+def _check_given(out, given: dict, recorded: dict, final: dict) -> None:
+    """ValueError naming the options given with ``resume`` that differ from the store's."""
+    differ = [name for name, value in given.items()
+              if value is not None and final[name] != recorded[name]]
+    if differ:
+        def shown(options):
+            return ", ".join(f"{name} {_text(options[name])}" for name in differ)
+
+        raise ValueError(f"{Path(out)}: was started with {shown(recorded)}; given "
+                         f"{shown(final)}: resume without {'it' if len(differ) == 1 else 'them'}"
+                         " (the store's options are taken), or choose another output")
+
+
+def _text(value) -> str:
+    return ",".join(value) if isinstance(value, tuple) else f"{value:g}" \
+        if isinstance(value, float) else str(value)
 
 
 builtins_map = map

@@ -23,7 +23,8 @@ if TYPE_CHECKING:
     from ._design import Plan
     from ._run import Spec, Task
 
-__all__ = ["FIELDS", "create_store", "open_sweep", "prepare_store", "write_chunk"]
+__all__ = ["FIELDS", "create_store", "open_sweep", "prepare_store", "recorded_options",
+           "write_chunk"]
 
 #: ``--fields`` choices: the variables each adds to the store.
 FIELDS = {
@@ -241,27 +242,62 @@ def case_text(case) -> str:
     return json.dumps(case.to_dict(), default=str)
 
 
-def prepare_store(spec: Spec, plan: Plan, case, resume: bool, chunks: int) -> list[int]:
-    out = Path(spec.out)
+#: The options a store records (its attributes) and the names :func:`softarm.sweep.run` gives
+#: them; the case and the design make the rest of its fingerprint.
+_OPTIONS = {"chunk": "chunk_size", "fields": "fields", "stations": "stations",
+            "dtype": "dtype", "method": "method", "tol": "tol", "path": "semantics"}
+_FINGERPRINT = {"case": "case_json", "design": "design", **_OPTIONS}
+
+
+def _existing(out: Path):
+    try:
+        return open_sweep(out)
+    except Exception as error:  # whatever xarray or zarr find wrong: one line
+        raise ValueError(f"{out}: not a sweep store softarm can resume ({error})") from None
+
+
+def recorded_options(out) -> dict | None:
+    """The options the store at ``out`` was started with, by :func:`softarm.sweep.run`'s
+    names (``path`` a bool), or None if there is nothing at ``out``."""
+    out = Path(out)
+    if not out.exists():
+        return None
+    attrs = _existing(out).attrs
+    try:
+        return {"chunk": int(attrs["chunk_size"]), "fields": tuple(attrs["fields"].split(",")),
+                "stations": int(attrs["stations"]), "dtype": str(attrs["dtype"]),
+                "method": str(attrs["method"]), "tol": float(attrs["tol"]),
+                "path": attrs["semantics"] == _PATH}
+    except (KeyError, TypeError, ValueError, AttributeError) as error:
+        raise ValueError(f"{out}: not a sweep store softarm can resume (its attribute "
+                         f"{error} is missing or wrong)") from None
+
+
+def _listing(names: list[str]) -> str:
+    """The names in words: a; a and b; a, b and c."""
+    return names[0] if len(names) == 1 else f"{', '.join(names[:-1])} and {names[-1]}"
+
+
+def prepare_store(spec: Spec, plan: Plan, case, resume: bool, chunks: int, where) -> list[int]:
+    """The chunks left to solve: every one for a new store (created here), those without
+    their done flag for a store resumed. ``where``: the store's path as the caller gave it
+    (for messages; ``spec.out`` is absolute)."""
+    out, where = Path(spec.out), Path(where)
     if out.exists():
         if not resume:
-            raise ValueError(f"{out}: exists; give --resume (resume=True) to finish an "
+            raise ValueError(f"{where}: exists; give --resume (resume=True) to finish an "
                              "interrupted sweep, or remove it or choose another output")
-        try:
-            store = open_sweep(out)
-        except Exception as error:
-            raise ValueError(f"{out}: not a sweep store softarm can resume ({error})") from None
+        store = _existing(where)
         if store.attrs.get("sweep_fingerprint") != spec.key:
             mine = dataset_attrs(spec, "")
-            differ = [k for k in ("case_json", "design", "method", "tol", "stations", "fields",
-                                  "dtype", "chunk_size", "semantics")
-                      if str(store.attrs.get(k)) != str(mine[k])]
-            raise ValueError(f"{out}: holds another sweep (its {', '.join(differ) or 'version'}"
-                             " differ); resume with the case and options it was started with, "
-                             "or choose another output")
+            differ = [name for name, key in _FINGERPRINT.items()
+                      if str(store.attrs.get(key)) != str(mine[key])] or ["softarm version"]
+            raise ValueError(f"{where}: holds another sweep (its {_listing(differ)} "
+                             f"{'differs' if len(differ) == 1 else 'differ'}); resume with the "
+                             "case it was started with, or choose another output")
         done = np.asarray(store["chunk_done"].values)
         return [k for k in range(chunks) if not done[k]]
     if not out.parent.is_dir():
-        raise ValueError(f"{out}: folder {out.parent} does not exist")
+        raise ValueError(f"{where}: folder {out.parent} does not exist")
     create_store(spec, plan, case_text(case))
     return list(range(chunks))
