@@ -113,7 +113,7 @@ def main() -> None:
                                  name="demo")
         case = _sweep_case(folder)
         io.save_result(solve_case(case), folder / "sweep.npz", case)
-        sweep = view.view_result_file(folder / "sweep.npz", folder / "sweep.html")
+        sweep = view.view_result_file(io.load_saved(folder / "sweep.npz"), folder / "sweep.html")
         print(f"HTML size: one equilibrium {single.stat().st_size / 1e6:.2f} MB, "
               f"11-step sweep {sweep.stat().st_size / 1e6:.2f} MB "
               f"(plotly.js {view.plotly_js_path().stat().st_size / 1e6:.2f} MB of it)")

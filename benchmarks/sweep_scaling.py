@@ -154,17 +154,17 @@ def main(argv=None) -> int:
             print(f"RATIO {label}: {ratio:.2f}")
 
         # the fixed costs that set the chunk size: one chunk's store write, one Dask task
-        from softarm import _sweep_run
+        from softarm.sweep import _run, _store
 
-        spec = _sweep_run.Spec(case.to_dict(), None, design, "numeric", 101, 1e-8, fields,
-                               "float64", args.chunk, str(scratch / "serial.zarr"))
-        data = _sweep_run._allocate(spec, args.chunk)
+        spec = _run.Spec(case.to_dict(), None, design, "numeric", 101, 1e-8, fields,
+                         "float64", args.chunk, str(scratch / "serial.zarr"))
+        data = _store.allocate(spec, args.chunk)
         data["status"][:] = 0
         chunks = min(20, args.cases // args.chunk)
         start = clock()
         for k in range(chunks):
-            task = _sweep_run.Task(spec, k, k * args.chunk, (k + 1) * args.chunk, None)
-            _sweep_run._write_chunk(spec, task, data)
+            task = _run.Task(spec, k, k * args.chunk, (k + 1) * args.chunk, None)
+            _store.write_chunk(spec, task, data)
         wall, _ = since(start)
         print(f"COST store write of one chunk of {args.chunk} cases (tip, positions): "
               f"{1e3 * wall / chunks:.1f} ms")

@@ -1,4 +1,4 @@
-"""The compiled bounded least-squares step (``softarm._bounded``) against scipy's
+"""The compiled bounded least-squares step (``softarm.statics._bounded``) against scipy's
 bounded-variable least squares (``scipy.optimize.lsq_linear(method="bvls")``, an independent
 implementation) on random problems: boxes with finite and infinite sides, columns scaled over
 orders of magnitude, square and tall A."""
@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from scipy.optimize import lsq_linear
 
-from softarm._bounded import box_least_squares, regularised_step
+from softarm.statics._bounded import box_least_squares, regularised_step
 
 
 def _problem(rng):

@@ -166,7 +166,7 @@ def test_convergence_failure_exit_1(tmp_path, capsys, monkeypatch):
     def failing(*args, **kwargs):
         raise softarm.ConvergenceError("did not converge", 3.5e-2, "30 iterations")
 
-    monkeypatch.setattr(softarm.sweep, "_solver", lambda: failing)
+    monkeypatch.setattr(softarm.case, "_solver", lambda: failing)
     out = tmp_path / "out.csv"
     code, _, stderr = run(capsys, "solve", FIG2, "-o", out)
     assert code == 1
@@ -199,7 +199,7 @@ def test_long_sweep_is_solved_in_chunks_with_progress(monkeypatch, method):
     import time
 
     case = load_case(SWEEP)
-    real = softarm.sweep._solver()
+    real = softarm.case._solver()
     calls = []
 
     def slow(arm, loads, **kwargs):

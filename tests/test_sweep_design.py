@@ -202,7 +202,9 @@ def test_softarm_solve_points_a_design_to_softarm_sweep(tmp_path, capsys):
                     "GJ = 1.0, EIy = 1.0, EIz = 1.0 }\n[[load]]\nkind = 'tip'\n"
                     "[sweep]\n[[sweep.parameter]]\npath = 'arm.length'\nvalues = [1.0, 2.0]\n")
     assert main(["solve", str(case)]) == 2
-    assert "softarm sweep" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "softarm sweep" in err and len(err.splitlines()) == 1
+    assert err.count(str(case)) == 1  # the file named once (it was twice: "case: case: ...")
 
 
 def test_progress_counts_cases_with_rate_and_eta():

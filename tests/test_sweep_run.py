@@ -386,3 +386,221 @@ def test_segment_parameters_group_cases_onto_their_arm():
                                    softarm.lie.so3.to_quaternion(eq.rotations), rtol=0,
                                    atol=1e-12)
     np.testing.assert_allclose(ds["length"].values, 0.3)
+
+
+# --------------------------------------------------------------------------------------------
+# softarm sweep: what goes wrong around the sweep (issue 30)
+# --------------------------------------------------------------------------------------------
+
+SMALL_GRID = {"design": "grid", "parameter": [
+    {"path": "load[2].force.y", "start": 0.0, "stop": 0.1, "steps": 10},
+    {"path": "load[2].force.z", "start": -0.1, "stop": 0.0, "steps": 4}]}
+
+
+def _children(pid: int) -> list[int]:
+    """The processes whose parent is ``pid`` (Linux /proc)."""
+    found = []
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            try:
+                fields = (entry / "stat").read_text().rpartition(")")[2].split()
+            except OSError:
+                continue
+            if int(fields[1]) == pid:
+                found.append(int(entry.name))
+    return found
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").is_file(), reason="reads /proc (Linux)")
+def test_a_killed_worker_is_one_line_naming_the_resume_command(tmp_path):
+    """One worker of --workers 2 gets SIGKILL (what the kernel's out-of-memory killer sends):
+    one line on stderr that names the command to resume, exit 1 (a failure, not bad input);
+    that command, run as printed, finishes a store equal to the bit to an uninterrupted run."""
+    sweep = {"design": "grid", "parameter": [
+        {"path": "load[2].force.y", "start": 0.0, "stop": 0.1, "steps": 20},
+        {"path": "load[2].force.z", "start": -0.1, "stop": 0.0, "steps": 8}]}
+    case_file = tmp_path / "killed.toml"
+    case_file.write_text(_toml(soft_arm_case(sweep)))
+    out = tmp_path / "killed.zarr"
+    process = subprocess.Popen(
+        [sys.executable, "-m", "softarm", "sweep", str(case_file), "-o", str(out), "--chunk",
+         "2", "--workers", "2", "--dtype", "float32"],
+        stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 180
+    while _chunk_files(out) < 3 and process.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.005)
+    workers = _children(process.pid)
+    assert len(workers) >= 2, workers
+    os.kill(workers[0], signal.SIGKILL)
+    _, err = process.communicate(timeout=180)
+    assert process.returncode == 1, err
+    lines = [line for line in err.splitlines() if line.strip() and  # but the progress bar
+             not line.startswith("sweep [")]
+    assert len(lines) == 1 and "Traceback" not in err, err
+    command = f"softarm sweep {case_file} -o {out} --resume"
+    assert lines[0].startswith("softarm: ") and lines[0].endswith(command)
+    assert _chunk_files(out) < 80  # the run stopped with chunks left to solve
+    resumed = subprocess.run([sys.executable, "-m", *command.split()], capture_output=True,
+                             text=True, timeout=300, check=False)
+    assert resumed.returncode == 0, resumed.stderr
+    assert "160 ok, 0 failed" in resumed.stdout
+    whole = softarm.sweep.run(load_case(case_file), out=tmp_path / "whole.zarr", chunk=2,
+                              fields=("tip", "positions"), dtype="float32")
+    final = softarm.open_sweep(out)
+    assert final["positions"].dtype == np.float32
+    assert_same_outputs(final, whole, atol=0.0)
+
+
+@pytest.mark.parametrize("name", ["out.csv", "out.zarr.d", "out"])
+def test_an_output_that_is_not_a_zarr_store_is_refused(tmp_path, capsys, name):
+    from softarm.cli import main
+
+    case_file = tmp_path / "case.toml"
+    case_file.write_text(_toml(soft_arm_case(SMALL_GRID)))
+    assert main(["sweep", str(case_file), "-o", str(tmp_path / name)]) == 2
+    err = capsys.readouterr().err
+    assert len(err.splitlines()) == 1 and ".zarr" in err and name in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["case.toml"]  # nothing written
+
+
+def _interrupted_store(case_file: Path, out: Path, options: list[str], after: int) -> None:
+    """``softarm sweep`` with ``options``, stopped by Ctrl-C after ``after`` cases."""
+    from softarm import cli
+
+    calls = {"n": 0}
+    real = cli._Progress.__call__
+
+    def progress(self, done, total, *rest):
+        calls["n"] += 1
+        if done >= after:
+            raise KeyboardInterrupt
+        return real(self, done, total, *rest)
+
+    handler = signal.getsignal(signal.SIGINT)  # the command ignores a second Ctrl-C after one
+    try:
+        with pytest.MonkeyPatch.context() as patch:
+            patch.setattr(cli._Progress, "__call__", progress)
+            assert cli.main(["sweep", str(case_file), "-o", str(out), *options]) == 130
+    finally:
+        signal.signal(signal.SIGINT, handler)
+    assert calls["n"] >= 1
+
+
+def test_resume_takes_the_options_recorded_in_the_store(tmp_path, capsys):
+    """The README's two lines: a sweep with --fields and --dtype, interrupted, then
+    `softarm sweep CASE -o STORE --resume` with no option: it resumes with the store's
+    options (it said "holds another sweep (its dtype differ)"), and the store equals an
+    uninterrupted run with those options, to the bit."""
+    case_file = tmp_path / "design.toml"
+    case_file.write_text(_toml(soft_arm_case(SMALL_GRID)))
+    out = tmp_path / "design.zarr"
+    options = ["--fields", "tip,strains", "--dtype", "float32", "--chunk", "4",
+               "--stations", "7"]
+    _interrupted_store(case_file, out, options, after=8)
+    partial = softarm.open_sweep(out)
+    assert 0 < int(np.sum(partial["status"].values == -1)) < 40
+    capsys.readouterr()
+    from softarm.cli import main
+
+    assert main(["sweep", str(case_file), "-o", str(out), "--resume"]) == 0, \
+        capsys.readouterr().err
+    assert "40 ok, 0 failed" in capsys.readouterr().out
+    whole = softarm.sweep.run(load_case(case_file), out=tmp_path / "whole.zarr", chunk=4,
+                              stations=7, fields=("tip", "strains"), dtype="float32")
+    final = softarm.open_sweep(out)
+    assert final["strains"].dtype == np.float32 and final.sizes["station"] == 7
+    assert "positions" not in final
+    assert_same_outputs(final, whole, atol=0.0)
+    # given again, the same options are accepted
+    assert main(["sweep", str(case_file), "-o", str(out), "--resume", *options]) == 0
+
+
+def test_resume_refuses_options_that_differ_from_the_store(tmp_path, capsys):
+    """An option given with --resume that differs from the store's: one line that names it
+    with both values, exit 2, the store untouched."""
+    case_file = tmp_path / "design.toml"
+    case_file.write_text(_toml(soft_arm_case(SMALL_GRID)))
+    out = tmp_path / "design.zarr"
+    _interrupted_store(case_file, out, ["--dtype", "float32", "--chunk", "4"], after=8)
+    before = np.asarray(softarm.open_sweep(out)["chunk_done"].values)
+    capsys.readouterr()
+    from softarm.cli import main
+
+    code = main(["sweep", str(case_file), "-o", str(out), "--resume", "--dtype", "float64",
+                 "--fields", "tip"])
+    err = capsys.readouterr().err
+    assert code == 2 and len(err.splitlines()) == 1, err
+    assert "dtype" in err and "float32" in err and "float64" in err
+    assert "fields" in err and "tip,positions" in err
+    assert "chunk" not in err  # given the same as the store's: not named
+    np.testing.assert_array_equal(softarm.open_sweep(out)["chunk_done"].values, before)
+    # the same in Python
+    with pytest.raises(ValueError, match=r"dtype float32.*given dtype float64"):
+        softarm.sweep.run(load_case(case_file), out=out, resume=True, dtype="float64")
+
+
+@pytest.mark.parametrize(("change", "words"), [
+    (("force = [0.0, 0.02, -0.05]", "force = [0.0, 0.03, -0.05]"), "(its case differs)"),
+    (("steps = 10", "steps = 11"), "(its case and design differ)"),
+])
+def test_resume_of_another_sweep_says_what_differs(tmp_path, capsys, change, words):
+    case_file = tmp_path / "design.toml"
+    case_file.write_text(_toml(soft_arm_case(SMALL_GRID)))
+    out = tmp_path / "design.zarr"
+    _interrupted_store(case_file, out, ["--chunk", "4"], after=8)
+    text = case_file.read_text()
+    assert change[0] in text
+    case_file.write_text(text.replace(change[0], change[1]))
+    capsys.readouterr()
+    from softarm.cli import main
+
+    assert main(["sweep", str(case_file), "-o", str(out), "--resume"]) == 2
+    err = capsys.readouterr().err
+    assert len(err.splitlines()) == 1 and f"{out}: holds another sweep {words}" in err, err
+    assert err.count(str(out)) == 1
+
+
+def test_resume_in_python_takes_the_store_options(tmp_path):
+    """softarm.sweep.run(..., resume=True) without options resumes with the store's."""
+    case = parse_case(soft_arm_case(SMALL_GRID), "design.toml")
+    out = tmp_path / "design.zarr"
+    calls = []
+
+    def stop(done, total, failed):
+        calls.append(done)
+        if done >= 8:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        softarm.sweep.run(case, out=out, chunk=4, dtype="float32", fields=("tip",),
+                          progress=stop)
+    ds = softarm.sweep.run(case, out=out, resume=True)
+    assert ds["tip_position"].dtype == np.float32 and "positions" not in ds
+    assert int(np.sum(ds["status"].values == 0)) == 40
+    whole = softarm.sweep.run(case, chunk=4, dtype="float32", fields=("tip",))
+    assert_same_outputs(ds, whole, atol=0.0)
+
+
+def test_an_unreachable_scheduler_is_named_with_the_time_waited(tmp_path, capsys):
+    """--scheduler tcp://ADDRESS where nothing answers: one line that says so, with the
+    connect timeout of Dask's configuration (it said "cannot write: Timed out"); exit 2."""
+    need("distributed", "dask")
+    import socket
+
+    import dask
+
+    from softarm.cli import main
+
+    with socket.socket() as probe:  # a port nothing listens on
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    case_file = tmp_path / "case.toml"
+    case_file.write_text(_toml(soft_arm_case(SMALL_GRID)))
+    address = f"tcp://127.0.0.1:{port}"
+    with dask.config.set({"distributed.comm.timeouts.connect": "1s"}):
+        code = main(["sweep", str(case_file), "-o", str(tmp_path / "out.zarr"), "--scheduler",
+                     address])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert err == f"softarm: error: cannot reach the Dask scheduler at {address} within 1 s\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["case.toml"]

@@ -30,6 +30,7 @@ from numbers import Integral, Real
 
 import numpy as np
 
+from ._sweep_table import COMPONENTS, Sweep
 from ._validate import as_array
 from .errors import CaseError, CaseTypeError
 from .loads import Key, as_loads
@@ -45,7 +46,6 @@ from .model import (
     Tube,
 )
 from .routing import ROUTINGS
-from .sweep import COMPONENTS, Sweep
 
 __all__ = [
     "ARM",

@@ -1,9 +1,10 @@
 """Case files (TOML): the case model, and the reader that turns a file into a :class:`Case`.
 
 A *case file* describes an arm, its loads and how to solve it; :func:`load_case` reads it into a
-:class:`Case` that notebooks and the ``softarm`` command share, and
-:func:`softarm.sweep.solve_case` solves it (every step of its ``[sweep]``). Every key is
-documented in ``docs/case-files.md``; the keys of each table are declared once, in
+:class:`Case` that notebooks and the ``softarm`` command share, and :func:`solve_case` solves
+it (every step of a one-parameter ``[sweep]``; a design is :func:`softarm.sweep.run`'s, above
+this module: the case knows its ``[sweep]`` table as plain data, :mod:`softarm._sweep_table`).
+Every key is documented in ``docs/case-files.md``; the keys of each table are declared once, in
 :mod:`softarm._schema`, which also writes models back (:func:`arm_to_dict`,
 :func:`loads_to_dict`). Unknown keys, wrong types and invalid values raise :class:`CaseError`
 naming the file, the key path and what is wrong: the reader checks what a TOML value is, the
@@ -24,20 +25,25 @@ import copy
 import math
 import os
 import sys
-from dataclasses import dataclass, field
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
 from numbers import Real
 from pathlib import Path
 
 import numpy as np
 
-from . import _schema
+from . import _schema, dispatch
+from ._keypath import resolve
 from ._schema import Table, arm_to_dict, loads_to_dict
+from ._sweep_table import DESIGNS, Design, Parameter, Sweep
 from ._validate import check_allocation, count
+from .equilibrium import Equilibrium, Stability
 from .errors import CaseError, CaseTypeError
 from .loads import LOAD_KINDS
 from .model import Arm, SegmentedArm, StiffnessMatrix
+from .statics import Solver
 from .statics.solver import check_tol
-from .sweep import Design, Parameter, Sweep, solve_case
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -57,8 +63,8 @@ __all__ = [
     "solve_case",
 ]
 
-# Sweep, solve_case (softarm.sweep), arm_to_dict and loads_to_dict (softarm._schema) are
-# re-exported here: softarm.case named them first.
+# Sweep (softarm._sweep_table, public in softarm.sweep), arm_to_dict and loads_to_dict
+# (softarm._schema) are re-exported here: softarm.case named them first.
 
 
 # --------------------------------------------------------------------------------------------
@@ -246,8 +252,6 @@ def _solve_options(table: Table) -> SolveOptions:
 def _design(table: Table, data: dict) -> Design:
     """A ``[sweep]`` with ``design`` and ``[[sweep.parameter]]`` tables: the design, its key
     paths resolved against the file (errors name the key path)."""
-    from ._sweep_design import DESIGNS, resolve
-
     keys = _schema.DESIGN
     kind = table.string("design", DESIGNS, default="grid")
     samples = table.read(keys["samples"]) if table.has("samples") else None
@@ -424,3 +428,148 @@ def load_case(path: str | os.PathLike) -> Case:
     except tomllib.TOMLDecodeError as error:
         raise CaseError(f"{path}: not valid TOML: {error}") from None
     return parse_case(data, path)
+
+
+# --------------------------------------------------------------------------------------------
+# Solving a case
+# --------------------------------------------------------------------------------------------
+
+
+def _solver():
+    """``softarm.solve`` that warm-starts each call from the previous one (sweep chunks).
+
+    One prepared :class:`softarm.statics.Solver` per (arm, stations, tol) serves every call
+    through :func:`softarm.dispatch.solve_prepared`: the same routes and checks as
+    ``softarm.solve``, but each chunk of a sweep starts from the last solution of the previous
+    chunk instead of from the unloaded arm.
+    """
+    prepared = {}
+
+    def solve(arm, loads, *, method="auto", s=None, tol=1e-8, branch=None):
+        if branch == "stable":
+            return dispatch.solve(arm, loads, method=method, s=s, tol=tol, branch=branch)
+        key = (arm, s, tol)
+        if key not in prepared:
+            prepared[key] = Solver(arm, s=s, tol=tol)
+        return dispatch.solve_prepared(prepared[key], loads, method)
+
+    return solve
+
+
+def solve_case(case: Case, *, method: str | None = None, stations: int | None = None,
+               tol: float | None = None, progress: Callable[[int, int], None] | None = None,
+               solve: Callable | None = None) -> Equilibrium:
+    """Solve a case (every step of its sweep, if it has one).
+
+    A sweep is solved as batched calls of ``softarm.solve`` (warm-started along the batch inside
+    the solver, and from one call to the next). When the first step shows that the whole sweep
+    will take more than about a second, the rest is solved in a few consecutive chunks so that
+    ``progress(done, total)`` can report; otherwise in one call.
+
+    Parameters
+    ----------
+    case : Case
+    method, stations, tol : optional
+        Override the case's ``[solve]`` options.
+    progress : callable, optional
+        Called as ``progress(steps_done, steps_total)`` after each chunk of a long sweep.
+    solve : callable, optional
+        The solver, with the signature of ``softarm.solve``; by default ``softarm.solve``
+        warm-started from one call to the next (:func:`_solver`).
+
+    Returns
+    -------
+    Equilibrium
+        Batch shape (steps,) for a sweep, () otherwise.
+    """
+    if getattr(case, "design", None) is not None:
+        raise ValueError(f"{case.source or case.name}: [sweep] is a design over "
+                         f"{', '.join(case.design.paths)}; run it with softarm sweep CASE.toml "
+                         "-o OUT.zarr (softarm.sweep.run)")
+    solve = _solver() if solve is None else solve
+    options = case.solve
+    kwargs = {"method": method or options.method,
+              "s": int(stations if stations is not None else options.stations),
+              "tol": float(tol if tol is not None else options.tol)}
+    steps = len(case.sweep.values) if case.sweep is not None else 1
+    check_allocation(steps, kwargs["s"], "")
+    if options.branch == "stable":
+        kwargs["branch"] = "stable"  # one case at a time: each its own stable branch
+    if case.sweep is None:
+        return solve(case.arm, case.loads, **kwargs)
+    loads = case.batched_loads
+    if options.branch == "stable":
+        parts = []
+        for k in range(len(case.sweep.values)):
+            parts.append(_batched(solve(case.arm, _take(loads, k, k + 1), **kwargs)))
+            if progress is not None:
+                progress(k + 1, len(case.sweep.values))
+        return _concatenate(parts, loads)
+    total = len(case.sweep.values)
+    start = time.perf_counter()
+    parts = [solve(case.arm, _take(loads, 0, 1), **kwargs)]
+    first = time.perf_counter() - start
+    done = 1
+    if progress is not None:
+        progress(done, total)
+    budget = 0.25  # seconds per chunk when progress is shown
+    chunk = total - 1 if first * (total - 1) < 1.0 else max(1, int(budget / max(first, 1e-9)))
+    while done < total:
+        stop = min(total, done + chunk)
+        parts.append(solve(case.arm, _take(loads, done, stop), **kwargs))
+        done = stop
+        if progress is not None:
+            progress(done, total)
+    return _concatenate(parts, loads)
+
+
+def _batched(eq: Equilibrium) -> Equilibrium:
+    """A single case as a batch of one (branch='stable' solves one case at a time)."""
+    if eq.batch_shape:
+        return eq
+    verdict = eq.stability
+    if verdict is not None:
+        verdict = Stability.of(np.array([verdict.index]), np.array([verdict.conservative]),
+                                 (1,))
+    return replace(eq, poses=eq.poses[None], strains=eq.strains[None],
+                   stresses=eq.stresses[None], residual=np.array([eq.residual]),
+                   error_estimate=np.array([eq.error_estimate]), stability=verdict,
+                   tip_compliance=None, compliance=None, base_wrench=None,
+                   tendon_tensions=None, tendon_lengths=None, tendon_length_changes=None,
+                   tendon_slack=None)
+
+
+def _take(loads: tuple, start: int, stop: int) -> tuple:
+    """Cases start..stop-1 of the batched loads (unbatched loads as they are)."""
+    return tuple(load.take(slice(start, stop)) if load.batch_shape else load for load in loads)
+
+
+def _concatenate(parts: list[Equilibrium], loads: tuple) -> Equilibrium:
+    if len(parts) == 1:
+        return replace(parts[0], loads=loads)
+    first = parts[0]
+
+    def cat(name):
+        return np.concatenate([np.broadcast_to(np.asarray(getattr(p, name), dtype=float),
+                                               p.batch_shape) for p in parts])
+
+    def fields(name):  # fresh and read-only: Equilibrium takes it without a copy
+        array = np.concatenate([getattr(p, name) for p in parts])
+        array.setflags(write=False)
+        return array
+
+    methods = sorted({p.method for p in parts})
+    stability = None
+    if all(p.stability is not None for p in parts):
+        stability = Stability.of(
+            np.concatenate([np.atleast_1d(p.stability.index) for p in parts]),
+            np.concatenate([np.broadcast_to(p.stability.conservative, p.batch_shape)
+                            for p in parts]), (sum(p.batch_shape[0] for p in parts),))
+    return Equilibrium(
+        s=first.s,
+        poses=fields("poses"),
+        strains=fields("strains"),
+        stresses=fields("stresses"),
+        arm=first.arm, loads=loads, method="+".join(methods),
+        exact=all(bool(p.exact) for p in parts),
+        residual=cat("residual"), error_estimate=cat("error_estimate"), stability=stability)

@@ -28,6 +28,7 @@ written through (its target is replaced, the link kept).
 from __future__ import annotations
 
 import argparse
+import concurrent.futures
 import contextlib
 import errno
 import os
@@ -252,18 +253,18 @@ def _parser() -> argparse.ArgumentParser:
                        help="'local' (a Dask LocalCluster of --workers processes) or a Dask "
                        "scheduler address such as tcp://host:8786")
     sweep.add_argument("--resume", action="store_true",
-                       help="finish the chunks an interrupted run of the same sweep left")
-    sweep.add_argument("--fields", type=_fields, default=("tip", "positions"),
-                       metavar="F,...", help="outputs to keep, comma-separated, among "
-                       "tip, positions, orientations, poses, strains, stresses (default "
-                       "tip,positions)")
+                       help="finish the chunks an interrupted run of the same sweep left, "
+                       "with the options the store was started with")
+    sweep.add_argument("--fields", type=_fields, metavar="F,...",
+                       help="outputs to keep, comma-separated, among tip, positions, "
+                       "orientations, poses, strains, stresses (default tip,positions)")
     sweep.add_argument("--stations", type=_stations, metavar="N",
                        help="number of output stations (default from the file, else 101)")
-    sweep.add_argument("--dtype", choices=("float64", "float32"), default="float64",
+    sweep.add_argument("--dtype", choices=("float64", "float32"),
                        help="of the stored outputs (default float64)")
     sweep.add_argument("--chunk", type=_positive, metavar="N",
                        help="cases per chunk (task and store chunk; default up to 1000)")
-    sweep.add_argument("--path", action="store_true",
+    sweep.add_argument("--path", action="store_true", default=None,
                        help="follow a one-parameter load sweep quasi-statically, serially, "
                        "instead of solving each case from the unloaded arm")
     sweep.add_argument("--method", choices=("auto", "numeric"),
@@ -438,12 +439,21 @@ def _solve(case: Case, args) -> tuple:
             result = solve_case(case, method=args.method, stations=args.stations,
                                 tol=args.tol, progress=progress)
     except (ValueError, TypeError) as error:  # the solver rejected the case's data
-        raise CaseError(f"{case.source or case.name}: {error}") from None
+        raise CaseError(_named(error, case.source or case.name)) from None
     finally:
         notice.cancel()
         progress.close()
     _report(caught)
     return result, time.perf_counter() - start
+
+
+def _named(error: Exception, *where) -> str:
+    """The error's message, starting with the first of ``where`` (a file) unless it starts
+    with one of them already (the library names the file itself where it knows it)."""
+    text = str(error)
+    if any(text.startswith(f"{w}: ") for w in where):
+        return text
+    return f"{where[0]}: {text}"
 
 
 def _report(caught) -> None:
@@ -675,6 +685,9 @@ def _run_sweep(args) -> int:
         raise CaseError(f"softarm sweep needs xarray and zarr ({error.name} is missing): pip "
                         "install 'softarm[sweep]'") from None
     out = Path(args.output)
+    if out.suffix.lower() != ".zarr":  # a folder of Zarr arrays, not a file of that format
+        raise CaseError(f"{out}: a sweep store is a Zarr folder; give a name ending in .zarr, "
+                        f"got suffix {out.suffix or '(none)'!r}")
     if _same_file(out, Path(args.case)):
         raise CaseError(f"{out}: is the input file {args.case}; choose another output")
     case = load_case(args.case)
@@ -700,7 +713,7 @@ def _run_sweep(args) -> int:
                                        processes=True, dashboard_address=None)
                 client = Client(cluster)
             else:
-                client = Client(args.scheduler)
+                client = _connect(Client, args.scheduler)
             executor = client.get_executor(pure=False)
             mapper = executor.map
         elif args.workers > 1 and not args.path:
@@ -712,9 +725,13 @@ def _run_sweep(args) -> int:
                                method=args.method, tol=args.tol, resume=args.resume,
                                path=args.path, progress=progress)
         except (ValueError, TypeError) as error:
-            text = str(error)
-            raise CaseError(text if text.startswith(str(out)) else
-                            f"{case.source or case.name}: {text}") from None
+            raise CaseError(_named(error, case.source or case.name, out)) from None
+        except concurrent.futures.BrokenExecutor:  # a worker killed (the OOM killer: SIGKILL)
+            progress.close()
+            print("softarm: a worker process of the sweep died (killed by the system, e.g. "
+                  "out of memory); the finished chunks are kept: finish with softarm sweep "
+                  f"{args.case} -o {out} --resume", file=sys.stderr)  # whole, however long
+            return 1
     except KeyboardInterrupt:
         progress.close()
         return interrupted(f"interrupted; finish it with softarm sweep {args.case} -o {out} "
@@ -780,6 +797,20 @@ class _CompileBar:
         text = f"compiling [{bar}] {index + 1}/{count} {step.text}"
         self.stream.write(f"\r{text[:72]}  {elapsed:.0f} s of about {estimate:.0f} s")
         self.stream.flush()
+
+
+def _connect(client, address: str):
+    """A Dask ``client(address)``, or one line if no scheduler answers there within Dask's
+    connect timeout (``distributed.comm.timeouts.connect``, 30 s unless configured)."""
+    import dask
+    from dask.utils import parse_timedelta
+
+    timeout = parse_timedelta(dask.config.get("distributed.comm.timeouts.connect"), "s")
+    try:
+        return client(address, timeout=timeout)
+    except OSError:  # distributed's "Timed out trying to connect"
+        raise CaseError(f"cannot reach the Dask scheduler at {address} within {timeout:g} s"
+                        ) from None
 
 
 def _run_demo(args) -> int:

@@ -25,13 +25,14 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ._bounded import regularised_step
 from ._validate import count, real
 from .dispatch import warn_unstable, warn_verdict
 from .equilibrium import Equilibrium, Stability
 from .errors import ConvergenceError
 from .loads import as_loads
 from .statics import Solver
+from .statics._bounded import regularised_step
+from .statics.displacement import displaced_columns, displacement_jacobians
 from .statics.solver import Snapshot, _kernels
 
 __all__ = ["ForwardResult", "ForwardSolver", "InverseResult", "InverseSolver", "inverse"]
@@ -461,8 +462,6 @@ class InverseSolver:
         per metre of displacement)."""
         if not self._displaced:
             return q.copy(), eq
-        from .statics.displacement import displaced_columns, displacement_jacobians
-
         inputs = q.copy()
         # the given loads: the displacement-controlled tendons' rows and input columns
         _, rows, cols = displaced_columns([*self.loads, *self.actuators])

@@ -7,17 +7,21 @@ this module is the only place that knows both.
 from __future__ import annotations
 
 import dataclasses
+import math
 import warnings
 
 import numpy as np
 
 from .analytic.exact import closed_form
 from .equilibrium import Equilibrium
-from .errors import StabilityWarning
+from .errors import ConvergenceError, StabilityWarning
 from .statics import Solver
+from .statics.continuation import STEPS, Path, follow
+from .statics.continuation import _switch as switch_at
 from .statics.solver import _IDENTITY
+from .statics.stability import closed_form_verdict
 
-__all__ = ["METHODS", "solve", "solve_prepared"]
+__all__ = ["METHODS", "solve", "solve_prepared", "solve_stable"]
 
 #: Accepted values of ``method``.
 METHODS = ("auto", "numeric", "analytic")
@@ -133,8 +137,6 @@ def solve(arm, loads, *, method="auto", s=None, tol=1e-8, base=None, jacobians=F
             raise ValueError("branch='stable' needs the numerical route with its stability "
                              "verdict (method 'auto' or 'numeric', no jacobians, "
                              "stability=True)")
-        from .stability import solve_stable
-
         return warn_unstable(solve_stable(solver, loads, imperfection))
     if jacobians:
         if method == "analytic":
@@ -142,6 +144,42 @@ def solve(arm, loads, *, method="auto", s=None, tol=1e-8, base=None, jacobians=F
                              "'numeric'")
         return warn_unstable(solver.solve_from_unloaded(loads, jacobians=True))
     return solve_prepared(solver, loads, method)
+
+
+def solve_stable(solver: Solver, loads, imperfection=None, *, max_switches=4):
+    """A stable equilibrium under ``loads`` (a single case): the one connected to the
+    unloaded arm if it is stable, else the branch reached by switching, at the first
+    critical point of the loading path, along the null vector of ∂r/∂x, followed to the
+    full load (repeated at later critical points of that branch)."""
+    _, shape = solver.check_loads(loads)
+    if shape != ():
+        raise ValueError("branch='stable' takes a single load case (batch shape ()), got "
+                         f"batch shape {shape}")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", StabilityWarning)
+        eq = solver.solve_from_unloaded(loads)
+    verdict = eq.stability
+    if verdict is None or verdict.index == 0 or not verdict.conservative:
+        return eq
+    path = Path(Solver(solver.arm, base=solver.base, s=solver.s, stability=False), (),
+                loads, STEPS)
+    z0 = path.correct(path.z(np.zeros(6), 0.0))
+    points, indices, critical = follow(path, z0, 1.0)
+    for _ in range(max_switches):
+        if indices[-1] == 0:
+            break
+        bifurcations = [c for c in critical if c.kind == "bifurcation"]
+        if not bifurcations:
+            break
+        new = switch_at(path, bifurcations[0], imperfection, 1.0)
+        points, indices, critical = (np.asarray(new.equilibria.base_wrench), new.index,
+                                     new.critical)
+        points = np.column_stack([np.asarray(new.x) / path.xscale, new.lam])
+    if indices[-1] != 0 or abs(points[-1, 6] - 1.0) > 1e-12:
+        raise ConvergenceError(
+            f"no stable equilibrium was reached under the full load (the branch followed has "
+            f"Morse index {int(indices[-1])} at λ = {points[-1, 6]:.6g})", math.nan)
+    return solver.solve_near(loads, path.x(points[-1]), path.n)
 
 
 def warn_unstable(eq: Equilibrium, stacklevel: int = 3) -> Equilibrium:
@@ -190,8 +228,6 @@ def solve_prepared(solver: Solver, loads, method="auto") -> Equilibrium:
         result = _closed_form(solver.arm, loads, shape, solver.s, solver.base)
         if result is not None:
             if solver.stability:
-                from .statics.stability import closed_form_verdict
-
                 result = result._with_stability(closed_form_verdict(solver, loads, result))
             return warn_unstable(result, 4)
         if method == "analytic":

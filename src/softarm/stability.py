@@ -7,7 +7,8 @@ the backward sweep); this module follows equilibria as a load grows:
   λ = 0 loses stability, its mode, kind and nullity;
 - :func:`continuation`: a :class:`Branch` of equilibria in (x, λ), with the index at each
   point and the critical points met; :meth:`Branch.switch` follows a bifurcating branch;
-- :func:`solve_stable`: what ``softarm.solve(..., branch="stable")`` returns.
+- :func:`solve_stable` (:mod:`softarm.dispatch`, re-exported here): what
+  ``softarm.solve(..., branch="stable")`` returns.
 """
 
 from __future__ import annotations
@@ -18,11 +19,11 @@ import warnings
 import numpy as np
 
 from ._validate import real
-from .errors import ConvergenceError, StabilityWarning
+from .dispatch import solve_stable
+from .errors import ConvergenceError
 from .loads import as_loads
 from .statics import Solver
 from .statics.continuation import STEPS, Branch, CriticalPoint, Mode, Path, branch, follow
-from .statics.continuation import _switch as switch_at
 
 __all__ = ["Branch", "CriticalPoint", "Mode", "continuation", "critical_load", "plot_branch",
            "solve_stable"]
@@ -155,42 +156,6 @@ def continuation(arm, loads, lam=(0.0, 1.0), *, steps=STEPS, base=None, s=None,
     points, indices, critical = follow(path, z0, lam1, max_points=max_points,
                                        locate=path.conservative, max_step=max_step)
     return branch(path, points, indices, critical)
-
-
-def solve_stable(solver: Solver, loads, imperfection=None, *, max_switches=4):
-    """A stable equilibrium under ``loads`` (a single case): the one connected to the
-    unloaded arm if it is stable, else the branch reached by switching, at the first
-    critical point of the loading path, along the null vector of ∂r/∂x, followed to the
-    full load (repeated at later critical points of that branch)."""
-    _, shape = solver.check_loads(loads)
-    if shape != ():
-        raise ValueError("branch='stable' takes a single load case (batch shape ()), got "
-                         f"batch shape {shape}")
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", StabilityWarning)
-        eq = solver.solve_from_unloaded(loads)
-    verdict = eq.stability
-    if verdict is None or verdict.index == 0 or not verdict.conservative:
-        return eq
-    path = Path(Solver(solver.arm, base=solver.base, s=solver.s, stability=False), (),
-                loads, STEPS)
-    z0 = path.correct(path.z(np.zeros(6), 0.0))
-    points, indices, critical = follow(path, z0, 1.0)
-    for _ in range(max_switches):
-        if indices[-1] == 0:
-            break
-        bifurcations = [c for c in critical if c.kind == "bifurcation"]
-        if not bifurcations:
-            break
-        new = switch_at(path, bifurcations[0], imperfection, 1.0)
-        points, indices, critical = (np.asarray(new.equilibria.base_wrench), new.index,
-                                     new.critical)
-        points = np.column_stack([np.asarray(new.x) / path.xscale, new.lam])
-    if indices[-1] != 0 or abs(points[-1, 6] - 1.0) > 1e-12:
-        raise ConvergenceError(
-            f"no stable equilibrium was reached under the full load (the branch followed has "
-            f"Morse index {int(indices[-1])} at λ = {points[-1, 6]:.6g})", math.nan)
-    return solver.solve_near(loads, path.x(points[-1]), path.n)
 
 
 def plot_branch(*branches, coordinate=2, ax=None, labels=None, path=None):

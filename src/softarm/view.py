@@ -28,6 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ._files import write_atomic
 from .geometry import (
     actuator_paths,
     cube_limits,
@@ -551,8 +552,6 @@ def notebook_html(result, **options) -> str:
 
 def write_html(result, path: str | os.PathLike, **options) -> Path:
     """Write :func:`figure` (``options`` as there) as a self-contained HTML file, atomically."""
-    from .io import write_atomic
-
     text = to_html(figure(result, **options), div_id="softarm-view")
     path = Path(path)
     with write_atomic(path, "wb") as stream:
@@ -560,12 +559,16 @@ def write_html(result, path: str | os.PathLike, **options) -> Path:
     return path
 
 
-def view_result_file(source, path: str | os.PathLike) -> Path:
-    """:func:`write_html` for a result file written by :func:`softarm.io.save_result` (CSV,
-    JSON or NPZ; a path or a :class:`softarm.io.SavedResult`)."""
-    from .io import SavedResult, load_saved
+def view_result_file(saved, path: str | os.PathLike) -> Path:
+    """:func:`write_html` for a result file read by :func:`softarm.io.load_saved` (CSV, JSON or
+    NPZ written by :func:`softarm.io.save_result`): ``saved``, a :class:`softarm.io.SavedResult`.
 
-    saved = source if isinstance(source, SavedResult) else load_saved(source)
+    (This module reads no file itself: it imports nothing above :mod:`softarm.geometry`, so
+    that :meth:`softarm.Equilibrium.show` may use it, see ``tests/test_layering.py``.)
+    """
+    if isinstance(saved, (str, os.PathLike)):
+        raise TypeError(f"saved must be a softarm.io.SavedResult (softarm.io.load_saved(path)), "
+                        f"got the path {str(saved)!r}")
     result = saved.result
     if len(result.batch_shape) > 1:
         raise ValueError(f"{saved.path}: cannot view a batch of shape {result.batch_shape}")

@@ -16,7 +16,7 @@ energy: Δℓ is its gradient), symmetric and negative definite at a stable equi
 conditions above are the optimality conditions of maximising it less τ·d over τ >= 0. Each
 Newton step is that problem's quadratic model, min ½ δᵀ M δ - gᵀ δ over τ + δ >= 0 with
 M = -H and g = Δℓ - d, a box-constrained least-squares problem |R δ - R⁻ᵀ g|² (M = RᵀR),
-solved by :func:`softarm._bounded.box_least_squares`. Where H is not symmetric (follower
+solved by :func:`softarm.statics._bounded.box_least_squares`. Where H is not symmetric (follower
 loads) M is its symmetric part: the fixed points are the same exact solutions, the
 convergence is then linear instead of quadratic.
 """
@@ -28,9 +28,9 @@ import math
 
 import numpy as np
 
-from .._bounded import box_least_squares
 from ..errors import ConvergenceError
 from ..loads import Tendon
+from ._bounded import box_least_squares
 
 __all__ = ["displaced_columns", "displacement_jacobians", "solve_displaced"]
 

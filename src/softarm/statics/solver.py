@@ -22,6 +22,7 @@ from ..equilibrium import Equilibrium, Stability
 from ..errors import ConvergenceError
 from ..loads import as_loads, batch_shape
 from ..model import Arm, SegmentedArm
+from .displacement import solve_displaced
 from .stability import verdict
 
 __all__ = ["METHOD", "PreparedSolve", "ShootResult", "Shooter", "Snapshot", "Solver",
@@ -924,8 +925,6 @@ class Solver:
             # the tensions are unknowns: a bounded Newton method over tension-controlled
             # solves from the unloaded arm (statics/displacement.py); a chained Solver
             # restarts from the unloaded arm after it
-            from .displacement import solve_displaced
-
             if chained:
                 self.reset()
             return solve_displaced(self, loads, jacobians=jacobians)

@@ -20,9 +20,9 @@ __all__ = ["conservative", "verdict"]
 def _k():
     global _KERNELS
     if _KERNELS is None:  # (a function-level import costs about 5 µs a call)
-        from .solver import _kernels
+        from . import _kernels
 
-        _KERNELS = _kernels()
+        _KERNELS = _kernels
     return _KERNELS
 
 

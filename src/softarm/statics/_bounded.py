@@ -1,8 +1,8 @@
 """Bounded least squares for the bounded Newton methods of the solver (displacement-controlled
-tendons, ``softarm.statics``) and of inverse statics (``softarm.control``). The step is
-compiled, in the solver's kernels (``statics/_kernels.py``, imported on first use: inverse
-statics' compiled iteration calls it there): a control loop takes one per iteration, where
-scipy's bounded least squares costs about 90 µs a call."""
+tendons, :mod:`softarm.statics.displacement`) and of inverse statics (:mod:`softarm.control`).
+The step is compiled, in the solver's kernels (``_kernels.py`` beside this file, imported on
+first use: inverse statics' compiled iteration calls it there): a control loop takes one per
+iteration, where scipy's bounded least squares costs about 90 µs a call."""
 
 from __future__ import annotations
 
@@ -11,10 +11,10 @@ import numpy as np
 __all__ = ["box_least_squares", "regularised_step"]
 
 
-def _kernels():
-    from .statics.solver import _kernels
+def _compiled():
+    from . import _kernels  # compiled on first use: importing this module compiles nothing
 
-    return _kernels()
+    return _kernels
 
 
 def _floats(value):
@@ -28,7 +28,7 @@ def box_least_squares(A, b, lower, upper, iterations: int = 100):
     Householder least squares; a variable that would leave its box is fixed at the bound it
     reaches first along the way; a fixed one is freed when the objective's slope points into
     the box. After ``iterations`` without convergence, the last iterate (in the box)."""
-    x, _ = _kernels().box_least_squares(_floats(A), _floats(b), _floats(lower),
+    x, _ = _compiled().box_least_squares(_floats(A), _floats(b), _floats(lower),
                                          _floats(upper), int(iterations))
     return x
 
@@ -39,6 +39,6 @@ def regularised_step(J, b, q, scales, mu, lower, upper, iterations: int = 100):
     σ = |J s|_F, ε = 1e-12 (the least effort along the task's null space, moving the task
     solution by ~1e-12 relative), δq = s δu; :func:`box_least_squares` of the stacked
     system, built in compiled code."""
-    return _kernels().regularised_step(_floats(J), _floats(b), _floats(q), _floats(scales),
+    return _compiled().regularised_step(_floats(J), _floats(b), _floats(q), _floats(scales),
                                        float(mu), _floats(lower), _floats(upper),
                                        int(iterations))
