@@ -42,6 +42,21 @@ def test_version_matches_the_dynamic_version_source():
     assert importlib.metadata.version("softarm") == softarm.__version__
 
 
+def test_plain_pytest_says_why_a_test_was_skipped(tmp_path):
+    """The project's pytest configuration reports the reason of every skip (``-rs``): a plain
+    ``pytest`` must not print "4 skipped" and leave the reader to guess."""
+    (tmp_path / "test_skip.py").write_text(
+        "import pytest\n\n\ndef test_needs_a_browser():\n"
+        "    pytest.skip('chromium-driver is not installed')\n", encoding="utf-8")
+    child = subprocess.run(
+        [sys.executable, "-m", "pytest", "-c", str(ROOT / "pyproject.toml"), "--rootdir",
+         str(tmp_path), "-p", "no:cacheprovider", str(tmp_path / "test_skip.py")],
+        capture_output=True, text=True, timeout=300, cwd=tmp_path)
+    assert child.returncode == 0, child.stdout + child.stderr
+    assert re.search(r"SKIPPED \[1\] .*test_skip\.py:\d+: chromium-driver is not installed",
+                     child.stdout), child.stdout
+
+
 def test_every_public_name_exists():
     assert len(set(softarm.__all__)) == len(softarm.__all__)
     missing = [name for name in softarm.__all__ if not hasattr(softarm, name)]
