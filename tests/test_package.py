@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import importlib.metadata
+import itertools
 import re
 import subprocess
 import sys
@@ -55,6 +56,49 @@ def test_plain_pytest_says_why_a_test_was_skipped(tmp_path):
     assert child.returncode == 0, child.stdout + child.stderr
     assert re.search(r"SKIPPED \[1\] .*test_skip\.py:\d+: chromium-driver is not installed",
                      child.stdout), child.stdout
+
+
+def _readme_outputs() -> list[str]:
+    """The files and folders that the README's ``softarm`` commands (in its code blocks
+    without a language: the shell ones) write, relative to the working directory:
+    -o/--output, --plot, --out, and demo's two; a folder as FOLDER/x."""
+    import shlex
+
+    commands, fence = [], None
+    for line in (ROOT / "README.md").read_text(encoding="utf-8").splitlines():
+        if line.startswith("```"):
+            fence = line[3:].strip() if fence is None else None
+        elif fence == "":
+            commands += line.split("#")[0].split("&&")
+    outputs = []
+    for command in commands:
+        words = shlex.split(command)
+        if words[:1] != ["softarm"] or len(words) < 2:
+            continue
+        folder = words[1] in ("sweep", "reproduce")  # their outputs are folders
+        for flag, value in itertools.pairwise(words):
+            if flag in ("-o", "--output", "--plot", "--out"):
+                outputs.append(value.rstrip("/") + ("/x" if folder else ""))
+        if words[1] == "demo" and "--out" not in words:
+            outputs += ["demo.png", "demo.csv"]
+    return [path for path in outputs if not Path(path).is_absolute()]
+
+
+def test_the_readme_commands_leave_no_untracked_files():
+    """Run in the clone, the README's commands write only what .gitignore ignores (or tracked
+    files such as docs/): no demo.png, result.csv, ... among the untracked files."""
+    if not (ROOT / ".git").exists():
+        pytest.skip("not a git checkout: .gitignore is not used")
+    outputs = _readme_outputs()
+    assert {"demo.png", "demo.csv", "result.csv", "validation/x"} <= set(outputs)
+    tracked = set(subprocess.run(["git", "ls-files"], cwd=ROOT, capture_output=True,
+                                 text=True, check=True).stdout.split())
+    outputs = [path for path in outputs
+               if not any(name == path or name.startswith(path.removesuffix("x"))
+                          for name in tracked)]
+    check = subprocess.run(["git", "check-ignore", "--no-index", *outputs], cwd=ROOT,
+                           capture_output=True, text=True)
+    assert sorted(check.stdout.split()) == sorted(outputs), check.stderr
 
 
 def test_every_public_name_exists():
