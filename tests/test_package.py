@@ -45,17 +45,21 @@ def test_version_matches_the_dynamic_version_source():
 
 def test_plain_pytest_says_why_a_test_was_skipped(tmp_path):
     """The project's pytest configuration reports the reason of every skip (``-rs``): a plain
-    ``pytest`` must not print "4 skipped" and leave the reader to guess."""
+    ``pytest`` must not print "4 skipped" and leave the reader to guess; failures stay listed
+    in the short summary too (pytest's default ``-rfE``)."""
     (tmp_path / "test_skip.py").write_text(
         "import pytest\n\n\ndef test_needs_a_browser():\n"
-        "    pytest.skip('chromium-driver is not installed')\n", encoding="utf-8")
+        "    pytest.skip('chromium-driver is not installed')\n\n\n"
+        "def test_fails():\n    assert 1 == 2\n", encoding="utf-8")
     child = subprocess.run(
         [sys.executable, "-m", "pytest", "-c", str(ROOT / "pyproject.toml"), "--rootdir",
          str(tmp_path), "-p", "no:cacheprovider", str(tmp_path / "test_skip.py")],
         capture_output=True, text=True, timeout=300, cwd=tmp_path)
-    assert child.returncode == 0, child.stdout + child.stderr
+    assert child.returncode == 1, child.stdout + child.stderr
+    summary = child.stdout.split("short test summary info")[1]
     assert re.search(r"SKIPPED \[1\] .*test_skip\.py:\d+: chromium-driver is not installed",
-                     child.stdout), child.stdout
+                     summary), child.stdout
+    assert re.search(r"FAILED .*test_skip\.py::test_fails", summary), child.stdout
 
 
 def _readme_outputs() -> list[str]:
