@@ -102,6 +102,61 @@ def test_round_trip_with_sweep_case(tmp_path, suffix):
         assert document["softarm_version"] == softarm.__version__
 
 
+@pytest.mark.parametrize("suffix", [".csv", ".json", ".npz"])
+def test_the_stability_verdict_round_trips_and_is_drawn(tmp_path, suffix):
+    """A straight cantilever compressed by 5 N with EI = 1 N m², L = 1 m: past the first Euler
+    load π²EI/4L² = 2.47 N and below the second, 9π²EI/4L² = 22.2 N, in both bending planes
+    (EIy = EIz), so the straight state has two unstable directions (Morse index 2). Read back
+    from any format, the result carries that verdict and its picture says so, as the picture
+    of the solve itself does."""
+    arm = softarm.Arm.from_stiffness(1.0, 1e6, 1e6, 1e6, 1.0, 1.0, 1.0)
+    with pytest.warns(softarm.StabilityWarning):
+        result = softarm.solve(arm, [softarm.TipLoad(force=[-5.0, 0.0, 0.0])], s=11)
+    assert (result.stability.index, result.stability.conservative) == (2, True)
+    saved = io.load_saved(io.save_result(result, tmp_path / f"r{suffix}"))
+    verdict = saved.result.stability
+    assert (verdict.index, verdict.conservative, verdict.stable) == (2, True, False)
+    from softarm import plot
+
+    def footer(fig):
+        return next(t.get_text() for t in fig.texts if t.get_text().startswith("tip at"))
+
+    drawn = footer(plot.plot_result_file(saved))
+    assert "; UNSTABLE (Morse index 2" in drawn
+    assert drawn == footer(plot.plot_equilibrium(result))
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".json", ".npz"])
+def test_a_batch_verdict_round_trips(tmp_path, suffix):
+    result = arc(np.array([[0.5, 1.0, 1.5], [2.0, 2.5, 3.0]]))._with_stability(
+        softarm.Stability.of([[0, 1, 2], [-1, 0, 3]],
+                             [[True, False, True], [True, True, False]]))
+    back = io.load_result(io.save_result(result, tmp_path / f"b{suffix}"))
+    np.testing.assert_array_equal(back.stability.index, [[0, 1, 2], [-1, 0, 3]])
+    np.testing.assert_array_equal(back.stability.stable, [[True, False, False],
+                                                          [False, True, False]])
+
+
+def test_a_file_without_verdict_reads_back_without_one(tmp_path):
+    """Files of softarm 0.2 carry no verdict: read back, the result has none (not a made-up
+    one); a verdict that is not integers and booleans of the batch shape is refused."""
+    path = io.save_result(arc(2.0)._with_stability(softarm.Stability.of(0, True, ())),
+                          tmp_path / "r.csv")
+    lines = path.read_text().splitlines()
+    meta = json.loads(lines[3].removeprefix("# meta: "))
+    for value, ok in ((None, True), ({"index": [0], "conservative": True}, False),
+                      ({"index": True, "conservative": True}, False),
+                      ({"index": 0, "conservative": 1}, False)):
+        meta["stability"] = value
+        lines[3] = "# meta: " + json.dumps(meta)
+        path.write_text("\n".join(lines) + "\n")
+        if ok:
+            assert io.load_result(path).stability is None
+        else:
+            with pytest.raises(CaseError, match="'stability'"):
+                io.load_result(path)
+
+
 def test_save_rejects_unknown_format(tmp_path):
     with pytest.raises(ValueError, match=r"unknown output format '\.txt'"):
         io.save_result(arc(), tmp_path / "r.txt")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import importlib.metadata
+import itertools
 import re
 import subprocess
 import sys
@@ -40,6 +41,68 @@ def test_version_matches_the_dynamic_version_source():
     assert found == [softarm.__version__]
     assert re.fullmatch(r"\d+\.\d+\.\d+([.-]?(a|b|rc|dev|post)\d*)*", softarm.__version__)
     assert importlib.metadata.version("softarm") == softarm.__version__
+
+
+def test_plain_pytest_says_why_a_test_was_skipped(tmp_path):
+    """The project's pytest configuration reports the reason of every skip (``-rs``): a plain
+    ``pytest`` must not print "4 skipped" and leave the reader to guess; failures stay listed
+    in the short summary too (pytest's default ``-rfE``)."""
+    (tmp_path / "test_skip.py").write_text(
+        "import pytest\n\n\ndef test_needs_a_browser():\n"
+        "    pytest.skip('chromium-driver is not installed')\n\n\n"
+        "def test_fails():\n    assert 1 == 2\n", encoding="utf-8")
+    child = subprocess.run(
+        [sys.executable, "-m", "pytest", "-c", str(ROOT / "pyproject.toml"), "--rootdir",
+         str(tmp_path), "-p", "no:cacheprovider", str(tmp_path / "test_skip.py")],
+        capture_output=True, text=True, timeout=300, cwd=tmp_path)
+    assert child.returncode == 1, child.stdout + child.stderr
+    summary = child.stdout.split("short test summary info")[1]
+    assert re.search(r"SKIPPED \[1\] .*test_skip\.py:\d+: chromium-driver is not installed",
+                     summary), child.stdout
+    assert re.search(r"FAILED .*test_skip\.py::test_fails", summary), child.stdout
+
+
+def _readme_outputs() -> list[str]:
+    """The files and folders that the README's ``softarm`` commands (in its code blocks
+    without a language: the shell ones) write, relative to the working directory:
+    -o/--output, --plot, --out, and demo's two; a folder as FOLDER/x."""
+    import shlex
+
+    commands, fence = [], None
+    for line in (ROOT / "README.md").read_text(encoding="utf-8").splitlines():
+        if line.startswith("```"):
+            fence = line[3:].strip() if fence is None else None
+        elif fence == "":
+            commands += line.split("#")[0].split("&&")
+    outputs = []
+    for command in commands:
+        words = shlex.split(command)
+        if words[:1] != ["softarm"] or len(words) < 2:
+            continue
+        folder = words[1] in ("sweep", "reproduce")  # their outputs are folders
+        for flag, value in itertools.pairwise(words):
+            if flag in ("-o", "--output", "--plot", "--out"):
+                outputs.append(value.rstrip("/") + ("/x" if folder else ""))
+        if words[1] == "demo" and "--out" not in words:
+            outputs += ["demo.png", "demo.csv"]
+    return [path for path in outputs if not Path(path).is_absolute()]
+
+
+def test_the_readme_commands_leave_no_untracked_files():
+    """Run in the clone, the README's commands write only what .gitignore ignores (or tracked
+    files such as docs/): no demo.png, result.csv, ... among the untracked files."""
+    if not (ROOT / ".git").exists():
+        pytest.skip("not a git checkout: .gitignore is not used")
+    outputs = _readme_outputs()
+    assert {"demo.png", "demo.csv", "result.csv", "validation/x"} <= set(outputs)
+    tracked = set(subprocess.run(["git", "ls-files"], cwd=ROOT, capture_output=True,
+                                 text=True, check=True).stdout.split())
+    outputs = [path for path in outputs
+               if not any(name == path or name.startswith(path.removesuffix("x"))
+                          for name in tracked)]
+    check = subprocess.run(["git", "check-ignore", "--no-index", *outputs], cwd=ROOT,
+                           capture_output=True, text=True)
+    assert sorted(check.stdout.split()) == sorted(outputs), check.stderr
 
 
 def test_every_public_name_exists():

@@ -10,6 +10,9 @@ import csv
 import io
 import json
 import math
+import re
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -171,13 +174,72 @@ def test_command_exit_status(tmp_path):
 
 
 def test_softarm_reproduce_subcommand(tmp_path, capsys):
+    """The summary and the files written go to stdout, the progress to stderr (docs/cli.md:
+    results and summaries on stdout)."""
     from softarm.cli import main as softarm_main
 
     code = softarm_main(["reproduce", "--out", str(tmp_path), "--case", "axial_force",
                          "--no-figures"])
     assert code == 0
-    assert "8 checks: 8 pass" in capsys.readouterr().err
+    out, err = capsys.readouterr()
+    assert out.splitlines() == [
+        out.splitlines()[0], f"  wrote {tmp_path / 'validation.md'}",
+        f"  wrote {tmp_path / 'tables' / 'checks.csv'}"]
+    assert re.fullmatch(r"reproduce: 8 checks: 8 pass, 0 fail, 0 finding, 0 skipped in "
+                        r"\d+\.\d s", out.splitlines()[0])
+    assert "reproduce [" in err and "checks:" not in err and "wrote" not in err
     assert softarm_main(["reproduce", "--case", "no_such_case"]) == 2
+
+
+# matplotlib blocked as if it were not installed (a plain `pip install .`)
+_WITHOUT_MATPLOTLIB = """\
+import sys
+sys.modules["matplotlib"] = None
+from softarm.cli import main
+sys.exit(main(sys.argv[1:]))
+"""
+
+
+@pytest.mark.parametrize("failing", [False, True])
+def test_reproduce_without_matplotlib_writes_the_report_without_figures(tmp_path, failing):
+    """No traceback: the report and tables, one line saying how to get the figures, and the
+    exit status of the checks alone (0, or 1 with a failed check)."""
+    argv = ["reproduce", "--out", str(tmp_path / "out"), "--case", "fig2_pure_bending"]
+    if failing:  # a failing check as well: the exit status is still the checks'
+        data = _write_tables(tmp_path / "bad", {"shear_deformable_tip_force": {
+            **_SHEAR_CASE["shear_deformable_tip_force"],
+            "computed_here": [{**_SHEAR_CASE["shear_deformable_tip_force"]["computed_here"][0],
+                               "tip_rotation_rad": 0.5}]}})
+        argv += ["--case", "shear_deformable_tip_force", "--data", str(data)]
+    child = subprocess.run([sys.executable, "-c", _WITHOUT_MATPLOTLIB, *argv],
+                           capture_output=True, text=True, timeout=600, cwd=tmp_path)
+    assert child.returncode == (1 if failing else 0), child.stderr
+    assert "Traceback" not in child.stderr and "Error" not in child.stderr, child.stderr
+    notes = [line for line in child.stderr.splitlines() if "matplotlib" in line]
+    assert notes == ["reproduce: the report has no figures: matplotlib is not installed "
+                     "(pip install \"softarm[plot]\" draws them)"], child.stderr
+    report = (tmp_path / "out" / "validation.md").read_text(encoding="utf-8")
+    assert "## Paper Fig. 2" in report and "![" not in report
+    assert (tmp_path / "out" / "tables" / "checks.csv").is_file()
+    assert not (tmp_path / "out" / "figures").exists()
+    assert "wrote" in child.stdout and "png" not in child.stdout
+
+
+def test_plot_without_matplotlib_is_one_line(tmp_path):
+    case = tmp_path / "moment.toml"
+    case.write_text('[arm]\nlength = 1.0\nstiffness = { EA = 1e6, GAy = 1e6, GAz = 1e6, '
+                    'GJ = 1.0, EIy = 1.0, EIz = 1.0 }\n[[load]]\nkind = "tip"\n'
+                    'moment = [0.0, 3.0, 0.0]\n', encoding="utf-8")
+    result = tmp_path / "moment.csv"
+    child = subprocess.run([sys.executable, "-c", _WITHOUT_MATPLOTLIB, "solve", str(case), "-o",
+                            str(result)], capture_output=True, text=True, timeout=600)
+    assert child.returncode == 0, child.stderr
+    child = subprocess.run([sys.executable, "-c", _WITHOUT_MATPLOTLIB, "plot", str(result)],
+                           capture_output=True, text=True, timeout=600)
+    assert child.returncode == 2
+    assert child.stderr == (f"softarm: error: {tmp_path / 'moment.png'}: softarm.plot needs "
+                            "matplotlib: pip install 'softarm[plot]'\n")
+    assert not (tmp_path / "moment.png").exists()
 
 
 def test_unknown_case_is_rejected():

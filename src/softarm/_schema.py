@@ -31,7 +31,7 @@ from numbers import Integral, Real
 import numpy as np
 
 from ._sweep_table import COMPONENTS, Sweep
-from ._validate import as_array
+from ._validate import as_array, format_value
 from .errors import CaseError, CaseTypeError
 from .loads import Key, as_loads
 from .model import (
@@ -266,7 +266,7 @@ class Table:
 
     def __init__(self, data, path: str, where: str, *, batched: bool = False):
         if not isinstance(data, dict):
-            raise CaseError(f"{where}: {path or 'file'}: must be a table, got {data!r}")
+            raise CaseError(f"{where}: {path or 'file'}: must be a table, got {format_value(data)}")
         self.data = data
         self.path = path
         self.where = where
@@ -344,7 +344,8 @@ class Table:
             raw = self.raw(key.name)
             if not (isinstance(raw, list) and len(raw) == 2 and not _has_bool(raw)
                     and all(isinstance(v, Real) for v in raw)):
-                raise self.error(key.name, f"must be [s0, s1], two numbers in m, got {raw!r}")
+                raise self.error(key.name, "must be [s0, s1], two numbers in m, got "
+                                 f"{format_value(raw)}")
             return tuple(float(v) for v in raw)
         raise AssertionError(f"no reader for keys of kind {kind!r}")  # pragma: no cover
 
@@ -392,9 +393,9 @@ class Table:
             return default
         value = self.raw(key)
         if isinstance(value, bool) or not isinstance(value, Real):
-            raise self.type_error(key, f"must be a number in {unit}, got {value!r}")
+            raise self.type_error(key, f"must be a number in {unit}, got {format_value(value)}")
         if finite and not math.isfinite(value):
-            raise self.error(key, f"must be finite, got {value!r}")
+            raise self.error(key, f"must be finite, got {format_value(value)}")
         return float(value)
 
     def integer(self, key: str, *, default=None, minimum: int | None = 0) -> int:
@@ -405,9 +406,9 @@ class Table:
             return default
         value = self.raw(key)
         if isinstance(value, bool) or not isinstance(value, Integral):
-            raise self.type_error(key, f"must be an integer, got {value!r}")
+            raise self.type_error(key, f"must be an integer, got {format_value(value)}")
         if minimum is not None and value < minimum:
-            raise self.error(key, f"must be >= {minimum}, got {value!r}")
+            raise self.error(key, f"must be >= {minimum}, got {format_value(value)}")
         return int(value)
 
     def string(self, key: str, choices=None, *, default=None) -> str:
@@ -418,21 +419,21 @@ class Table:
             return default
         value = self.raw(key)
         if not isinstance(value, str):
-            raise self.type_error(key, f"must be a string, got {value!r}")
+            raise self.type_error(key, f"must be a string, got {format_value(value)}")
         if choices is not None and value not in choices:
-            raise self.error(key, f"unknown value {value!r}; expected one of "
+            raise self.error(key, f"unknown value {format_value(value)}; expected one of "
                              f"{_quoted(choices)}{suggest(value, choices)}")
         return value
 
     def boolean(self, key: str, *, default: bool) -> bool:
         value = self.raw(key, default)
         if not isinstance(value, bool):
-            raise self.type_error(key, f"must be true or false, got {value!r}")
+            raise self.type_error(key, f"must be true or false, got {format_value(value)}")
         return value
 
     def vector(self, key: str, unit: str, *, default=(0.0, 0.0, 0.0)) -> np.ndarray:
         value = self.raw(key, default)
-        what = f"must be a list of 3 finite numbers in {unit}, got {value!r}"
+        what = f"must be a list of 3 finite numbers in {unit}, got {format_value(value)}"
         try:
             array = as_array(value, key)  # strict: no strings, bools or complex numbers
         except TypeError as error:
@@ -447,7 +448,7 @@ class Table:
         """Finite numbers of trailing shape ``shape`` (batch axes only in result files)."""
         value = self.raw(key)
         what = (f"must be {'a number' if not shape else f'a {shape[0]} × {shape[1]} list'} "
-                f"of finite numbers in {unit}, got {value!r}")
+                f"of finite numbers in {unit}, got {format_value(value)}")
         try:
             array = as_array(value, key)
         except TypeError:
@@ -466,7 +467,8 @@ class Table:
                 or not all(isinstance(v, Real) and math.isfinite(v) for v in raw)):
             wrong_type = isinstance(raw, list) and raw and not all(
                 isinstance(v, Real) and not isinstance(v, bool) for v in raw)
-            raise self.error(key, f"must be a non-empty list of finite numbers, got {raw!r}",
+            raise self.error(key, "must be a non-empty list of finite numbers, got "
+                             f"{format_value(raw)}",
                              CaseTypeError if wrong_type else CaseError)
         return tuple(float(v) for v in raw)
 
@@ -478,7 +480,8 @@ class Table:
         if isinstance(value, dict):
             value = [value]
         if not isinstance(value, list):
-            raise self.error(key, f"must be an array of tables ([[{key}]]), got {value!r}")
+            raise self.error(key, f"must be an array of tables ([[{key}]]), got "
+                             f"{format_value(value)}")
         return [Table(item, f"{self.key(key)}[{i + 1}]", self.where, batched=self.batched)
                 for i, item in enumerate(value)]
 

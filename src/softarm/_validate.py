@@ -26,8 +26,10 @@ __all__ = [
     "check_allocation",
     "count",
     "format_bytes",
+    "format_value",
     "length",
     "memory_limit",
+    "nonnegative",
     "positive",
     "real",
     "rigid_transform",
@@ -49,12 +51,59 @@ ROTATION_TOLERANCE = 1e-5
 _OK = object()
 
 
-def _short(value, limit: int = 80) -> str:
-    """repr of ``value`` cut to ``limit`` characters (error messages stay one short line)."""
-    if isinstance(value, np.ndarray) and value.size > 8:
-        return f"array of shape {value.shape} and dtype {value.dtype}"
-    text = " ".join(repr(value).split())
+def format_value(value, limit: int = 80) -> str:
+    """``value`` as an error message shows it, on one line of at most ``limit`` characters.
+
+    A number is shown as the plain Python number with the shortest repr that reads back to
+    the same float: ``0.10000000001`` (never rounded to ``0.1``, which would hide why it is
+    out of range) and ``-0.5`` (never ``np.float64(-0.5)``, numpy 2's repr). Lists, tuples and
+    small arrays are shown element by element the same way; a large array by its shape and
+    dtype; anything else by its repr. Every number put into a message goes through here.
+
+    Examples
+    --------
+    >>> format_value(np.float64(0.10000000001)), format_value([np.float32(0.5), np.int64(2)])
+    ('0.10000000001', '[0.5, 2]')
+    >>> format_value((np.float64(0.1), None)), format_value(np.zeros(9))
+    ('(0.1, None)', 'array of shape (9,) and dtype float64')
+    """
+    text = " ".join(_plain_text(value, limit, 0).split())
     return text if len(text) <= limit else text[: limit - 1] + "…"
+
+
+def _plain_text(value, limit: int, depth: int) -> str:
+    """:func:`format_value` before the cut; lists, tuples and dicts show at most ``limit``
+    items (each takes at least a character) and 16 levels (no deep recursion on a hostile
+    input)."""
+    if isinstance(value, (bool, np.bool_)):
+        return repr(bool(value))
+    if isinstance(value, str):  # np.str_ too: 'text', never np.str_('text')
+        return repr(str(value))
+    if isinstance(value, (Integral, np.integer)):
+        return repr(int(value))
+    if isinstance(value, (Real, np.floating)):
+        return repr(float(value))
+    if isinstance(value, np.ndarray):
+        if value.size > 8:
+            return f"array of shape {value.shape} and dtype {value.dtype}"
+        return _plain_text(value.tolist(), limit, depth)  # a scalar for shape ()
+    if isinstance(value, dict):
+        if depth >= 16:
+            return "{…}"
+        items = [f"{_plain_text(k, limit, depth + 1)}: {_plain_text(v, limit, depth + 1)}"
+                 for k, v in list(value.items())[:limit]]
+        return "{" + ", ".join(items + ["…"] * (len(value) > limit)) + "}"
+    if isinstance(value, (list, tuple)):
+        if depth >= 16:
+            return "[…]" if isinstance(value, list) else "(…)"
+        items = [_plain_text(v, limit, depth + 1) for v in value[:limit]]
+        if len(value) > limit:
+            items.append("…")
+        inner = ", ".join(items)
+        if isinstance(value, list):
+            return f"[{inner}]"
+        return f"({inner},)" if len(value) == 1 else f"({inner})"
+    return repr(value)
 
 
 def _first_non_real(value):
@@ -117,16 +166,16 @@ def as_array(value, name: str) -> np.ndarray:
     """
     bad = _first_non_real(value)
     if bad is not _OK:
-        where = "" if bad is value else f" in {_short(value)}"
+        where = "" if bad is value else f" in {format_value(value)}"
         raise TypeError(f"{name} must be numeric (real numbers), got {_kind(bad)} "
-                        f"({_short(bad, 40)}){where}")
+                        f"({format_value(bad, 40)}){where}")
     try:
         array = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError) as error:  # e.g. ragged nested lists
         raise ValueError(f"{name} must be a (nested) list or array of numbers of one shape, "
-                         f"got {_short(value)}") from error
+                         f"got {format_value(value)}") from error
     if not np.all(np.isfinite(array)):
-        raise ValueError(f"{name} must be finite, got {_short(value)}")
+        raise ValueError(f"{name} must be finite, got {format_value(value)}")
     return array
 
 
@@ -169,24 +218,35 @@ def real(value, name: str, unit: str = "") -> float:
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, (Real, np.integer,
                                                                       np.floating)):
         raise TypeError(f"{name} must be a real number{in_unit}, got {_kind(value)} "
-                        f"({_short(value, 40)})")
+                        f"({format_value(value, 40)})")
     number = float(value)
     if not math.isfinite(number):
-        raise ValueError(f"{name} must be a finite number{in_unit}, got {value!r}")
+        raise ValueError(f"{name} must be a finite number{in_unit}, got {format_value(value)}")
     return number
 
 
 def positive(value, name: str, unit: str) -> float:
     """A positive finite real number, as float (numpy scalars of any width accepted)."""
+    return _not_below_zero(value, name, unit, zero=False)
+
+
+def nonnegative(value, name: str, unit: str) -> float:
+    """A finite real number >= 0, as float: a quantity for which 0 is a valid model (a
+    massless rod's mass per length)."""
+    return _not_below_zero(value, name, unit, zero=True) + 0.0  # -0.0 as 0.0
+
+
+def _not_below_zero(value, name: str, unit: str, *, zero: bool) -> float:
+    what = "a finite value >= 0" if zero else "a positive finite value"
     try:
         number = real(value, name, unit)
     except TypeError:
-        raise TypeError(f"{name} must be a positive number in {unit}, got {_kind(value)} "
-                        f"({_short(value, 40)})") from None
+        raise TypeError(f"{name} must be {'a number >= 0' if zero else 'a positive number'} "
+                        f"in {unit}, got {_kind(value)} ({format_value(value, 40)})") from None
     except ValueError:
         number = math.nan
-    if not number > 0:
-        raise ValueError(f"{name} must be a positive finite value in {unit}, got {value!r}")
+    if not (number >= 0 if zero else number > 0):
+        raise ValueError(f"{name} must be {what} in {unit}, got {format_value(value)}")
     return number
 
 
@@ -204,7 +264,7 @@ def length(value, name: str) -> float:
     low, high = LENGTH_RANGE
     if not low <= number <= high:
         raise ValueError(f"{name} must be a length in m between {low:g} and {high:g}, got "
-                         f"{value!r}")
+                         f"{format_value(value)}")
     return number
 
 
@@ -213,9 +273,10 @@ def count(value, name: str, minimum: int = 0) -> int:
     if type(value) is int and value >= minimum:  # the common case, first
         return value
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, (Integral, np.integer)):
-        raise TypeError(f"{name} must be an integer, got {_kind(value)} ({_short(value, 40)})")
+        raise TypeError(f"{name} must be an integer, got {_kind(value)} "
+                        f"({format_value(value, 40)})")
     if value < minimum:
-        raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}")
+        raise ValueError(f"{name} must be an integer >= {minimum}, got {format_value(value)}")
     return int(value)
 
 
@@ -293,7 +354,7 @@ def rigid_transform(value, name: str = "base") -> np.ndarray:
         raise ValueError(
             f"{name} must be a rigid transform [[R, p], [0, 0, 0, 1]] with R a proper rotation "
             f"(RᵀR = I to {ROTATION_TOLERANCE:g}, det R = +1, last row 0, 0, 0, 1), got "
-            f"{_short(H.tolist(), 200)}"
+            f"{format_value(H.tolist(), 200)}"
         )
     U, _, Vt = np.linalg.svd(R)
     out = np.eye(4)
@@ -325,8 +386,9 @@ def stations(s, length: float, name: str = "s", default: int = 101) -> np.ndarra
     tolerance = 8 * max(float(eps), float(np.finfo(np.float64).eps)) * length
     if array[0] < -tolerance or array[-1] > length + tolerance:
         raise ValueError(
-            f"{name} must lie in [0, L] = [0, {length!r}] m, got [{array[0]!r}, {array[-1]!r}]"
+            f"{name} must lie in [0, L] = [0, {format_value(length)}] m, got "
+            f"[{format_value(array[0])}, {format_value(array[-1])}]"
         )
     if np.any(np.diff(array) <= 0):
-        raise ValueError(f"{name} must be strictly increasing, got {_short(s)}")
+        raise ValueError(f"{name} must be strictly increasing, got {format_value(s)}")
     return np.clip(array, 0.0, length)

@@ -37,6 +37,7 @@ from urllib.parse import parse_qsl, urlsplit
 
 import numpy as np
 
+from ._validate import format_value
 from .case import Case, CaseError
 from .errors import ConvergenceError
 from .geometry import cube_limits
@@ -179,8 +180,9 @@ class LiveCase:
             if not math.isfinite(value):
                 raise BadRequest(f"{name} must be a finite number, got {text!r}")
             if not item.low <= value <= item.high:
-                raise BadRequest(f"{name} must be in [{item.low:g}, {item.high:g}] "
-                                 f"{item.unit}, got {value:g}".rstrip())
+                raise BadRequest(f"{name} must be in [{format_value(item.low)}, "
+                                 f"{format_value(item.high)}] {item.unit}, got "
+                                 f"{format_value(value)}".rstrip())
             if item.component is None and value not in (0.0, 1.0):
                 raise BadRequest(f"{name} must be 0 (off) or 1 (on), got {text!r}")
             new[name] = value

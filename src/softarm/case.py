@@ -37,7 +37,7 @@ from . import _schema, dispatch
 from ._keypath import resolve
 from ._schema import Table, arm_to_dict, loads_to_dict
 from ._sweep_table import DESIGNS, Design, Parameter, Sweep
-from ._validate import check_allocation, count
+from ._validate import check_allocation, count, format_value
 from .equilibrium import Equilibrium, Stability
 from .errors import CaseError, CaseTypeError
 from .loads import LOAD_KINDS
@@ -104,7 +104,7 @@ class SolveOptions:
         object.__setattr__(self, "tol", tol)
         if self.branch not in ("connected", "stable"):
             raise ValueError(f"SolveOptions.branch must be 'connected' or 'stable', got "
-                             f"{self.branch!r}")
+                             f"{format_value(self.branch)}")
 
 
 @dataclass(frozen=True)
@@ -133,13 +133,13 @@ class InverseTask:
         target = np.asarray(self.target, dtype=float)
         if target.shape != (3,) or not np.all(np.isfinite(target)):
             raise ValueError(f"InverseTask.target must be 3 finite numbers in m, got "
-                             f"{self.target!r}")
+                             f"{format_value(self.target)}")
         object.__setattr__(self, "target", tuple(float(v) for v in target))
         if not (isinstance(self.tol, float) and self.tol > 0):
-            raise ValueError(f"InverseTask.tol must be > 0, got {self.tol!r}")
+            raise ValueError(f"InverseTask.tol must be > 0, got {format_value(self.tol)}")
         if self.max_iterations < 1:
             raise ValueError(f"InverseTask.max_iterations must be >= 1, got "
-                             f"{self.max_iterations!r}")
+                             f"{format_value(self.max_iterations)}")
 
 
 @dataclass(frozen=True, eq=False)
@@ -357,8 +357,34 @@ def parse_case(data: dict, source: str | os.PathLike | None = None, *,
     return _parse(data, source, name=name, batched=False)
 
 
+#: Deepest nesting of tables and arrays a case accepts: a case file needs about six levels, a
+#: result file's case a few more (a batch array has one per batch axis, at most 64).
+MAX_DEPTH = 100
+
+
+def _check_depth(data, where: str) -> None:
+    """CaseError if ``data`` nests tables and arrays more than :data:`MAX_DEPTH` deep: a
+    hostile file must not end in a RecursionError further on (every reader of a case walks it
+    recursively). Walked with an explicit stack, not by recursion."""
+    stack = [(data, 1)]
+    while stack:
+        value, depth = stack.pop()
+        if depth > MAX_DEPTH:
+            raise _too_deep(where)
+        children = value.values() if isinstance(value, dict) else \
+            value if isinstance(value, (list, tuple)) else ()
+        stack.extend((child, depth + 1) for child in children
+                     if isinstance(child, (dict, list, tuple)))
+
+
+def _too_deep(where) -> CaseError:
+    return CaseError(f"{where}: tables and arrays nested more than {MAX_DEPTH} levels deep (a "
+                     "case file needs about six)")
+
+
 def _parse(data, source, *, name=None, batched=False) -> Case:
     where = str(source) if source is not None else "<case>"
+    _check_depth(data, where)
     top = Table(data, "", where, batched=batched)
     case_name = top.string("name", default=name or (Path(source).stem if source else "case"))
     description = top.string("description", default="")
@@ -427,6 +453,8 @@ def load_case(path: str | os.PathLike) -> Case:
         raise CaseError(f"{path}: not a UTF-8 text file") from None
     except tomllib.TOMLDecodeError as error:
         raise CaseError(f"{path}: not valid TOML: {error}") from None
+    except RecursionError:  # the TOML reader recurses per level: some hundred levels deep
+        raise _too_deep(path) from None
     return parse_case(data, path)
 
 

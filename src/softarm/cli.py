@@ -626,7 +626,10 @@ def _run_plot(args) -> int:
     saved = load_saved(source)
     from . import plot
 
-    plot.plot_result_file(saved, path=picture)
+    try:
+        plot.plot_result_file(saved, path=picture)
+    except ImportError as error:  # matplotlib missing
+        raise CaseError(f"{picture}: {error}") from None
     print(f"wrote {picture}")
     return 0
 

@@ -337,7 +337,7 @@ class InverseSolver:
         self.loads = as_loads(loads)
         self.tol = real(tol, "tol")
         if not self.tol > 0.0:
-            raise ValueError(f"tol must be > 0, got {tol!r}")
+            raise ValueError(f"tol must be > 0, got {self.tol!r}")
         self.max_iterations = count(max_iterations, "max_iterations", 1)
         self.length = float(arm.length)
         solver_tol = 0.1 * self.tol if solver_tol is None else solver_tol

@@ -12,6 +12,7 @@ import warnings
 
 import numpy as np
 
+from ._validate import format_value
 from .analytic.exact import closed_form
 from .equilibrium import Equilibrium
 from .errors import ConvergenceError, StabilityWarning
@@ -127,9 +128,9 @@ def solve(arm, loads, *, method="auto", s=None, tol=1e-8, base=None, jacobians=F
     _check_method(method)
     solver = Solver(arm, s=s, tol=tol, base=base, **options)
     if not isinstance(jacobians, (bool, np.bool_)):
-        raise TypeError(f"jacobians must be True or False, got {jacobians!r}")
+        raise TypeError(f"jacobians must be True or False, got {format_value(jacobians)}")
     if branch not in (None, "stable"):
-        raise ValueError(f"branch must be None or 'stable', got {branch!r}")
+        raise ValueError(f"branch must be None or 'stable', got {format_value(branch)}")
     if imperfection is not None and branch != "stable":
         raise ValueError("imperfection chooses a buckled branch: it needs branch='stable'")
     if branch == "stable":
@@ -212,7 +213,7 @@ def warn_verdict(verdict, stacklevel: int = 3) -> None:
 
 def _check_method(method) -> None:
     if method not in METHODS:
-        raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+        raise ValueError(f"method must be one of {METHODS}, got {format_value(method)}")
 
 
 def solve_prepared(solver: Solver, loads, method="auto") -> Equilibrium:

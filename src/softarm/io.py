@@ -24,7 +24,7 @@ from . import __version__
 from ._files import write_atomic
 from ._schema import arm_to_dict, loads_to_dict
 from .case import Case, CaseError, _parse
-from .equilibrium import Equilibrium
+from .equilibrium import Equilibrium, Stability
 from .lie import se3, so3
 
 __all__ = [
@@ -99,9 +99,19 @@ def _meta(result: Equilibrium, case: Case | None) -> dict:
         "stations": int(result.s.size),
         "sweep_column": sweep.column if sweep is not None else None,
         "sweep_label": sweep.label if sweep is not None else None,
+        "stability": _verdict(result.stability),
         "rotation": _ROTATION_NOTE,
         "case": _case_dict(result, case),
     }
+
+
+def _verdict(stability: Stability | None) -> dict | None:
+    """The stability verdict as plain JSON: the Morse index and the conservative flag, each a
+    number or a nested list of the batch shape (the verdict is derived from them)."""
+    if stability is None:
+        return None
+    return {"index": np.asarray(stability.index).tolist(),
+            "conservative": np.asarray(stability.conservative).tolist()}
 
 
 #: File suffixes that save_result writes and load_result reads.
@@ -111,11 +121,14 @@ FORMATS = (".csv", ".json", ".npz")
 def save_result(result: Equilibrium, path: str | os.PathLike, case: Case | None = None) -> Path:
     """Write an equilibrium to ``path``; the suffix chooses the format.
 
-    ``.csv``: ``#`` comment lines (softarm version, case name, method, residual, the rotation
-    convention and the case as one line of JSON), then a header line of :data:`COLUMNS` (a
-    first column for the swept parameter, or ``batch_index`` for another batch) and one row per
-    station (per step, step-major). ``.json`` and ``.npz``: the same columns as arrays of shape
-    (B..., N), the poses, residuals, the case as a dict and the softarm version.
+    ``.csv``: five ``#`` comment lines (softarm version and case name; method, residual and
+    stability verdict; the rotation convention; the metadata and the case as one line of JSON
+    each), then a header line of :data:`COLUMNS` (a first column for the swept parameter, or
+    ``batch_index`` for another batch) and one row per station (per step, step-major).
+    ``.json`` and ``.npz``: the same columns as arrays of shape (B..., N), the poses,
+    residuals, the case as a dict and the softarm version. Every format carries the stability
+    verdict (``stability``: the Morse index and the conservative flag per case, or null), so
+    a result read back is drawn with it.
 
     Parameters
     ----------
@@ -170,8 +183,10 @@ def save_result(result: Equilibrium, path: str | os.PathLike, case: Case | None 
 def _csv_text(result, table, meta, sweep, residual, estimate) -> str:
     buffer = _stdio.StringIO()
     buffer.write(f"# softarm {meta['softarm_version']} equilibrium: {meta['name']}\n")
+    verdict = "" if result.stability is None or result.batch_shape else \
+        f"; stability: {result.stability.describe()}"  # a batch's: in the '# meta:' line
     buffer.write(f"# method: {meta['method']}; exact: {str(meta['exact']).lower()}; residual "
-                 f"(N, N m): max {float(np.max(residual)):.3e}\n")
+                 f"(N, N m): max {float(np.max(residual)):.3e}{verdict}\n")
     buffer.write(f"# {meta['rotation']}\n")
     line = {k: v for k, v in meta.items() if k not in ("rotation", "case")}
     line.update(residual=residual.tolist(), error_estimate=estimate.tolist())
@@ -287,12 +302,15 @@ def load_saved(path: str | os.PathLike) -> SavedResult:
     stresses = _stack(columns, COLUMNS[17:23])
     if case is None:  # pragma: no cover - every file written by save_result embeds its case
         raise CaseError(f"{path}: the file carries no case (arm and loads)")
+    verdict = meta.get("stability")
     result = Equilibrium(
         s=s, poses=poses.reshape(*batch, s.size, 4, 4),
         strains=strains.reshape(*batch, s.size, 6), stresses=stresses.reshape(*batch, s.size, 6),
         arm=case.arm, loads=case.batched_loads, method=meta["method"], exact=meta["exact"],
         residual=residual.reshape(batch) if batch else float(residual),
-        error_estimate=estimate.reshape(batch) if batch else float(estimate))
+        error_estimate=estimate.reshape(batch) if batch else float(estimate),
+        stability=None if verdict is None else Stability.of(verdict["index"],
+                                                            verdict["conservative"], batch))
     sweep = None if sweep is None else np.asarray(sweep, dtype=float)
     return SavedResult(result, case, str(meta.get("softarm_version", "")), sweep,
                        meta.get("sweep_label"), path)
@@ -385,10 +403,27 @@ def _check_saved(path: Path, meta, columns, poses, residual, estimate, sweep) ->
                 or not np.all(np.isfinite(sweep)):
             raise fail(f"'sweep_values' must be {batch[:1]} finite numbers, got shape "
                        f"{sweep.shape}")
+    _check_verdict(meta.get("stability"), batch, fail)
     for key in ("softarm_version", "sweep_label", "sweep_column"):
         if meta.get(key) is not None and not isinstance(meta[key], str):
             raise fail(f"{key!r} must be a string, got {meta[key]!r}")
     return batch
+
+
+def _check_verdict(verdict, batch: tuple, fail) -> None:
+    """The ``stability`` entry: null (none computed, or a file of softarm 0.2) or the Morse
+    indices (integers >= -1) and conservative flags (booleans), each of the batch shape."""
+    if verdict is None:
+        return
+    if not (isinstance(verdict, dict) and set(verdict) == {"index", "conservative"}):
+        raise fail("'stability' must be null or an object with 'index' and 'conservative'")
+    for key, kind, valid in (("index", "integers >= -1",
+                              lambda v: isinstance(v, int) and not isinstance(v, bool)
+                              and v >= -1),
+                             ("conservative", "booleans", lambda v: isinstance(v, bool))):
+        values = np.asarray(verdict[key], dtype=object)
+        if values.shape != batch or not all(valid(v) for v in values.flat):
+            raise fail(f"'stability' {key!r} must be {kind} of shape {batch}")
 
 
 def _read_csv(path: Path):

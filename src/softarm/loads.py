@@ -21,7 +21,7 @@ from typing import ClassVar, Protocol
 
 import numpy as np
 
-from ._validate import as_array, as_matrices, as_vectors, real
+from ._validate import as_array, as_matrices, as_vectors, format_value, real
 from .routing import Routing
 
 __all__ = [
@@ -76,7 +76,8 @@ def _broadcast(obj, *names: str) -> tuple[int, ...]:
 def _check_follower(obj) -> None:
     if not isinstance(obj.follower, (bool, np.bool_)):
         raise TypeError(
-            f"{type(obj).__name__}.follower must be True or False, got {obj.follower!r}")
+            f"{type(obj).__name__}.follower must be True or False, got "
+            f"{format_value(obj.follower)}")
     object.__setattr__(obj, "follower", bool(obj.follower))
 
 
@@ -393,18 +394,19 @@ def _check_span(obj) -> None:
     name = type(obj).__name__
     if obj.span is not None and obj.segment is not None:
         raise ValueError(f"{name}: give span or segment, not both "
-                         f"(got span={obj.span!r}, segment={obj.segment!r})")
+                         f"(got span={format_value(obj.span)}, "
+                         f"segment={format_value(obj.segment)})")
     if obj.segment is not None:
         if isinstance(obj.segment, bool) or not isinstance(obj.segment, (int, np.integer)) \
                 or obj.segment < 0:
             raise ValueError(f"{name}.segment must be a segment index >= 0, got "
-                             f"{obj.segment!r}")
+                             f"{format_value(obj.segment)}")
         object.__setattr__(obj, "segment", int(obj.segment))
     if obj.span is not None:
         span = as_array(obj.span, f"{name}.span")
         if span.shape != (2,) or not 0.0 <= span[0] < span[1]:
             raise ValueError(f"{name}.span must be (s0, s1) in m with 0 <= s0 < s1, got "
-                             f"{obj.span!r}")
+                             f"{format_value(obj.span)}")
         object.__setattr__(obj, "span", (float(span[0]), float(span[1])))
 
 
@@ -541,7 +543,8 @@ class PointLoad(Load):
     def __post_init__(self):
         s = as_array(self.s, "PointLoad.s")
         if s.ndim != 0:
-            raise ValueError(f"PointLoad.s must be a single arc length in m, got {self.s!r}")
+            raise ValueError(f"PointLoad.s must be a single arc length in m, got "
+                             f"{format_value(self.s)}")
         object.__setattr__(self, "s", float(s))
         _vector(self, "force")
         _vector(self, "moment")
@@ -576,7 +579,7 @@ def _magnitude(obj, name: str, *, nonnegative: bool, unit: str) -> np.ndarray:
     array = as_array(getattr(obj, name), f"{type(obj).__name__}.{name}").copy()
     if nonnegative and np.any(array < 0.0):
         raise ValueError(f"{type(obj).__name__}.{name} must be >= 0 {unit} (a tendon cannot "
-                         f"push), got {np.min(array)!r}")
+                         f"push), got {format_value(np.min(array))}")
     array.setflags(write=False)
     object.__setattr__(obj, name, array)
     return array
@@ -585,7 +588,7 @@ def _magnitude(obj, name: str, *, nonnegative: bool, unit: str) -> np.ndarray:
 def _routing(obj) -> None:
     if not isinstance(obj.routing, Routing):
         raise TypeError(f"{type(obj).__name__}.routing must be a softarm.routing path "
-                        f"(Straight, Helix or Polynomial), got {obj.routing!r}")
+                        f"(Straight, Helix or Polynomial), got {format_value(obj.routing)}")
 
 
 def _magnitude_text(value: np.ndarray, unit: str, swept, name: str) -> str:
@@ -705,7 +708,8 @@ class Tendon(Load):
         if self.end is not None:
             end = real(self.end, "Tendon.end", "m")
             if not end > 0.0:
-                raise ValueError(f"Tendon.end must be an arc length > 0 m, got {self.end!r}")
+                raise ValueError(f"Tendon.end must be an arc length > 0 m, got "
+                                 f"{format_value(self.end)}")
             object.__setattr__(self, "end", end)
 
     @property
@@ -804,7 +808,7 @@ class Chamber(Load):
         _magnitude(self, "pressure", nonnegative=False, unit="Pa")
         area = real(self.area, "Chamber.area", "m²")
         if not area > 0.0:
-            raise ValueError(f"Chamber.area must be > 0 m², got {self.area!r}")
+            raise ValueError(f"Chamber.area must be > 0 m², got {format_value(self.area)}")
         object.__setattr__(self, "area", area)
         _routing(self)
         object.__setattr__(self, "start", real(self.start, "Chamber.start", "m"))
@@ -935,12 +939,13 @@ def as_loads(loads) -> tuple[Load, ...]:
     except TypeError:
         items = None
     if items is None:
-        raise TypeError(f"loads must be a softarm.Load or a list of them, got {loads!r}")
+        raise TypeError(f"loads must be a softarm.Load or a list of them, got "
+                        f"{format_value(loads)}")
     for item in items:
         if not isinstance(item, Load):
             raise TypeError(
                 f"loads must be softarm.Load instances (TipLoad, Gravity, DistributedForce, "
-                f"DistributedMoment, PointLoad, ...), got {item!r} of type "
+                f"DistributedMoment, PointLoad, ...), got {format_value(item)} of type "
                 f"{type(item).__name__}")
         _LOAD_TYPES.add(type(item))
     return items

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._validate import real
+from ._validate import format_value, real
 
 __all__ = ["Helix", "Polynomial", "Routing", "Straight"]
 
@@ -153,7 +153,7 @@ class Helix(Routing):
     def __post_init__(self):
         radius = real(self.radius, "Helix.radius")
         if not radius > 0.0:
-            raise ValueError(f"Helix.radius must be > 0 m, got {self.radius!r}")
+            raise ValueError(f"Helix.radius must be > 0 m, got {format_value(self.radius)}")
         object.__setattr__(self, "radius", radius)
         object.__setattr__(self, "turns_per_metre",
                            real(self.turns_per_metre, "Helix.turns_per_metre"))
@@ -193,11 +193,12 @@ class Polynomial(Routing):
                 coefficients = tuple(real(v, f"Polynomial.{name}") for v in values.ravel())
             except (TypeError, ValueError) as error:
                 raise type(error)(f"Polynomial.{name} must be a list of power-series "
-                                  f"coefficients in m/m^k, got {getattr(self, name)!r}"
+                                  f"coefficients in m/m^k, got "
+                                  f"{format_value(getattr(self, name))}"
                                   ) from None
             if values.ndim != 1 or not coefficients:
                 raise ValueError(f"Polynomial.{name} must be a non-empty list of "
-                                 f"coefficients, got {getattr(self, name)!r}")
+                                 f"coefficients, got {format_value(getattr(self, name))}")
             object.__setattr__(self, name, coefficients)
 
     @property

@@ -42,7 +42,9 @@ class _TipWrench:
         else:
             self.other = True
 
-    def distributed(self, **_):
+    def distributed(self, *, per_mass=False, moment=None, **_):
+        if per_mass and moment is None and self.arm.linear_density == 0.0:
+            return  # a force per unit mass (gravity) on a massless arm acts on nothing
         self.other = True
 
     def __getattr__(self, name):  # any other channel: no closed form here
@@ -71,9 +73,9 @@ def exact_closed_form(arm, loads, s=None):
 
     Several tip wrenches in the same frame are summed (through each load's
     :meth:`~softarm.Load.apply`, so a point load at s = L counts as one); any other load
-    (gravity, distributed, interior point loads), mixed dead/follower tip loads, a force
-    together with a moment, a follower
-    transverse force or a SegmentedArm give None.
+    (gravity on an arm with mass, distributed, interior point loads), mixed dead/follower
+    tip loads, a force together with a moment, a follower transverse force or a
+    SegmentedArm give None.
 
     Parameters
     ----------

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import as_vectors, length, positive
+from .._validate import as_vectors, format_value, length, nonnegative
 from .material import Material
 from .sections import Circle, Rectangle, Rigidities, Section, StiffnessMatrix, Tube
 
@@ -36,7 +36,8 @@ class Arm:
     curvature : array_like, shape (3,)
         κ⁰ = (twist, curvature about y, curvature about z) in 1/m, material frame.
     mass_per_length : float, optional
-        kg/m; overrides ρ A (e.g. for an arm with embedded parts).
+        kg/m, >= 0; overrides ρ A (e.g. for an arm with embedded parts). 0 is a massless rod:
+        gravity acts on nothing (a magnetic rod whose weight is negligible).
     magnetization : array_like, shape (3,), optional
         A hard magnetisation per unit length (A m²/m = A m), material components, fixed in
         the material (it turns with the section): acted on by a
@@ -67,23 +68,25 @@ class Arm:
         if not isinstance(self.section, _SECTION_KINDS):
             raise TypeError(
                 "Arm.section must be a Circle, Tube, Rectangle, Section or Rigidities, got "
-                f"{self.section!r}"
+                f"{format_value(self.section)}"
             )
         if isinstance(self.section, (Rigidities, StiffnessMatrix)):
             if self.material is not None:
                 raise ValueError(
                     "Arm.material must be None when the section is given by its Rigidities "
-                    f"(use Arm.from_stiffness), got {self.material!r}"
+                    f"(use Arm.from_stiffness), got {format_value(self.material)}"
                 )
         elif not isinstance(self.material, Material):
-            raise TypeError(f"Arm.material must be a softarm.Material, got {self.material!r}")
+            raise TypeError(f"Arm.material must be a softarm.Material, got "
+                            f"{format_value(self.material)}")
         curvature = as_vectors(self.curvature, "Arm.curvature", 3)
         if curvature.shape != (3,):
             raise ValueError(f"Arm.curvature must have shape (3,), got shape {curvature.shape}")
         object.__setattr__(self, "curvature", tuple(float(c) for c in curvature))
         if self.mass_per_length is not None:
             object.__setattr__(self, "mass_per_length",
-                               positive(self.mass_per_length, "Arm.mass_per_length", "kg/m"))
+                               nonnegative(self.mass_per_length, "Arm.mass_per_length",
+                                           "kg/m"))
         for name in ("magnetization", "tip_magnet"):
             value = getattr(self, name)
             if value is not None:
@@ -200,7 +203,8 @@ class SegmentedArm:
             segments = ()
         if not segments or not all(isinstance(a, Arm) for a in segments):
             raise TypeError(
-                f"SegmentedArm.segments must be a non-empty sequence of Arm, got {self.segments!r}"
+                "SegmentedArm.segments must be a non-empty sequence of Arm, got "
+                f"{format_value(self.segments)}"
             )
         object.__setattr__(self, "segments", segments)
 

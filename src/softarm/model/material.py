@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from .._validate import positive, real
+from .._validate import format_value, nonnegative, positive, real
 
 __all__ = ["Material"]
 
@@ -26,7 +26,8 @@ class Material:
     shear_modulus : float, optional
         G in Pa; must give ν = E/2G - 1 in (-1, 0.5].
     density : float, optional
-        ρ in kg/m³, needed for gravity.
+        ρ in kg/m³, >= 0, needed for gravity (0: a massless rod, on which gravity acts on
+        nothing).
 
     Examples
     --------
@@ -46,7 +47,8 @@ class Material:
         if (self.poisson_ratio is None) == (self.shear_modulus is None):
             raise ValueError(
                 "Material needs exactly one of poisson_ratio and shear_modulus, got "
-                f"poisson_ratio={self.poisson_ratio!r}, shear_modulus={self.shear_modulus!r}"
+                f"poisson_ratio={format_value(self.poisson_ratio)}, "
+                f"shear_modulus={format_value(self.shear_modulus)}"
             )
         if self.shear_modulus is not None:
             object.__setattr__(self, "shear_modulus",
@@ -57,20 +59,21 @@ class Material:
                                    real(self.poisson_ratio, "Material.poisson_ratio"))
             except TypeError:
                 raise TypeError(f"Material.poisson_ratio must be a number, got "
-                                f"{self.poisson_ratio!r}") from None
+                                f"{format_value(self.poisson_ratio)}") from None
             except ValueError:  # not finite: reported by the range check below
                 pass
         nu = self.nu
         if not (math.isfinite(nu) and -1.0 < nu <= 0.5):
             what = (
-                f"poisson_ratio={self.poisson_ratio!r}"
+                f"poisson_ratio={format_value(self.poisson_ratio)}"
                 if self.poisson_ratio is not None
-                else f"shear_modulus={self.shear_modulus!r} (ν = E/2G - 1 = {nu!r})"
+                else f"shear_modulus={format_value(self.shear_modulus)} (ν = E/2G - 1 = "
+                f"{format_value(nu)})"
             )
             raise ValueError(f"Material.poisson_ratio must lie in (-1, 0.5], got {what}")
         if self.density is not None:
             object.__setattr__(self, "density",
-                               positive(self.density, "Material.density", "kg/m³"))
+                               nonnegative(self.density, "Material.density", "kg/m³"))
 
     @property
     def E(self) -> float:

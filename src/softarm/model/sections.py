@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import length, positive
+from .._validate import format_value, length, positive
 from .material import Material
 
 __all__ = ["Circle", "Rectangle", "Rigidities", "Section", "StiffnessMatrix", "Tube"]
@@ -72,7 +72,7 @@ class StiffnessMatrix:
             K = np.array(self.matrix, dtype=np.float64)
         except (TypeError, ValueError):
             raise TypeError(f"the stiffness matrix K must be a 6 × 6 array of numbers, got "
-                            f"{self.matrix!r}") from None
+                            f"{format_value(self.matrix)}") from None
         if K.shape != (6, 6) or not np.all(np.isfinite(K)):
             raise ValueError(f"the stiffness matrix K must be a finite 6 × 6 array, got shape "
                              f"{K.shape}")
@@ -136,7 +136,7 @@ class Section:
     def rigidities(self, material: Material) -> Rigidities:
         """Stiffnesses of this section made of ``material`` (eqs. 11-12)."""
         if not isinstance(material, Material):
-            raise TypeError(f"material must be a softarm.Material, got {material!r}")
+            raise TypeError(f"material must be a softarm.Material, got {format_value(material)}")
         p = self.properties(material.nu)
         E, G = material.E, material.G
         return Rigidities(

@@ -82,7 +82,7 @@ def _normal_positive(values, what: str) -> None:
     bad = ~(np.isfinite(values) & (values >= np.finfo(np.float64).tiny))
     if np.any(bad):
         raise ValueError(f"{what} must be finite, positive and representable (normal floats), "
-                         f"got {values[bad][0]!r}")
+                         f"got {float(values[bad][0])!r}")
 
 
 class _ArmData:
