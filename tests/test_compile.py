@@ -35,10 +35,11 @@ _NOT_PASSIVE = ("_law", "_dipole", "_actuator_rates", "_ldl_substitute", "_impli
                 "inverse_newton", "box_least_squares", "shoot", "sweep_point")
 
 
-def _python(code: str, *args: str, cache: Path, notice: bool = True):
-    """``python -c code args`` with its own numba cache and the compile notice on or off."""
+def _python(code: str, *args: str, cache: Path, notice: bool = True, prefetch: bool = False):
+    """``python -c code args`` with its own numba cache, the compile notice on or off, and
+    the verdict's compile on another core (statics/_prefetch.py) or in the process."""
     return subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True,
-                          timeout=900, env=_env(cache, notice))
+                          timeout=900, env=_env(cache, notice, prefetch))
 
 
 def _softarm(*args: str, cache: Path, notice: bool = True):
@@ -46,9 +47,10 @@ def _softarm(*args: str, cache: Path, notice: bool = True):
                           text=True, timeout=900, env=_env(cache, notice))
 
 
-def _env(cache: Path, notice: bool) -> dict:
+def _env(cache: Path, notice: bool, prefetch: bool = False) -> dict:
     return dict(os.environ, NUMBA_CACHE_DIR=str(cache),
-                SOFTARM_COMPILE_NOTICE="1" if notice else "0")
+                SOFTARM_COMPILE_NOTICE="1" if notice else "0",
+                SOFTARM_PREFETCH="1" if prefetch else "0")
 
 
 @pytest.fixture(scope="module")
@@ -122,3 +124,22 @@ def test_softarm_compile_pays_the_first_solve_ahead(tmp_path):
     again = _softarm("compile", cache=cache, notice=False)
     assert again.returncode == 0
     assert again.stdout.splitlines()[-1] == "every kernel was already compiled (numba's cache)"
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(len(os.sched_getaffinity(0)) < 2,
+                    reason="the verdict compiles beside the solver only with 2 usable cores")
+def test_a_cold_first_solve_compiles_its_verdict_on_another_core(tmp_path):
+    run = _python(_PASSIVE_SOLVE, "stability_cases", "solve_cases", cache=tmp_path,
+                  prefetch=True)
+    assert run.returncode == 0, run.stderr
+    # this process compiled the solver; the verdict it loaded from the cache, where the
+    # other process had put it
+    assert ast.literal_eval(run.stdout.splitlines()[0]) == {"stability_cases": 0,
+                                                            "solve_cases": 1}
+    notices = [line for line in run.stderr.splitlines() if line.startswith("softarm:")]
+    assert len(notices) == 1 and notices[0].startswith(
+        "softarm: compiling the solver for passive arms and its stability verdict beside it "
+        "on another core, once (about ")
+    record = json.loads(next(tmp_path.rglob("softarm-compile-seconds.json")).read_text())
+    assert set(record) == {"solve", "verdict"}

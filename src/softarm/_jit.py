@@ -30,7 +30,8 @@ from collections.abc import Callable
 from numba import njit
 from numba.core import event
 
-__all__ = ["COMPILED", "REFERENCE_SECONDS", "compile_seconds", "jit", "notices"]
+__all__ = ["COMPILED", "REFERENCE_SECONDS", "compile_seconds", "jit", "notices",
+           "on_cold_compile"]
 
 _WARNED = set()
 
@@ -62,6 +63,8 @@ _RECORD = "softarm-compile-seconds.json"
 
 #: compiled entry points: Python function -> capability(argument types) -> (key, text)
 _ENTRIES: dict[Callable, Callable] = {}
+#: entry points' Python function -> callbacks(argument types) at the start of a cold compile
+_ON_COLD: dict[Callable, list[Callable]] = {}
 _ANNOUNCED: set[str] = set()
 _STATE = threading.local()
 _LOCK = threading.Lock()
@@ -106,6 +109,13 @@ def jit(function=None, *, what: str = "softarm's compiled kernels", capability=N
     if capability is not None:
         _ENTRIES[function] = capability
     return dispatcher
+
+
+def on_cold_compile(dispatcher, callback: Callable) -> None:
+    """Call ``callback(argument types)`` when the entry point ``dispatcher`` starts a compile
+    that missed numba's cache (statics/_prefetch.py starts the verdict's compile then); what
+    it returns, if not None, is added to the notice."""
+    _ON_COLD.setdefault(dispatcher.py_func, []).append(callback)
 
 
 def compile_seconds(key: str, dispatcher=None) -> tuple[float, bool]:
@@ -187,6 +197,8 @@ class _Notice(event.Listener):
             return
         key, text = capability(ev.data["args"])
         stack.append((key, text, dispatcher, time.perf_counter()))
+        extra = [callback(ev.data["args"]) for callback in _ON_COLD.get(dispatcher.py_func, ())]
+        text += "".join(f" and {more}" for more in extra if more)
         with _LOCK:
             first = key not in _ANNOUNCED
             _ANNOUNCED.add(key)

@@ -43,7 +43,8 @@ from functools import partial
 import numpy as np
 from numba.core import types
 
-from .._jit import jit
+from .._jit import jit, on_cold_compile
+from . import _prefetch
 
 __all__ = ["MEMORY", "OPTIONS", "PIECE_LOADS", "TIP_LOADS", "shoot", "solve_cases"]
 
@@ -2044,6 +2045,11 @@ def _through_x(e, X, row):
         e[k] = row[k]
     for k in range(6, m):
         e[k] -= row[k]
+
+
+# A cold compile of the solver starts its verdict's compile on another core (_prefetch.py)
+on_cold_compile(solve_cases, lambda args: _prefetch.start(
+    "actuated" if _given(args[2]) else "passive", stability_cases))
 
 
 @_entry(_per_arm("shoot", "the shooting primitive (Solver.shoot)", 5))

@@ -22,6 +22,7 @@ from ..equilibrium import Equilibrium, Stability
 from ..errors import ConvergenceError
 from ..loads import as_loads, batch_shape
 from ..model import Arm, SegmentedArm
+from . import _prefetch
 from .displacement import solve_displaced
 from .stability import verdict
 
@@ -601,6 +602,7 @@ class PreparedSolve:
             if self._tips.shape[0]:
                 np.copyto(self._tips[0], self.poses[-1])
             self._Ns[0] = self.info[4]
+            _prefetch.wait(_prefetch.kind(self._arm))
             k.stability_cases(solver._base_kernel, *self._arm, (piece, tip), self._outs[7],
                               self._Ns, self._tips, 1, self._index, self._theta0, self._flags)
             self.index, self.conservative = int(self._index[0]), bool(self._flags[0])
@@ -1322,3 +1324,20 @@ def solve_numeric(arm, loads, *, s=None, tol=1e-8, base=None, jacobians=False,
     (every case independently); see :class:`Solver` for the options."""
     return Solver(arm, s=s, tol=tol, base=base, **options).solve_from_unloaded(
         loads, jacobians=jacobians)
+
+
+def compile_verdict(kind: str) -> None:
+    """Compile (or load) the stability verdict of a small arm of this kind, "passive" or
+    "actuated": the same kernel, with the same argument types, as every solve's verdict
+    (what ``_prefetch`` runs in another process beside a cold first solve)."""
+    from ..loads import Gravity, Tendon
+    from ..model import Circle, Material
+    from ..routing import Straight
+
+    arm = Arm(0.2, Circle(0.01), Material(youngs_modulus=1e6, poisson_ratio=0.49,
+                                          density=1000.0))
+    loads = [Gravity()] + ([Tendon(0.1, Straight(0.0, 0.005))] if kind == "actuated" else [])
+    solver = Solver(arm)
+    _, shape, count, _, channels = solver._prepare(loads)
+    verdict(channels, solver._base_kernel, np.zeros((count, 6)), np.full(count, 8.0), shape,
+            np.zeros((count, 4, 4)))

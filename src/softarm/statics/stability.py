@@ -13,6 +13,7 @@ import numpy as np
 from .._threads import in_threads
 from ..equilibrium import Stability
 from ..loads import TipLoad, as_loads
+from . import _prefetch
 
 __all__ = ["conservative", "verdict"]
 
@@ -65,6 +66,7 @@ def verdict(channels, base, xs, Ns, shape, tips=None, factor=1, threads=1) -> St
     xs = np.array(xs, dtype=np.float64)
     flags = np.empty(count, dtype=np.bool_)
     arm, Ns, factor = channels.arm_tuple(), np.array(Ns, dtype=np.float64), int(factor)
+    _prefetch.wait(_prefetch.kind(arm))  # a cold first solve's verdict compile, if launched
 
     def run(a, b):  # cases [a, b)
         k.stability_cases(base, *arm, (channels.piece[a:b], channels.tip_loads[a:b]), xs[a:b],

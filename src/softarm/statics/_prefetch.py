@@ -1,0 +1,94 @@
+"""A cold first solve compiles its stability verdict on another core, beside the solver.
+
+A first solve on a machine compiles two kernels (softarm._jit, statics/README.md): the
+solver (``solve_cases``) and then the stability verdict (``stability_cases``), one after the
+other in one process (numba compiles under one lock, mostly in Python). When the solver's
+compile starts cold (numba's event, the moment the cache misses), :func:`start` launches a
+Python process running ``softarm.statics.solver.compile_verdict(KIND)``: it compiles the
+verdict of the same kind of arm (passive, or actuated/magnetic) into numba's cache, on the
+second core.
+Before its first verdict, :func:`wait` waits for that process, and numba loads the verdict
+from the cache instead of compiling it (a cache miss, had the process failed, compiles it as
+before: nothing depends on the process but the time). On a 2-core machine the first solve's
+wall time drops by the verdict's compile (tests/test_compile.py, docs/performance.md).
+
+Not launched with one usable core, where numba cannot write its cache, with
+``SOFTARM_PREFETCH=0``, or inside such a process itself.
+"""
+
+from __future__ import annotations
+
+import atexit
+import os
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+__all__ = ["kind", "start", "wait"]
+
+#: The verdict compiles launched by this process: kind -> Popen
+_RUNNING: dict[str, subprocess.Popen] = {}
+_LOCK = threading.Lock()
+#: The longest wait for a launched compile (it takes a few seconds to half a minute)
+_PATIENCE = 300.0
+
+
+def _usable_cores() -> int:
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
+
+
+def start(kind: str, dispatcher) -> str | None:
+    """Launch the verdict's compile for ``kind`` ("passive" or "actuated") in another
+    process, unless one ran already or it cannot help (see the module docstring); says so
+    (for the compile notice), or None. ``dispatcher``: a kernel whose cache folder is the one
+    to fill (where numba can cache)."""
+    if (os.environ.get("SOFTARM_PREFETCH", "1") == "0" or _usable_cores() < 2
+            or getattr(getattr(dispatcher, "_cache", None), "cache_path", None) is None):
+        return None
+    with _LOCK:
+        if kind in _RUNNING:
+            return None
+        package = Path(__file__).resolve().parents[2]  # the folder holding softarm/
+        path = os.pathsep.join(filter(None, [str(package), os.environ.get("PYTHONPATH")]))
+        env = dict(os.environ, PYTHONPATH=path, SOFTARM_PREFETCH="0",
+                   SOFTARM_COMPILE_NOTICE="0", SOFTARM_NUM_THREADS="1")
+        try:
+            _RUNNING[kind] = subprocess.Popen(
+                [sys.executable, "-c", "import sys; from softarm.statics.solver import "
+                 "compile_verdict; compile_verdict(sys.argv[1])", kind],
+                env=env, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                stderr=subprocess.DEVNULL)
+        except OSError:  # no process can be started here: compile as before
+            _RUNNING[kind] = None
+            return None
+    return "its stability verdict beside it on another core"
+
+
+def kind(arm) -> str:
+    """"passive" or "actuated": the kind of the kernel's (arm, act) pair."""
+    return "passive" if arm[1] is None else "actuated"
+
+
+def wait(kind: str) -> None:
+    """Wait for the verdict compile of ``kind`` launched by :func:`start`, if any (a verdict
+    call costs this one dictionary lookup when none was launched)."""
+    process = _RUNNING.get(kind)
+    if process is None:
+        return
+    deadline = time.monotonic() + _PATIENCE
+    while process.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.02)
+
+
+@atexit.register
+def _stop() -> None:
+    """A process that ends before its launched compiles do takes them with it (numba writes
+    its cache atomically: an interrupted compile leaves nothing behind)."""
+    for process in _RUNNING.values():
+        if process is not None and process.poll() is None:
+            process.kill()
