@@ -446,6 +446,9 @@ class _Handler(BaseHTTPRequestHandler):
                 self._json(200, [i.__dict__ | {"step": i.step} for i in self.live.inputs])
             elif url.path in ("/solve", "/reset"):
                 query = _query(url.query)
+                # one solve at a time (they share the Solver and its last equilibrium); the
+                # reply is encoded and sent after the lock is let go
+                failure = None
                 with self.lock:
                     old = self.live.values
                     self.live.update(query)
@@ -455,10 +458,11 @@ class _Handler(BaseHTTPRequestHandler):
                         body = self.live.solve()
                     except (ConvergenceError, ValueError) as error:
                         self.live.values = old
-                        self._json(422, {"error": _one_line(f"cannot solve for these "
-                                                            f"inputs: {error}")})
-                        return
-                self._send(200, to_json(body).encode("utf-8"), "application/json")
+                        failure = f"cannot solve for these inputs: {error}"
+                if failure is not None:
+                    self._json(422, {"error": _one_line(failure)})
+                else:
+                    self._send(200, to_json(body).encode("utf-8"), "application/json")
             else:
                 self._json(404, {"error": f"no such page: {url.path}"})
         except BadRequest as error:
@@ -486,13 +490,32 @@ def _one_line(text: str, limit: int = 400) -> str:
     return text if len(text) <= limit else text[: limit - 1] + "…"
 
 
+class _Server(ThreadingHTTPServer):
+    """The app's server: a thread per connection (a solve waits for the app's lock, see
+    _Handler; the page's script, plotly.js and /inputs do not), a listen queue long enough
+    for a burst of connections, and a client that goes away (a reset or closed connection,
+    at any point of its request) is no error of the app's.
+
+    The standard library's listen backlog is 5: a burst of 200 requests overflowed it, and
+    the kernel dropped the connections beyond it, which the clients saw as waits of seconds
+    (their connection attempts repeated after 1, 3, 7, ... s), resets or no answer at all."""
+
+    request_queue_size = 1024  # the kernel caps it at net.core.somaxconn
+    daemon_threads = True
+
+    def handle_error(self, request, client_address):
+        if isinstance(sys.exc_info()[1], ConnectionError):  # reset, broken pipe, aborted
+            return
+        super().handle_error(request, client_address)  # pragma: no cover - a bug of ours
+
+
 def make_server(live: LiveCase, port: int = 8050) -> ThreadingHTTPServer:
     """An HTTP server on 127.0.0.1:``port`` (0: any free port) serving ``live``; CaseError if
     the port is taken or not allowed."""
     handler = type("Handler", (_Handler,), {"live": live, "lock": threading.Lock(),
                                             "plotly_js": plotly_js_path().read_bytes()})
     try:
-        server = ThreadingHTTPServer(("127.0.0.1", port), handler)
+        server = _Server(("127.0.0.1", port), handler)
     except OSError as error:
         if error.errno == errno.EADDRINUSE:
             raise CaseError(f"port {port} on 127.0.0.1 is already in use (another softarm app "
@@ -503,7 +526,6 @@ def make_server(live: LiveCase, port: int = 8050) -> ThreadingHTTPServer:
             raise CaseError(f"port {port}: not allowed ({error.strerror}); use a port above "
                             "1023, e.g. --port 8050") from None
         raise
-    server.daemon_threads = True
     return server
 
 
