@@ -82,7 +82,7 @@ def test_figure_draws_the_equilibrium(demo):
     assert triangles.max() == vertices.shape[0] * 16 - 1
     surface = vertices
     # the tip frame: 0.15 L along each column of R(L)
-    (e1,) = traces(fig, "tip frame e1 e2 e3")
+    (e1,) = traces(fig, "e1")
     tip = np.stack([decode(e1[a]) for a in "xyz"], -1)
     np.testing.assert_allclose(tip[1] - tip[0], 0.15 * 0.4 * result.tip[:3, 0], atol=1e-6)
     # equal axis scaling: a cube holding every point drawn
@@ -108,6 +108,42 @@ def test_load_arrows_in_the_figure(demo):
     force = np.array([0.0, 0.15, -0.4])  # demo.toml, the tip load (dead: spatial)
     np.testing.assert_allclose(direction, force / np.linalg.norm(force), atol=1e-12)
     assert "0.15" in forces["text"][-2] and "N" in forces["text"][-2]
+
+
+def rgb(color: str) -> np.ndarray:
+    """"rgb(r,g,b)" as a vector."""
+    match = re.fullmatch(r"rgb\((\d+),\s*(\d+),\s*(\d+)\)", color)
+    assert match, color
+    return np.array([float(v) for v in match.groups()])
+
+
+@pytest.mark.parametrize("name", ["demo", "tendon_robot", "pneumatic_actuator"])
+def test_legend_entries_have_colours_of_their_own(name):
+    # The centreline was drawn in the red of the tip frame's e1, and the tip frame had one
+    # legend entry drawn in e1's red: now e1, e2 and e3 are entries of their own, and no two
+    # kinds of things in the legend are closer in colour than 60 (of 255, RGB distance).
+    # Actuators of one kind (three tendons) share their colour.
+    case = softarm.load_case(EXAMPLES / f"{name}.toml")
+    fig = json.loads(view.to_json(view.figure(softarm.case.solve_case(case), name=name)))
+    actuators = {load.describe(): load.kind for load in case.loads
+                 if load.kind in ("tendon", "chamber")}
+    colours: dict[str, np.ndarray] = {}
+    for trace in fig["data"]:
+        if not trace.get("showlegend", trace["type"] == "scatter3d"):
+            continue
+        kind = actuators.get(trace["name"], trace["name"])
+        colour = rgb(trace["color"] if trace["type"] == "mesh3d" else trace["line"]["color"])
+        assert np.array_equal(colours.setdefault(kind, colour), colour), kind
+    kinds = sorted(colours)
+    for i, a in enumerate(kinds):
+        for b in kinds[i + 1:]:
+            assert np.linalg.norm(colours[a] - colours[b]) > 60, (a, b)
+    assert {"arm", "centreline", "e1", "e2", "e3", "forces"} <= set(colours)
+    assert set(actuators.values()) <= set(colours)
+    # the tip frame's three entries, one group: a click on one hides or shows the frame
+    frame = [trace for trace in fig["data"] if trace.get("legendgroup") == "tip frame"]
+    assert [trace["name"] for trace in frame] == ["e1", "e2", "e3"]
+    assert frame[0]["legendgrouptitle"]["text"] == "tip frame"
 
 
 def test_sweep_figure_has_frames_slider_and_tip_plot(sweep):

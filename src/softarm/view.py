@@ -13,10 +13,11 @@ browsers that may draw WebGL in software; the notes at ``_SIDES``, ``_cube_ancho
 
 Drawn: the arm as a tube of its real radius (its centreline when the sections are not known),
 the arm and its centreline with hover read-outs (s, position, strains and stresses in the
-material frame), the tip's material frame (e1 red, e2 green, e3 blue), arrows for the loads (forces
-solid, moments dashed; each load's arrows are scaled to its own largest value, the hover
-gives the value) and the clamped base. A sweep gets a slider over its parameter, a play
-button and a plot of the tip coordinates against the parameter.
+material frame), the tip's material frame (e1 red, e2 green, e3 blue: no other legend entry
+shares their colours), arrows for the loads (forces solid, moments dashed; each load's arrows
+are scaled to its own largest value, the hover gives the value) and the clamped base. A sweep
+gets a slider over its parameter, a play button and a plot of the tip coordinates against
+the parameter.
 """
 
 from __future__ import annotations
@@ -46,11 +47,16 @@ __all__ = ["NOTEBOOK_PLOTLYJS", "PLOTLY_MISSING", "figure", "notebook_html", "pl
 #: The message when plotly is not installed.
 PLOTLY_MISSING = "the browser views need plotly: pip install 'softarm[view]'"
 
+# Every entry of the legend has a colour of its own (tests/test_view.py measures how far
+# apart they are): e1 e2 e3 are red, green and blue, so the centreline is dark brown, the
+# tendons black, the forces mid grey and the chambers cyan.
 _TUBE = "rgb(255,127,14)"
-_LINE = "rgb(214,39,40)"
+_LINE = "rgb(110,55,0)"
 _AXES = ("rgb(220,40,40)", "rgb(40,160,40)", "rgb(40,80,220)")
-_FORCE = "rgb(60,60,60)"
+_FORCE = "rgb(100,100,100)"
 _MOMENT = "rgb(148,103,189)"
+_TENDON = "rgb(30,30,30)"
+_CHAMBER = "rgb(23,190,207)"
 # The tube's mesh: software WebGL (headless or GPU-less browsers) spends its time per vertex,
 # so the tube has at most about _RINGS rings of _SIDES vertices whatever the number of
 # stations (1616 vertices at 101 stations before; the look is the same, see tube_rings).
@@ -169,17 +175,16 @@ def _scene_traces(result, arrows, scales, rings) -> list[dict]:
         tendon = path.kind == "tendon"
         traces.append({"type": "scatter3d", "mode": "lines", "x": path.points[:, 0],
                        "y": path.points[:, 1], "z": path.points[:, 2],
-                       "line": {"color": "rgb(30,30,30)" if tendon else "rgb(40,110,200)",
+                       "line": {"color": _TENDON if tendon else _CHAMBER,
                                 "width": 3 if tendon else 8},
                        "name": path.label, "hovertemplate": f"{path.label}<extra></extra>"})
     frame = tip_frame(poses, 0.15 * length)
-    for k, axis in enumerate(("e1", "e2", "e3")):
+    for k, axis in enumerate(("e1", "e2", "e3")):  # one legend entry each, in its colour
         traces.append({"type": "scatter3d", "mode": "lines", "x": frame[k, :, 0],
                        "y": frame[k, :, 1], "z": frame[k, :, 2],
-                       "line": {"color": _AXES[k], "width": 6},
-                       "name": "tip frame e1 e2 e3" if k == 0 else f"tip {axis}",
-                       "legendgroup": "tip frame", "showlegend": k == 0,
-                       "hovertemplate": f"tip frame {axis}<extra></extra>"})
+                       "line": {"color": _AXES[k], "width": 6}, "name": axis,
+                       "legendgroup": "tip frame", "legendgrouptitle": {"text": "tip frame"},
+                       "showlegend": True, "hovertemplate": f"tip frame {axis}<extra></extra>"})
     traces += _arrow_traces(arrows, scales, length)
     traces.append({"type": "scatter3d", "mode": "markers", "x": p[:1, 0], "y": p[:1, 1],
                    "z": p[:1, 2],
