@@ -292,6 +292,19 @@ def test_axis_cube_holds_the_arm_and_only_grows():
     np.testing.assert_allclose(live.solve()["ranges"], hanging)
 
 
+def test_the_page_figure_fills_the_page_and_its_ticks_follow_the_cube():
+    # the app's figure was 700 px high, whatever the window: now it has no height of its own
+    # (it is as high as its element, the page); each reply carries the tick values for the
+    # axis cube as it grows (none near a corner of the box, see softarm.view.axis_ticks)
+    live = app.LiveCase(softarm.load_case(EXAMPLES / "mattiasson_cantilever.toml"))
+    assert "height" not in live.figure()["layout"]
+    for force in ("0", "-10"):
+        live.update({"l1.force.z": force})
+        reply = live.solve()
+        assert reply["ticks"] == [softarm.view.axis_ticks(*bounds)
+                                  for bounds in reply["ranges"]]
+
+
 def test_without_plotly_one_line(monkeypatch, capsys):
     def missing():
         raise ImportError(softarm.view.PLOTLY_MISSING)

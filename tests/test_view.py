@@ -174,6 +174,73 @@ def test_sweep_figure_has_frames_slider_and_tip_plot(sweep):
         np.testing.assert_allclose(decode(line["x"])[-1], np.sin(tau[k]) / tau[k], atol=1e-6)
 
 
+def test_a_page_fills_the_window_and_a_notebook_output_has_a_height(demo, sweep, tmp_path):
+    # A 650 px figure left a third of a 1200 x 900 window blank below it: a page's figure
+    # (softarm view, Equilibrium.show) now has no height of its own and its <div> is as high
+    # as the window; a notebook output keeps a fixed height (a notebook has no window height).
+    _, result = demo
+    page = view.write_html(result, tmp_path / "demo.html").read_text(encoding="utf-8")
+    assert re.search(r'<div id="softarm-view" class="plotly-graph-div" '
+                     r'style="height:100vh; min-height:\d+px; width:100%;">', page)
+    assert '"height":' not in page.split("var id =")[1].split("function draw")[0]
+    case, swept = sweep
+    path = view.view_result_file(io_saved(swept, case, tmp_path), tmp_path / "sweep.html")
+    page = path.read_text(encoding="utf-8")
+    # the sweep's 3D figure and its tip plot in a container as high as the window, the tip
+    # plot placed in percentages of it
+    assert re.search(r'<div style="position:relative; height:100vh; min-height:\d+px; '
+                     r'width:100%;"><div id="softarm-view" class="plotly-graph-div" '
+                     r'style="height:100%; width:100%;">', page)
+    assert re.search(r'id="softarm-view-tips" class="plotly-graph-div" style="position:'
+                     r'absolute; top:calc\([^;]*%[^;]*\); bottom:calc\([^;]*%[^;]*\);', page)
+    notebook = view.notebook_html(result)
+    assert re.search(r'class="plotly-graph-div" style="height:650px; width:100%;"', notebook)
+
+
+def io_saved(result, case, folder):
+    """``result`` written and read back by softarm.io, as `softarm view` gets it."""
+    softarm.io.save_result(result, folder / "saved.npz", case)
+    return softarm.io.load_saved(folder / "saved.npz")
+
+
+@pytest.mark.parametrize(("low", "high"), [(-0.1, 0.52), (-0.31, 0.31), (0.0, 1.0),
+                                           (-1e-3, 2e-3), (5.0, 5.4), (-0.2222, 0.4444),
+                                           (-100.0, 300.0), (0.123, 0.124)])
+def test_axis_ticks_keep_away_from_the_corners(low, high):
+    # plotly.js's own ticks run to the ends of an axis, where three axes' labels meet at a
+    # corner of the box and overlapped: at least three ticks of a 1, 2 or 5 x 10^k step,
+    # none within 10 % of the axis's length from either end
+    ticks = np.array(view.axis_ticks(low, high))
+    span = high - low
+    assert len(ticks) >= 3
+    assert np.all(ticks >= low + 0.1 * span - 1e-12 * span)
+    assert np.all(ticks <= high - 0.1 * span + 1e-12 * span)
+    steps = np.diff(ticks)
+    np.testing.assert_allclose(steps, steps[0], rtol=1e-9)
+    mantissa = steps[0] / 10.0 ** np.floor(np.log10(steps[0]))
+    assert min(abs(mantissa - m) for m in (1.0, 2.0, 5.0)) < 1e-9
+    np.testing.assert_allclose(ticks / steps[0], np.round(ticks / steps[0]), atol=1e-9)
+
+
+def test_figure_ticks_and_the_sweep_controls_stay_off_the_scene(demo, sweep):
+    _, result = demo
+    scene = view.figure(result)["layout"]["scene"]
+    for axis in "xyz":
+        low, high = scene[f"{axis}axis"]["range"]
+        assert scene[f"{axis}axis"]["tickvals"] == view.axis_ticks(low, high)
+    case, swept = sweep
+    layout = view.figure(swept, sweep=case.sweep)["layout"]
+    bottom = layout["scene"]["domain"]["y"][0]
+    # the play and pause buttons overlapped the 3D scene: the buttons and the slider hang
+    # below the plotting area now (their top at its bottom edge, y = 0, or lower), the
+    # buttons to the left of the slider's rail
+    for control in (layout["updatemenus"][0], layout["sliders"][0]):
+        assert control["yanchor"] == "top" and control["y"] <= bottom
+    buttons, slider = layout["updatemenus"][0], layout["sliders"][0]
+    assert buttons["xanchor"] == "left" and buttons["x"] == slider["x"] == 0.0
+    assert slider["pad"]["l"] >= buttons["pad"]["l"] + 70  # two buttons of about 35 px
+
+
 def test_page_is_self_contained(demo, tmp_path):
     _, result = demo
     path = view.write_html(result, tmp_path / "demo.html")

@@ -9,11 +9,11 @@ solver to the unloaded arm.
 
 Endpoints: ``GET /`` the page; ``GET /plotly.min.js``; ``GET /solve?NAME=VALUE&...`` the
 equilibrium for these inputs (names as listed by ``GET /inputs``; absent ones keep their last
-value) as JSON ``{"data": [...traces], "ranges", "title", "tip": [x, y, z], "solve_ms",
-"method", "residual", "stability"}`` (``data``: only what changes of each 3D trace of the
-page's figure, in its order, see :func:`softarm.view.scene_traces`; ``stability``: the
-verdict in words); ``GET /reset`` the same after returning
-to the unloaded arm. A bad request (an
+value) as JSON ``{"data": [...traces], "ranges", "ticks", "title", "tip": [x, y, z],
+"solve_ms", "method", "residual", "stability"}`` (``data``: only what changes of each 3D
+trace of the page's figure, in its order, see :func:`softarm.view.scene_traces`; ``ticks``:
+each axis's tick values, see :func:`softarm.view.axis_ticks`; ``stability``: the verdict in
+words); ``GET /reset`` the same after returning to the unloaded arm. A bad request (an
 unknown name, a value that is not a finite number or is out of its slider's range) gets
 HTTP 400 with ``{"error": message}``; a load the solver cannot follow (a fold, a load too large
 for the arm) gets HTTP 422 with the message, and the arm stays where it was.
@@ -41,7 +41,7 @@ from .case import Case, CaseError
 from .errors import ConvergenceError
 from .geometry import cube_limits
 from .statics import Solver
-from .view import figure, plotly_js_path, scene_traces, to_json
+from .view import axis_ticks, figure, plotly_js_path, scene_traces, to_json
 
 __all__ = ["Input", "LiveCase", "inputs", "make_server", "serve"]
 
@@ -212,7 +212,8 @@ class LiveCase:
         self.result = result
         self._grow_limits(result)
         centre, half = self.limits
-        return {"ranges": [[centre[k] - half, centre[k] + half] for k in range(3)],
+        ranges = [[centre[k] - half, centre[k] + half] for k in range(3)]
+        return {"ranges": ranges, "ticks": [axis_ticks(*bounds) for bounds in ranges],
                 "data": scene_traces(result, self.scales, changing=True),
                 "title": _title(self.case, loads),
                 "tip": np.asarray(result.tip_position).tolist(),
@@ -244,9 +245,9 @@ class LiveCase:
     def figure(self) -> dict:
         """The page's first figure: the current equilibrium (solved once, from unloaded)."""
         body = self.solve()
-        fig = figure(self.result, name=self.case.name, scales=self.scales, limits=self.limits)
+        fig = figure(self.result, name=self.case.name, scales=self.scales, limits=self.limits,
+                     height=None)  # as high as the page (#plot)
         fig["layout"]["title"]["text"] = body["title"]
-        fig["layout"]["height"] = 700
         return fig
 
 
@@ -367,6 +368,7 @@ async function send(path) {{
     }}
     ["xaxis", "yaxis", "zaxis"].forEach((axis, k) => {{
       layout.scene[axis].range = body.ranges[k];
+      layout.scene[axis].tickvals = body.ticks[k];  // see softarm.view.axis_ticks
       cube["xyz"[k]] = body.ranges[k]; }});
     layout.datarevision = (layout.datarevision || 0) + 1;
     await Plotly.react("plot", FIGURE.data, layout, CONFIG);
