@@ -199,6 +199,30 @@ def test_a_client_that_resets_its_connection_is_no_error():
     assert err.strip() == "softarm: interrupted"
 
 
+def test_static_files_are_served_while_a_solve_runs():
+    # a solve holds the app's lock (its one Solver): plotly.js, the inputs and unknown pages
+    # are answered meanwhile, and another solve waits for the lock
+    live = app.LiveCase(softarm.load_case(EXAMPLES / "mattiasson_cantilever.toml"))
+    httpd = app.make_server(live, port=0)
+    threading.Thread(target=httpd.serve_forever, kwargs={"poll_interval": 0.05},
+                     daemon=True).start()
+    url = f"http://127.0.0.1:{httpd.server_address[1]}"
+    done = threading.Event()
+    try:
+        with httpd.RequestHandlerClass.lock:
+            solving = threading.Thread(target=lambda: (get(f"{url}/solve?l1.force.z=-1"),
+                                                       done.set()), daemon=True)
+            solving.start()
+            assert get(f"{url}/plotly.min.js")[0] == 200
+            assert get(f"{url}/inputs")[0] == 200
+            assert get(f"{url}/nothing")[0] == 404
+            assert not done.is_set()
+        assert done.wait(timeout=60)
+    finally:
+        httpd.shutdown()
+        httpd.server_close()
+
+
 def test_a_burst_of_200_requests_is_all_answered():
     """200 clients connect at once, before the server takes any of them (a burst that
     arrives faster than it accepts): every connection is queued (the listen backlog was 5:
