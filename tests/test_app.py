@@ -1,15 +1,19 @@
 """The live app over HTTP (no browser): answers against a published elastica, bad requests,
-a taken port and Ctrl-C."""
+a taken port, Ctrl-C, clients that reset their connection and a burst of 200 requests."""
 
 from __future__ import annotations
 
+import http.client
 import json
 import os
+import select
 import signal
 import socket
+import struct
 import subprocess
 import sys
 import threading
+import time
 import urllib.error
 import urllib.request
 from pathlib import Path
@@ -129,25 +133,170 @@ def test_port_taken(capsys):
     assert code == 2 and err.count("\n") == 1 and "already in use" in err
 
 
-@pytest.mark.skipif(sys.platform == "win32", reason="SIGINT to a child process")
-def test_ctrl_c_stops_the_app_cleanly():
+def start_app():
+    """`softarm app` on the Mattiasson case, on a free port, as a child process; (the child,
+    its address)."""
     launcher = Path(sys.executable).with_name("softarm")
     command = [str(launcher)] if launcher.exists() else [sys.executable, "-m", "softarm"]
     child = subprocess.Popen([*command, "app", str(EXAMPLES / "mattiasson_cantilever.toml"),
                               "--port", "0", "--no-browser"], stdout=subprocess.PIPE,
                              stderr=subprocess.PIPE, text=True)
+    lines = [child.stdout.readline() for _ in range(2)]
+    assert "at http://127.0.0.1:" in lines[1], lines
+    return child, lines[1].split(" at ")[1].split()[0]
+
+
+def stop_app(child) -> str:
+    """Ctrl-C to the app; its stderr (the app must exit with 130)."""
     try:
-        lines = [child.stdout.readline() for _ in range(2)]
-        assert "at http://127.0.0.1:" in lines[1], lines
-        address = lines[1].split(" at ")[1].split()[0]
-        assert get(address)[0] == 200
         child.send_signal(signal.SIGINT)
         _, err = child.communicate(timeout=30)
     finally:
         if child.poll() is None:
             os.kill(child.pid, signal.SIGKILL)
     assert child.returncode == 130
+    return err
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="SIGINT to a child process")
+def test_ctrl_c_stops_the_app_cleanly():
+    child, address = start_app()
+    assert get(address)[0] == 200
+    assert stop_app(child).strip() == "softarm: interrupted"
+
+
+def reset(sock: socket.socket) -> None:
+    """Close with SO_LINGER 0: the connection ends with a TCP reset, as a client that crashes
+    or is killed leaves it."""
+    sock.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, struct.pack("ii", 1, 0))
+    sock.close()
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="SIGINT to a child process")
+def test_a_client_that_resets_its_connection_is_no_error():
+    # It used to print a ConnectionResetError traceback on the app's stderr.
+    child, address = start_app()
+    host, port = "127.0.0.1", int(address.rstrip("/").rsplit(":", 1)[1])
+    try:
+        # reset in the middle of the request's headers (the server is reading them) ...
+        sock = socket.create_connection((host, port), timeout=30)
+        sock.sendall(b"GET /solve?l1.force.z=-1 HTTP/1.1\r\nHost: softarm\r\n")
+        time.sleep(0.3)
+        reset(sock)
+        # ... and after a whole request for plotly.js, 4.8 MB (the server is writing it)
+        sock = socket.create_connection((host, port), timeout=30)
+        sock.sendall(b"GET /plotly.min.js HTTP/1.1\r\nHost: softarm\r\n\r\n")
+        sock.recv(1000)
+        reset(sock)
+        time.sleep(0.3)
+        # the app serves on: the Mattiasson elastica at k = 5 (w/L = 0.71379, u/L = 0.38763)
+        status, body = get(f"{address}reset?l1.force.z=-5")
+        assert status == 200
+        np.testing.assert_allclose(json.loads(body)["tip"], [1 - 0.38763, 0.0, -0.71379],
+                                   atol=2e-5)
+    finally:
+        err = stop_app(child)
     assert err.strip() == "softarm: interrupted"
+
+
+def test_static_files_are_served_while_a_solve_runs():
+    # a solve holds the app's lock (its one Solver): plotly.js, the inputs and unknown pages
+    # are answered meanwhile, and another solve waits for the lock
+    live = app.LiveCase(softarm.load_case(EXAMPLES / "mattiasson_cantilever.toml"))
+    httpd = app.make_server(live, port=0)
+    threading.Thread(target=httpd.serve_forever, kwargs={"poll_interval": 0.05},
+                     daemon=True).start()
+    url = f"http://127.0.0.1:{httpd.server_address[1]}"
+    done = threading.Event()
+    try:
+        with httpd.RequestHandlerClass.lock:
+            solving = threading.Thread(target=lambda: (get(f"{url}/solve?l1.force.z=-1"),
+                                                       done.set()), daemon=True)
+            solving.start()
+            assert get(f"{url}/plotly.min.js")[0] == 200
+            assert get(f"{url}/inputs")[0] == 200
+            assert get(f"{url}/nothing")[0] == 404
+            assert not done.is_set()
+        assert done.wait(timeout=60)
+    finally:
+        httpd.shutdown()
+        httpd.server_close()
+
+
+def test_a_burst_of_200_requests_is_all_answered():
+    """200 clients connect at once, before the server takes any of them (a burst that
+    arrives faster than it accepts): every connection is queued (the listen backlog was 5:
+    six got in, the others waited for seconds, were reset or never answered), then each
+    sends its request and gets the right answer: 150 solves, serialised on the app's one
+    Solver, each the equilibrium of its own input, mixed with requests for plotly.js and the
+    inputs. The timeouts are generous: they fail only if a request hangs."""
+    live = app.LiveCase(softarm.load_case(EXAMPLES / "mattiasson_cantilever.toml"))
+    httpd = app.make_server(live, port=0)  # listening, not yet accepting
+    port = httpd.server_address[1]
+    socks, serving = [], None
+    try:
+        for _ in range(200):
+            sock = socket.socket()
+            sock.setblocking(False)
+            sock.connect_ex(("127.0.0.1", port))
+            socks.append(sock)
+        pending, deadline = set(socks), time.monotonic() + 30
+        while pending and time.monotonic() < deadline:
+            _, writable, _ = select.select([], list(pending), [], 0.1)
+            pending -= set(writable)
+        connected = [s for s in socks
+                     if s not in pending and s.getsockopt(socket.SOL_SOCKET, socket.SO_ERROR) == 0]
+        assert len(connected) == 200, f"{len(connected)} of 200 connections were queued"
+        serving = threading.Thread(target=httpd.serve_forever,
+                                   kwargs={"poll_interval": 0.05}, daemon=True)
+        serving.start()
+        forces = -0.5 * np.arange(1, 11)  # k = P L²/EI = 0.5 ... 5
+        others = "&".join(f"l1.{field}.{axis}=0" for field in ("force", "moment")
+                          for axis in "xyz" if (field, axis) != ("force", "z"))
+        plotly_js = softarm.view.plotly_js_path().read_bytes()
+        replies: list = [None] * 200
+
+        def ask(k):
+            sock = socks[k]
+            sock.setblocking(True)
+            sock.settimeout(120)
+            connection = http.client.HTTPConnection("127.0.0.1", port, timeout=120)
+            connection.sock = sock
+            path = ("/plotly.min.js" if k % 8 == 0 else "/inputs" if k % 8 == 1 else
+                    f"/solve?{others}&l1.force.z={forces[k % 10]}")
+            connection.request("GET", path)
+            answer = connection.getresponse()
+            replies[k] = (answer.status, answer.read())
+            connection.close()
+
+        askers = [threading.Thread(target=ask, args=(k,), daemon=True) for k in range(200)]
+        for asker in askers:
+            asker.start()
+        for asker in askers:
+            asker.join(timeout=180)
+    finally:
+        if serving is not None:
+            httpd.shutdown()
+        httpd.server_close()
+        for sock in socks:
+            sock.close()
+    assert all(reply is not None for reply in replies), \
+        f"{sum(reply is None for reply in replies)} of 200 requests got no answer"
+    assert all(status == 200 for status, _ in replies)
+    # each solve is the equilibrium of its own input: the same tip as a solve from unloaded
+    expected = {k: softarm.solve(live.case.arm, softarm.TipLoad(force=[0.0, 0.0, force]),
+                                 method="numeric").tip_position
+                for k, force in enumerate(forces)}
+    names = [item.name for item in live.inputs]
+    for k, (_, body) in enumerate(replies):
+        if k % 8 == 0:
+            assert body == plotly_js
+        elif k % 8 == 1:
+            assert [item["name"] for item in json.loads(body)] == names
+        else:
+            np.testing.assert_allclose(json.loads(body)["tip"], expected[k % 10],
+                                       atol=1e-6, err_msg=f"request {k}")
+
 
 
 def test_axis_cube_holds_the_arm_and_only_grows():
@@ -165,6 +314,19 @@ def test_axis_cube_holds_the_arm_and_only_grows():
     assert hanging[2, 0] <= live.result.tip_position[2]
     live.update({"l1.force.z": "0"})  # back: the view keeps its size, it does not jump
     np.testing.assert_allclose(live.solve()["ranges"], hanging)
+
+
+def test_the_page_figure_fills_the_page_and_its_ticks_follow_the_cube():
+    # the app's figure was 700 px high, whatever the window: now it has no height of its own
+    # (it is as high as its element, the page); each reply carries the tick values for the
+    # axis cube as it grows (none near a corner of the box, see softarm.view.axis_ticks)
+    live = app.LiveCase(softarm.load_case(EXAMPLES / "mattiasson_cantilever.toml"))
+    assert "height" not in live.figure()["layout"]
+    for force in ("0", "-10"):
+        live.update({"l1.force.z": force})
+        reply = live.solve()
+        assert reply["ticks"] == [softarm.view.axis_ticks(*bounds)
+                                  for bounds in reply["ranges"]]
 
 
 def test_without_plotly_one_line(monkeypatch, capsys):

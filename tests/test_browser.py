@@ -193,6 +193,67 @@ def test_app_slider_resolves_and_redraws(browser, live_server, tmp_path):
     assert len(errors) == 1 and "oops" in errors[0] and "400" in errors[0]  # the one we sent
 
 
+RECT = ("const r = e => { const b = e.getBoundingClientRect(); "
+        "return [b.left, b.top, b.right, b.bottom]; };")
+
+
+def overlap(a, b) -> bool:
+    """Whether two rectangles [left, top, right, bottom] share an area."""
+    return min(a[2], b[2]) > max(a[0], b[0]) and min(a[3], b[3]) > max(a[1], b[1])
+
+
+def test_pages_fill_the_window_and_the_controls_stay_off_the_scene(browser, live_server,
+                                                                  tmp_path):
+    # In a 1200 x 900 window the figures were 650 px (the viewer) and 700 px (the app) high,
+    # leaving the rest blank, and the sweep's play and pause buttons lay over the 3D scene.
+    browser.execute_cdp_cmd("Emulation.setDeviceMetricsOverride", {
+        "width": 1200, "height": 900, "deviceScaleFactor": 1, "mobile": False})
+    try:
+        case = softarm.load_case(EXAMPLES / "demo.toml")
+        page = view.write_html(softarm.solve(case.arm, case.loads), tmp_path / "demo.html")
+        browser.get(page.as_uri())
+        wait_for(browser, "const gd = document.getElementById('softarm-view');"
+                 "return gd && gd._fullLayout && gd.querySelector('canvas') !== null;")
+        drawn = browser.execute_script(
+            RECT + "const gd = document.getElementById('softarm-view');"
+            "return [r(gd), gd._fullLayout.height, r(gd._fullLayout.scene._scene.container)]")
+        assert drawn[0] == [0, 0, 1200, 900] and drawn[1] == 900
+        assert drawn[2][3] >= 900 - 20  # the scene reaches down to the bottom margin
+        # the sweep: 3D figure, tip plot, slider and buttons, none over the scene
+        sweep_case = softarm.load_case(EXAMPLES / "fig2_sweep.toml")
+        io.save_result(solve_case(sweep_case), tmp_path / "sweep.npz", sweep_case)
+        page = view.view_result_file(tmp_path / "sweep.npz", tmp_path / "sweep.html")
+        browser.get(page.as_uri())
+        wait_for(browser, "const gd = document.getElementById('softarm-view');"
+                 "return !!(gd && gd._fullLayout && gd.querySelector('.updatemenu-button') "
+                 "&& document.getElementById('softarm-view-tips')._fullLayout);")
+        parts = browser.execute_script(
+            RECT + "const gd = document.getElementById('softarm-view');"
+            "return {figure: r(gd), height: gd._fullLayout.height,"
+            " scene: r(gd._fullLayout.scene._scene.container),"
+            " buttons: Array.from(gd.querySelectorAll('.updatemenu-button')).map(r),"
+            " rail: r(gd.querySelector('.slider-rail-rect')),"
+            " tips: r(document.getElementById('softarm-view-tips'))};")
+        (tmp_path / "sweep.png").write_bytes(browser.get_screenshot_as_png())
+        assert parts["figure"] == [0, 0, 1200, 900] and parts["height"] == 900
+        assert len(parts["buttons"]) == 2
+        for part in [*parts["buttons"], parts["rail"], parts["tips"]]:
+            assert not overlap(part, parts["scene"]), (part, parts["scene"])
+        for button in parts["buttons"]:  # left of the rail, on its row
+            assert button[2] <= parts["rail"][0] and button[1] <= parts["rail"][1] <= button[3]
+        # the app: the figure as high as the window too
+        url, _ = live_server
+        browser.get(url)
+        wait_for(browser, "return window.softarmTimings && window.softarmTimings.length > 0")
+        plot = browser.execute_script(
+            RECT + "const gd = document.getElementById('plot');"
+            "return [r(gd), gd._fullLayout.height]")
+        assert plot[0][1] == 0 and plot[0][3] == 900 and plot[1] == 900
+        assert _browser.severe_console_messages(browser) == []
+    finally:
+        browser.execute_cdp_cmd("Emulation.clearDeviceMetricsOverride", {})
+
+
 def test_notebook_outputs_share_one_plotly_js(browser, tmp_path, monkeypatch):
     # Outputs as a notebook page holds them: only the first display of the kernel session
     # embeds plotly.js. A view above it on the page (drawn before the library arrives) waits

@@ -24,7 +24,7 @@ def solve(name: str):
 def test_the_examples_are_there():
     assert {"demo", "fig2_pure_bending", "fig2_sweep", "fig3_shear_load",
             "mattiasson_cantilever", "precurved", "tendon_robot", "pneumatic_actuator",
-            "magnetic_catheter"} <= set(CASES)
+            "magnetic_catheter", "greenhill_upright"} <= set(CASES)
     assert (EXAMPLES / "design_sweep.toml").is_file()  # run by test_design_sweep_example
 
 
@@ -139,6 +139,30 @@ def test_precurved_arc():
     s = result.s
     np.testing.assert_allclose(result.positions[:, 0], np.sin(k * s) / k, atol=1e-6)
     np.testing.assert_allclose(result.positions[:, 1], (1 - np.cos(k * s)) / k, atol=1e-6)
+
+
+def test_greenhill_upright_buckles_at_greenhills_load(capsys):
+    """`softarm critical` on the upright heavy arm: the weight scaled by λ buckles it at
+    q L³/EI = 7.837347438943 (Greenhill 1881; buckling.json, greenhill_heavy_column), in both
+    bending planes of the round section at once (nullity 2); the case has q L³/EI = 1."""
+    from conftest import reference_table
+
+    from softarm import cli
+
+    case = load_case(EXAMPLES / "greenhill_upright.toml")
+    arm = case.arm
+    q = arm.linear_density * float(np.linalg.norm(case.loads[0].acceleration))
+    assert q * arm.length**3 / arm.rigidities.EIy == pytest.approx(1.0, rel=1e-12)
+    assert cli.main(["critical", str(EXAMPLES / "greenhill_upright.toml")]) == 0
+    out = capsys.readouterr().out
+    line = next(line for line in out.splitlines() if line.startswith("critical"))
+    factor = float(line.split("λc = ")[1].split()[0])
+    greenhill = reference_table("buckling.json")["facts"]["greenhill_heavy_column"]["C"]
+    assert factor == pytest.approx(greenhill, rel=1e-9)
+    assert "(bifurcation, nullity 2; Morse index 0 -> 2)" in line
+    _, result = solve("greenhill_upright")  # at λ = 1 it stands straight, and is stable
+    assert result.stability.stable
+    np.testing.assert_allclose(result.tip_position, [1.0, 0.0, 0.0], atol=1e-8)
 
 
 def test_demo_global_equilibrium():

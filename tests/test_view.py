@@ -82,7 +82,7 @@ def test_figure_draws_the_equilibrium(demo):
     assert triangles.max() == vertices.shape[0] * 16 - 1
     surface = vertices
     # the tip frame: 0.15 L along each column of R(L)
-    (e1,) = traces(fig, "tip frame e1 e2 e3")
+    (e1,) = traces(fig, "e1")
     tip = np.stack([decode(e1[a]) for a in "xyz"], -1)
     np.testing.assert_allclose(tip[1] - tip[0], 0.15 * 0.4 * result.tip[:3, 0], atol=1e-6)
     # equal axis scaling: a cube holding every point drawn
@@ -108,6 +108,42 @@ def test_load_arrows_in_the_figure(demo):
     force = np.array([0.0, 0.15, -0.4])  # demo.toml, the tip load (dead: spatial)
     np.testing.assert_allclose(direction, force / np.linalg.norm(force), atol=1e-12)
     assert "0.15" in forces["text"][-2] and "N" in forces["text"][-2]
+
+
+def rgb(color: str) -> np.ndarray:
+    """"rgb(r,g,b)" as a vector."""
+    match = re.fullmatch(r"rgb\((\d+),\s*(\d+),\s*(\d+)\)", color)
+    assert match, color
+    return np.array([float(v) for v in match.groups()])
+
+
+@pytest.mark.parametrize("name", ["demo", "tendon_robot", "pneumatic_actuator"])
+def test_legend_entries_have_colours_of_their_own(name):
+    # The centreline was drawn in the red of the tip frame's e1, and the tip frame had one
+    # legend entry drawn in e1's red: now e1, e2 and e3 are entries of their own, and no two
+    # kinds of things in the legend are closer in colour than 60 (of 255, RGB distance).
+    # Actuators of one kind (three tendons) share their colour.
+    case = softarm.load_case(EXAMPLES / f"{name}.toml")
+    fig = json.loads(view.to_json(view.figure(softarm.case.solve_case(case), name=name)))
+    actuators = {load.describe(): load.kind for load in case.loads
+                 if load.kind in ("tendon", "chamber")}
+    colours: dict[str, np.ndarray] = {}
+    for trace in fig["data"]:
+        if not trace.get("showlegend", trace["type"] == "scatter3d"):
+            continue
+        kind = actuators.get(trace["name"], trace["name"])
+        colour = rgb(trace["color"] if trace["type"] == "mesh3d" else trace["line"]["color"])
+        assert np.array_equal(colours.setdefault(kind, colour), colour), kind
+    kinds = sorted(colours)
+    for i, a in enumerate(kinds):
+        for b in kinds[i + 1:]:
+            assert np.linalg.norm(colours[a] - colours[b]) > 60, (a, b)
+    assert {"arm", "centreline", "e1", "e2", "e3", "forces"} <= set(colours)
+    assert set(actuators.values()) <= set(colours)
+    # the tip frame's three entries, one group: a click on one hides or shows the frame
+    frame = [trace for trace in fig["data"] if trace.get("legendgroup") == "tip frame"]
+    assert [trace["name"] for trace in frame] == ["e1", "e2", "e3"]
+    assert frame[0]["legendgrouptitle"]["text"] == "tip frame"
 
 
 def test_sweep_figure_has_frames_slider_and_tip_plot(sweep):
@@ -136,6 +172,73 @@ def test_sweep_figure_has_frames_slider_and_tip_plot(sweep):
         assert index in frame["traces"]
         line = frame["data"][frame["traces"].index(index)]
         np.testing.assert_allclose(decode(line["x"])[-1], np.sin(tau[k]) / tau[k], atol=1e-6)
+
+
+def test_a_page_fills_the_window_and_a_notebook_output_has_a_height(demo, sweep, tmp_path):
+    # A 650 px figure left a third of a 1200 x 900 window blank below it: a page's figure
+    # (softarm view, Equilibrium.show) now has no height of its own and its <div> is as high
+    # as the window; a notebook output keeps a fixed height (a notebook has no window height).
+    _, result = demo
+    page = view.write_html(result, tmp_path / "demo.html").read_text(encoding="utf-8")
+    assert re.search(r'<div id="softarm-view" class="plotly-graph-div" '
+                     r'style="height:100vh; min-height:\d+px; width:100%;">', page)
+    assert '"height":' not in page.split("var id =")[1].split("function draw")[0]
+    case, swept = sweep
+    path = view.view_result_file(io_saved(swept, case, tmp_path), tmp_path / "sweep.html")
+    page = path.read_text(encoding="utf-8")
+    # the sweep's 3D figure and its tip plot in a container as high as the window, the tip
+    # plot placed in percentages of it
+    assert re.search(r'<div style="position:relative; height:100vh; min-height:\d+px; '
+                     r'width:100%;"><div id="softarm-view" class="plotly-graph-div" '
+                     r'style="height:100%; width:100%;">', page)
+    assert re.search(r'id="softarm-view-tips" class="plotly-graph-div" style="position:'
+                     r'absolute; top:calc\([^;]*%[^;]*\); bottom:calc\([^;]*%[^;]*\);', page)
+    notebook = view.notebook_html(result)
+    assert re.search(r'class="plotly-graph-div" style="height:650px; width:100%;"', notebook)
+
+
+def io_saved(result, case, folder):
+    """``result`` written and read back by softarm.io, as `softarm view` gets it."""
+    softarm.io.save_result(result, folder / "saved.npz", case)
+    return softarm.io.load_saved(folder / "saved.npz")
+
+
+@pytest.mark.parametrize(("low", "high"), [(-0.1, 0.52), (-0.31, 0.31), (0.0, 1.0),
+                                           (-1e-3, 2e-3), (5.0, 5.4), (-0.2222, 0.4444),
+                                           (-100.0, 300.0), (0.123, 0.124)])
+def test_axis_ticks_keep_away_from_the_corners(low, high):
+    # plotly.js's own ticks run to the ends of an axis, where three axes' labels meet at a
+    # corner of the box and overlapped: at least three ticks of a 1, 2 or 5 x 10^k step,
+    # none within 10 % of the axis's length from either end
+    ticks = np.array(view.axis_ticks(low, high))
+    span = high - low
+    assert len(ticks) >= 3
+    assert np.all(ticks >= low + 0.1 * span - 1e-12 * span)
+    assert np.all(ticks <= high - 0.1 * span + 1e-12 * span)
+    steps = np.diff(ticks)
+    np.testing.assert_allclose(steps, steps[0], rtol=1e-9)
+    mantissa = steps[0] / 10.0 ** np.floor(np.log10(steps[0]))
+    assert min(abs(mantissa - m) for m in (1.0, 2.0, 5.0)) < 1e-9
+    np.testing.assert_allclose(ticks / steps[0], np.round(ticks / steps[0]), atol=1e-9)
+
+
+def test_figure_ticks_and_the_sweep_controls_stay_off_the_scene(demo, sweep):
+    _, result = demo
+    scene = view.figure(result)["layout"]["scene"]
+    for axis in "xyz":
+        low, high = scene[f"{axis}axis"]["range"]
+        assert scene[f"{axis}axis"]["tickvals"] == view.axis_ticks(low, high)
+    case, swept = sweep
+    layout = view.figure(swept, sweep=case.sweep)["layout"]
+    bottom = layout["scene"]["domain"]["y"][0]
+    # the play and pause buttons overlapped the 3D scene: the buttons and the slider hang
+    # below the plotting area now (their top at its bottom edge, y = 0, or lower), the
+    # buttons to the left of the slider's rail
+    for control in (layout["updatemenus"][0], layout["sliders"][0]):
+        assert control["yanchor"] == "top" and control["y"] <= bottom
+    buttons, slider = layout["updatemenus"][0], layout["sliders"][0]
+    assert buttons["xanchor"] == "left" and buttons["x"] == slider["x"] == 0.0
+    assert slider["pad"]["l"] >= buttons["pad"]["l"] + 70  # two buttons of about 35 px
 
 
 def test_page_is_self_contained(demo, tmp_path):

@@ -9,11 +9,11 @@ solver to the unloaded arm.
 
 Endpoints: ``GET /`` the page; ``GET /plotly.min.js``; ``GET /solve?NAME=VALUE&...`` the
 equilibrium for these inputs (names as listed by ``GET /inputs``; absent ones keep their last
-value) as JSON ``{"data": [...traces], "ranges", "title", "tip": [x, y, z], "solve_ms",
-"method", "residual", "stability"}`` (``data``: only what changes of each 3D trace of the
-page's figure, in its order, see :func:`softarm.view.scene_traces`; ``stability``: the
-verdict in words); ``GET /reset`` the same after returning
-to the unloaded arm. A bad request (an
+value) as JSON ``{"data": [...traces], "ranges", "ticks", "title", "tip": [x, y, z],
+"solve_ms", "method", "residual", "stability"}`` (``data``: only what changes of each 3D
+trace of the page's figure, in its order, see :func:`softarm.view.scene_traces`; ``ticks``:
+each axis's tick values, see :func:`softarm.view.axis_ticks`; ``stability``: the verdict in
+words); ``GET /reset`` the same after returning to the unloaded arm. A bad request (an
 unknown name, a value that is not a finite number or is out of its slider's range) gets
 HTTP 400 with ``{"error": message}``; a load the solver cannot follow (a fold, a load too large
 for the arm) gets HTTP 422 with the message, and the arm stays where it was.
@@ -42,7 +42,7 @@ from .case import Case, CaseError
 from .errors import ConvergenceError
 from .geometry import cube_limits
 from .statics import Solver
-from .view import figure, plotly_js_path, scene_traces, to_json
+from .view import axis_ticks, figure, plotly_js_path, scene_traces, to_json
 
 __all__ = ["Input", "LiveCase", "inputs", "make_server", "serve"]
 
@@ -214,7 +214,8 @@ class LiveCase:
         self.result = result
         self._grow_limits(result)
         centre, half = self.limits
-        return {"ranges": [[centre[k] - half, centre[k] + half] for k in range(3)],
+        ranges = [[centre[k] - half, centre[k] + half] for k in range(3)]
+        return {"ranges": ranges, "ticks": [axis_ticks(*bounds) for bounds in ranges],
                 "data": scene_traces(result, self.scales, changing=True),
                 "title": _title(self.case, loads),
                 "tip": np.asarray(result.tip_position).tolist(),
@@ -246,9 +247,9 @@ class LiveCase:
     def figure(self) -> dict:
         """The page's first figure: the current equilibrium (solved once, from unloaded)."""
         body = self.solve()
-        fig = figure(self.result, name=self.case.name, scales=self.scales, limits=self.limits)
+        fig = figure(self.result, name=self.case.name, scales=self.scales, limits=self.limits,
+                     height=None)  # as high as the page (#plot)
         fig["layout"]["title"]["text"] = body["title"]
-        fig["layout"]["height"] = 700
         return fig
 
 
@@ -369,6 +370,7 @@ async function send(path) {{
     }}
     ["xaxis", "yaxis", "zaxis"].forEach((axis, k) => {{
       layout.scene[axis].range = body.ranges[k];
+      layout.scene[axis].tickvals = body.ticks[k];  // see softarm.view.axis_ticks
       cube["xyz"[k]] = body.ranges[k]; }});
     layout.datarevision = (layout.datarevision || 0) + 1;
     await Plotly.react("plot", FIGURE.data, layout, CONFIG);
@@ -448,6 +450,9 @@ class _Handler(BaseHTTPRequestHandler):
                 self._json(200, [i.__dict__ | {"step": i.step} for i in self.live.inputs])
             elif url.path in ("/solve", "/reset"):
                 query = _query(url.query)
+                # one solve at a time (they share the Solver and its last equilibrium); the
+                # reply is encoded and sent after the lock is let go
+                failure = None
                 with self.lock:
                     old = self.live.values
                     self.live.update(query)
@@ -457,10 +462,11 @@ class _Handler(BaseHTTPRequestHandler):
                         body = self.live.solve()
                     except (ConvergenceError, ValueError) as error:
                         self.live.values = old
-                        self._json(422, {"error": _one_line(f"cannot solve for these "
-                                                            f"inputs: {error}")})
-                        return
-                self._send(200, to_json(body).encode("utf-8"), "application/json")
+                        failure = f"cannot solve for these inputs: {error}"
+                if failure is not None:
+                    self._json(422, {"error": _one_line(failure)})
+                else:
+                    self._send(200, to_json(body).encode("utf-8"), "application/json")
             else:
                 self._json(404, {"error": f"no such page: {url.path}"})
         except BadRequest as error:
@@ -488,13 +494,32 @@ def _one_line(text: str, limit: int = 400) -> str:
     return text if len(text) <= limit else text[: limit - 1] + "…"
 
 
+class _Server(ThreadingHTTPServer):
+    """The app's server: a thread per connection (a solve waits for the app's lock, see
+    _Handler; the page's script, plotly.js and /inputs do not), a listen queue long enough
+    for a burst of connections, and a client that goes away (a reset or closed connection,
+    at any point of its request) is no error of the app's.
+
+    The standard library's listen backlog is 5: a burst of 200 requests overflowed it, and
+    the kernel dropped the connections beyond it, which the clients saw as waits of seconds
+    (their connection attempts repeated after 1, 3, 7, ... s), resets or no answer at all."""
+
+    request_queue_size = 1024  # the kernel caps it at net.core.somaxconn
+    daemon_threads = True
+
+    def handle_error(self, request, client_address):
+        if isinstance(sys.exc_info()[1], ConnectionError):  # reset, broken pipe, aborted
+            return
+        super().handle_error(request, client_address)  # pragma: no cover - a bug of ours
+
+
 def make_server(live: LiveCase, port: int = 8050) -> ThreadingHTTPServer:
     """An HTTP server on 127.0.0.1:``port`` (0: any free port) serving ``live``; CaseError if
     the port is taken or not allowed."""
     handler = type("Handler", (_Handler,), {"live": live, "lock": threading.Lock(),
                                             "plotly_js": plotly_js_path().read_bytes()})
     try:
-        server = ThreadingHTTPServer(("127.0.0.1", port), handler)
+        server = _Server(("127.0.0.1", port), handler)
     except OSError as error:
         if error.errno == errno.EADDRINUSE:
             raise CaseError(f"port {port} on 127.0.0.1 is already in use (another softarm app "
@@ -505,7 +530,6 @@ def make_server(live: LiveCase, port: int = 8050) -> ThreadingHTTPServer:
             raise CaseError(f"port {port}: not allowed ({error.strerror}); use a port above "
                             "1023, e.g. --port 8050") from None
         raise
-    server.daemon_threads = True
     return server
 
 

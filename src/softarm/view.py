@@ -13,16 +13,18 @@ browsers that may draw WebGL in software; the notes at ``_SIDES``, ``_cube_ancho
 
 Drawn: the arm as a tube of its real radius (its centreline when the sections are not known),
 the arm and its centreline with hover read-outs (s, position, strains and stresses in the
-material frame), the tip's material frame (e1 red, e2 green, e3 blue), arrows for the loads (forces
-solid, moments dashed; each load's arrows are scaled to its own largest value, the hover
-gives the value) and the clamped base. A sweep gets a slider over its parameter, a play
-button and a plot of the tip coordinates against the parameter.
+material frame), the tip's material frame (e1 red, e2 green, e3 blue: no other legend entry
+shares their colours), arrows for the loads (forces solid, moments dashed; each load's arrows
+are scaled to its own largest value, the hover gives the value) and the clamped base. A sweep
+gets a slider over its parameter, a play button and a plot of the tip coordinates against
+the parameter.
 """
 
 from __future__ import annotations
 
 import base64
 import json
+import math
 import os
 from pathlib import Path
 
@@ -41,17 +43,23 @@ from .geometry import (
     tube_surface,
 )
 
-__all__ = ["NOTEBOOK_PLOTLYJS", "PLOTLY_MISSING", "figure", "notebook_html", "plotly_js_path",
-           "scene_traces", "to_html", "to_json", "view_result_file", "write_html"]
+__all__ = ["NOTEBOOK_PLOTLYJS", "PLOTLY_MISSING", "axis_ticks", "figure", "notebook_html",
+           "plotly_js_path", "scene_traces", "to_html", "to_json", "view_result_file",
+           "write_html"]
 
 #: The message when plotly is not installed.
 PLOTLY_MISSING = "the browser views need plotly: pip install 'softarm[view]'"
 
+# Every entry of the legend has a colour of its own (tests/test_view.py measures how far
+# apart they are): e1 e2 e3 are red, green and blue, so the centreline is dark brown, the
+# tendons black, the forces mid grey and the chambers cyan.
 _TUBE = "rgb(255,127,14)"
-_LINE = "rgb(214,39,40)"
+_LINE = "rgb(110,55,0)"
 _AXES = ("rgb(220,40,40)", "rgb(40,160,40)", "rgb(40,80,220)")
-_FORCE = "rgb(60,60,60)"
+_FORCE = "rgb(100,100,100)"
 _MOMENT = "rgb(148,103,189)"
+_TENDON = "rgb(30,30,30)"
+_CHAMBER = "rgb(23,190,207)"
 # The tube's mesh: software WebGL (headless or GPU-less browsers) spends its time per vertex,
 # so the tube has at most about _RINGS rings of _SIDES vertices whatever the number of
 # stations (1616 vertices at 101 stations before; the look is the same, see tube_rings).
@@ -170,17 +178,16 @@ def _scene_traces(result, arrows, scales, rings) -> list[dict]:
         tendon = path.kind == "tendon"
         traces.append({"type": "scatter3d", "mode": "lines", "x": path.points[:, 0],
                        "y": path.points[:, 1], "z": path.points[:, 2],
-                       "line": {"color": "rgb(30,30,30)" if tendon else "rgb(40,110,200)",
+                       "line": {"color": _TENDON if tendon else _CHAMBER,
                                 "width": 3 if tendon else 8},
                        "name": path.label, "hovertemplate": f"{path.label}<extra></extra>"})
     frame = tip_frame(poses, 0.15 * length)
-    for k, axis in enumerate(("e1", "e2", "e3")):
+    for k, axis in enumerate(("e1", "e2", "e3")):  # one legend entry each, in its colour
         traces.append({"type": "scatter3d", "mode": "lines", "x": frame[k, :, 0],
                        "y": frame[k, :, 1], "z": frame[k, :, 2],
-                       "line": {"color": _AXES[k], "width": 6},
-                       "name": "tip frame e1 e2 e3" if k == 0 else f"tip {axis}",
-                       "legendgroup": "tip frame", "showlegend": k == 0,
-                       "hovertemplate": f"tip frame {axis}<extra></extra>"})
+                       "line": {"color": _AXES[k], "width": 6}, "name": axis,
+                       "legendgroup": "tip frame", "legendgrouptitle": {"text": "tip frame"},
+                       "showlegend": True, "hovertemplate": f"tip frame {axis}<extra></extra>"})
     traces += _arrow_traces(arrows, scales, length)
     traces.append({"type": "scatter3d", "mode": "markers", "x": p[:1, 0], "y": p[:1, 1],
                    "z": p[:1, 2],
@@ -226,7 +233,7 @@ def _describe(loads) -> str:
 
 
 def figure(result, *, name: str | None = None, values=None, label: str | None = None,
-           sweep=None, title: str | None = None, height: int = 650, scales=None,
+           sweep=None, title: str | None = None, height: int | None = 650, scales=None,
            limits=None) -> dict:
     """The plotly figure (a dict: ``data``, ``layout`` and, for a sweep, ``frames``).
 
@@ -243,8 +250,9 @@ def figure(result, *, name: str | None = None, values=None, label: str | None = 
     sweep : softarm.case.Sweep, optional
     title : str, optional
         Replaces the whole title.
-    height : int
-        In pixels.
+    height : int or None
+        In pixels; None: as high as the element it is drawn in (:func:`to_html`'s page: the
+        browser window).
     scales : dict, optional
         Arrow length in m per unit of each load's field, keyed by (load index, field name)
         (default: each field's largest arrow is 0.25 L, or 0.12 L for distributed loads).
@@ -263,14 +271,19 @@ def figure(result, *, name: str | None = None, values=None, label: str | None = 
         else limits
     scene = {"aspectmode": "cube", "domain": {"x": [0.0, 0.66 if batch else 1.0],
                                               "y": [0.0, 1.0]},
-             "camera": {"eye": {"x": 1.1, "y": -1.6, "z": 0.75}}}
+             # the camera far enough out that the whole box and its labels are in the picture
+             "camera": {"eye": {"x": 1.27, "y": -1.84, "z": 0.86}}}
     for k, axis in enumerate("xyz"):
-        scene[f"{axis}axis"] = {"range": [centre[k] - half, centre[k] + half],
+        low, high = centre[k] - half, centre[k] + half
+        scene[f"{axis}axis"] = {"range": [low, high], "tickmode": "array",
+                                "tickvals": axis_ticks(low, high),
                                 "title": {"text": f"{axis} (m)"}}
     head = name or "softarm"
-    layout = {"scene": scene, "height": height, "margin": {"l": 10, "r": 10, "t": 60, "b": 10},
+    layout = {"scene": scene, "margin": {"l": 10, "r": 10, "t": 60, "b": 10},
               "legend": {"x": 0.0, "y": 1.0}, "hovermode": "closest",
               "uirevision": "keep the camera"}
+    if height is not None:
+        layout["height"] = height
     rings = tube_rings(result.arm, result.s, _RINGS)
     data = _scene_traces(cases[0], arrows[0], scales, rings)
 
@@ -325,17 +338,44 @@ def figure(result, *, name: str | None = None, values=None, label: str | None = 
     # The frames are shown by the page's script (to_html; "skip": plotly.js only draws the
     # slider and the buttons): one Plotly.react per frame, see _DRAW.
     fig["frames"] = frames
+    # The slider and the play and pause buttons share one row below the plotting area (they
+    # hang from its bottom edge, y = 0, yanchor "top"), the buttons left of the slider's rail
+    # (its pad "l"): nothing of them lies over the 3D scene, where they hid part of the arm.
     layout["sliders"] = [{
-        "active": 0, "x": 0.05, "len": 0.9, "y": 0.0, "pad": {"t": 10},
+        "active": 0, "x": 0.0, "len": 1.0, "y": 0.0, "yanchor": "top",
+        "pad": {"t": 10, "l": _BUTTONS_WIDTH + 20, "r": 20},
         "currentvalue": {"prefix": f"{label} = ", "font": {"size": 13}},
         "steps": [{"label": n, "method": "skip", "args": [[n]]} for n in names]}]
     layout["updatemenus"] = [{
-        "type": "buttons", "direction": "left", "x": 0.05, "y": 0.08, "xanchor": "right",
-        "showactive": False,
+        "type": "buttons", "direction": "left", "x": 0.0, "xanchor": "left", "y": 0.0,
+        "yanchor": "top", "pad": {"t": 36, "l": 10}, "showactive": False,
         "buttons": [{"label": "▶", "method": "skip", "args": [None]},
                     {"label": "❚❚", "method": "skip", "args": [None]}]}]
     layout["margin"]["b"] = 40
     return fig
+
+
+#: The play and pause buttons' width in pixels (two buttons of about 35 px).
+_BUTTONS_WIDTH = 75
+#: The smallest height of a figure that fills the window, pixels.
+_MIN_HEIGHT = 480
+
+
+def axis_ticks(low: float, high: float) -> list[float]:
+    """Tick values for a 3D axis over [low, high]: multiples of 1, 2 or 5 × 10^k, at least
+    three, none within 10 % of the axis length from either end.
+
+    A 3D scene draws each axis's tick labels along an edge of its box, and three edges meet
+    at each corner: a label at an axis's end sat on the labels of the other axes there, which
+    overlapped (plotly.js's own ticks run to the ends of the range)."""
+    span = high - low
+    inner = (low + 0.1 * span, high - 0.1 * span)
+    exponent = math.floor(math.log10((inner[1] - inner[0]) / 3))
+    step = max(m * 10.0**exponent for m in (1.0, 2.0, 5.0)
+               if m * 10.0**exponent <= (inner[1] - inner[0]) / 3)
+    first, last = math.ceil(inner[0] / step), math.floor(inner[1] / step)
+    digits = max(0, 1 - math.floor(math.log10(step)))
+    return [round(k * step, digits) + 0.0 for k in range(first, last + 1)]
 
 
 def _cube_anchor(centre, half) -> dict:
@@ -493,19 +533,24 @@ def to_html(fig: dict, *, full_html: bool = True, div_id: str | None = None,
     if include_plotlyjs:
         _plotly()
     div_id = div_id or f"softarm-{uuid.uuid4().hex[:12]}"
-    height = fig.get("layout", {}).get("height", 650)
+    height = fig.get("layout", {}).get("height")
+    # a figure without a height fills the window (min-height: a usable figure in a small one)
+    size = f"height:{int(height)}px;" if height else f"height:100vh; min-height:{_MIN_HEIGHT}px;"
     script = _DRAW % {"id": json.dumps(div_id), "fig": to_json(fig).replace("</", "<\\/"),
                       "waiting": json.dumps(_WAITING)}
+    own = "height:100%;" if "tips" in fig else size  # a sweep's: that of its container
     main = (f'<div id="{html.escape(div_id)}" class="plotly-graph-div" '
-            f'style="height:{int(height)}px; width:100%;"></div>')
+            f'style="{own} width:100%;"></div>')
     if "tips" in fig:  # a sweep's tip plot over the right of the 3D figure, see figure()
+        # its axes from 0.1 to 0.7 of the plotting area's height (that of the page less the
+        # 3D figure's margins), whatever the page's height: CSS percentages of the container
         margin = fig["layout"]["margin"]
-        inner = int(height) - margin["t"] - margin["b"]
-        top = int(height) - margin["b"] - 0.9 * inner - 30  # its axes at 0.3-0.9 of the height
-        bottom = margin["b"] + 0.3 * inner - 50
-        main = (f'<div style="position:relative; height:{int(height)}px; width:100%;">{main}'
+        inner = f"(100% - {margin['t'] + margin['b']}px)"
+        top = f"calc({margin['t'] - 30}px + 0.1 * {inner})"
+        bottom = f"calc({margin['b'] - 50}px + 0.3 * {inner})"
+        main = (f'<div style="position:relative; {size} width:100%;">{main}'
                 f'<div id="{html.escape(div_id)}-tips" class="plotly-graph-div" '
-                f'style="position:absolute; top:{top:.0f}px; bottom:{bottom:.0f}px; '
+                f'style="position:absolute; top:{top}; bottom:{bottom}; '
                 f'left:calc(0.72 * (100% - 20px) - 50px); right:0px;"></div></div>')
     body = ((_library() if include_plotlyjs else "") + main + "\n" +
             f'<script type="text/javascript">{script}</script>\n')
@@ -551,7 +596,9 @@ def notebook_html(result, **options) -> str:
 
 
 def write_html(result, path: str | os.PathLike, **options) -> Path:
-    """Write :func:`figure` (``options`` as there) as a self-contained HTML file, atomically."""
+    """Write :func:`figure` (``options`` as there; ``height`` default None: the figure fills
+    the browser's window) as a self-contained HTML file, atomically."""
+    options.setdefault("height", None)
     text = to_html(figure(result, **options), div_id="softarm-view")
     path = Path(path)
     with write_atomic(path, "wb") as stream:

@@ -20,8 +20,9 @@ from .._threads import in_threads, threads_for
 from .._validate import check_allocation, count, real, rigid_transform, stations
 from ..equilibrium import Equilibrium, Stability
 from ..errors import ConvergenceError
-from ..loads import as_loads, batch_shape
-from ..model import Arm, SegmentedArm
+from ..loads import Gravity, Tendon, as_loads, batch_shape
+from ..model import Arm, Circle, Material, SegmentedArm
+from ..routing import Straight
 from . import _prefetch
 from .displacement import solve_displaced
 from .stability import verdict
@@ -1330,10 +1331,6 @@ def compile_verdict(kind: str) -> None:
     """Compile (or load) the stability verdict of a small arm of this kind, "passive" or
     "actuated": the same kernel, with the same argument types, as every solve's verdict
     (what ``_prefetch`` runs in another process beside a cold first solve)."""
-    from ..loads import Gravity, Tendon
-    from ..model import Circle, Material
-    from ..routing import Straight
-
     arm = Arm(0.2, Circle(0.01), Material(youngs_modulus=1e6, poisson_ratio=0.49,
                                           density=1000.0))
     loads = [Gravity()] + ([Tendon(0.1, Straight(0.0, 0.005))] if kind == "actuated" else [])
