@@ -540,8 +540,8 @@ def serve(case: Case, *, port: int = 8050, browser: bool = True, stream=None) ->
     live = LiveCase(case)
     server = make_server(live, port)
     try:
-        print("preparing the solver (the first run compiles it, about 15 s)...", file=stream,
-              flush=True)
+        # (a kernel compiled here for the first time says so itself, with this machine's
+        # time: softarm._jit; a cached one loads in a fraction of a second)
         live.solve()
         host, port = server.server_address[:2]
         address = f"http://{host}:{port}/"
