@@ -383,8 +383,9 @@ def test_the_tendon_law_with_and_without_tangents_solves_the_law_equation():
                        [0.012, 0.004, 2 * np.pi * 3.0, 0.4, 0.006, -0.004],
                        [0.01, 0.0, 0.0, 0.0, -0.007, -0.004]])
     arm = (np.zeros(1), np.array([0.3]), np.linalg.inv(K)[None], f0, np.zeros((1, 6)), False,
-           0.3, np.ones(6), K[None], routes, np.zeros(3, dtype=np.int64), np.ones((1, 3)),
-           np.zeros((1, 3)), np.zeros((2, 3)))
+           0.3, np.ones(6), K[None])
+    act = (routes, np.zeros(3, dtype=np.int64), np.ones((1, 3)), np.zeros((1, 3)),
+           np.zeros((2, 3)))
     tension = np.array([4.0, 2.5, 1.0])
     now = np.zeros((1, k.PIECE_LOADS + 3))
     now[0, k.PIECE_LOADS:] = tension
@@ -412,7 +413,7 @@ def test_the_tendon_law_with_and_without_tangents_solves_the_law_equation():
     strains = {}
     for tangents in (0, 6):
         law = k._scratch(1, 3, 7)[8]
-        *eps, factored = k._law(arm, 0, s, now, law, np.int64(tangents), *sigma)
+        *eps, factored = k._law(arm, act, 0, s, now, law, np.int64(tangents), *sigma)
         eps = np.array(eps)
         value, H = law_equation(eps)
         np.testing.assert_allclose(value, 0.0, atol=1e-12 * np.abs(sigma).max())

@@ -21,7 +21,8 @@ import pytest
 _PASSIVE_SOLVE = """
 import sys, numpy as np, softarm
 from softarm.statics.solver import _kernels
-arm = softarm.Arm(0.2, softarm.Circle(0.01), softarm.Material(1.5e6, 0.49, 1070.0))
+silicone = softarm.Material(youngs_modulus=1.5e6, poisson_ratio=0.49, density=1070.0)
+arm = softarm.Arm(0.2, softarm.Circle(0.01), silicone)
 eq = softarm.solve(arm, [softarm.Gravity(), softarm.TipLoad(force=[0.0, 0.01, 0.0])],
                    method="numeric")
 k = _kernels()

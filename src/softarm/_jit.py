@@ -210,7 +210,8 @@ class _Notice(event.Listener):
     def on_end(self, ev):
         stack = _STATE.__dict__.setdefault("stack", [])
         entry = stack.pop() if stack else None
-        if entry is not None and not ev.is_failed:
+        # (not ev.is_failed: numba 0.68's is_failed is inverted, True for a success)
+        if entry is not None and getattr(ev, "_exc_details", None) is None:
             key, text, dispatcher, start = entry
             seconds = time.perf_counter() - start
             COMPILED.append((key, text, seconds))
