@@ -43,6 +43,9 @@ LENGTH_RANGE = (1e-12, 1e12)
 #: Bytes of output per load case and station: a pose (16), strains (6) and stresses (6),
 #: float64.
 BYTES_PER_STATION = 28 * 8
+#: Bytes of a result per load case besides its stations (residual, error estimate, base
+#: wrench, verdict, ...): measured 200-610 B (tests/test_memory.py)
+BYTES_PER_CASE = 640
 
 #: Largest deviation ‖RᵀR − I‖ (max entry) of a base rotation that is re-orthonormalised; a
 #: rotation off by more is rejected.
@@ -169,6 +172,8 @@ def as_array(value, name: str) -> np.ndarray:
         where = "" if bad is value else f" in {format_value(value)}"
         raise TypeError(f"{name} must be numeric (real numbers), got {_kind(bad)} "
                         f"({format_value(bad, 40)}){where}")
+    if isinstance(value, np.ndarray):  # (a broadcast view may be far larger than its data)
+        check_array_size(value.shape, name)
     try:
         array = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError) as error:  # e.g. ragged nested lists
@@ -300,12 +305,28 @@ def memory_limit() -> int:
         return 1 << 40
 
 
-def check_allocation(cases, stations, name: str = "the result") -> int:
+def check_array_size(shape, name: str) -> None:
+    """ValueError naming ``name`` if a float64 array of this shape (an input softarm copies,
+    e.g. a zero-copy ``np.broadcast_to`` view) cannot fit in :func:`memory_limit`."""
+    size = 8.0 * float(np.prod(np.asarray(shape, dtype=np.float64)))
+    if size > memory_limit():
+        raise ValueError(
+            f"{name}: an array of shape {tuple(int(n) for n in shape)} would need "
+            f"{format_bytes(size)} of memory as softarm's own float64 copy, more than the "
+            f"{format_bytes(memory_limit())} (half of this machine's memory) one result may "
+            "take; solve fewer cases at a time")
+
+
+def check_allocation(cases, stations, name: str = "the result", *,
+                     per_station: float = BYTES_PER_STATION,
+                     per_case: float = BYTES_PER_CASE, work: float = 0.0) -> int:
     """Reject, before allocating, a result of ``cases`` × ``stations`` that cannot fit in memory.
 
     The output of one solve is a pose, strains and stresses per load case and station
-    (:data:`BYTES_PER_STATION`). ValueError naming the sizes and the memory they would need if
-    that exceeds :func:`memory_limit`; else the number of bytes.
+    (:data:`BYTES_PER_STATION`; more with Jacobians: ``per_station``) and a few numbers per
+    case (``per_case``), plus the ``work`` (bytes) the solve needs beside it (a batch is
+    solved in parts of bounded size, statics.solver). ValueError naming the sizes and the
+    memory they would need if that exceeds :func:`memory_limit`; else the number of bytes.
 
     Examples
     --------
@@ -313,16 +334,16 @@ def check_allocation(cases, stations, name: str = "the result") -> int:
     ...     check_allocation(10**7, 101, "loads")
     ... except ValueError as error:
     ...     print(str(error)[:69])
-    loads: 10000000 load cases × 101 stations would need 226 GB of memory
+    loads: 10000000 load cases × 101 stations would need 233 GB of memory
     """
-    size = float(cases) * float(stations) * BYTES_PER_STATION
+    size = float(cases) * (float(stations) * per_station + per_case) + work
     limit = memory_limit()
     if size > limit:
         raise ValueError(
             f"{name + ': ' if name else ''}{cases} load case{'s' if cases != 1 else ''} × "
             f"{stations} stations would need "
             f"{format_bytes(size)} "
-            "of memory for the poses, strains and stresses alone, more than the "
+            "of memory for the result and its solve, more than the "
             f"{format_bytes(limit)} (half of this machine's memory) one result may take; solve "
             "fewer cases or stations at a time"
         )

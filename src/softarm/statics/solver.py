@@ -17,7 +17,14 @@ from typing import NamedTuple
 import numpy as np
 
 from .._threads import in_threads, threads_for
-from .._validate import check_allocation, count, real, rigid_transform, stations
+from .._validate import (
+    BYTES_PER_STATION,
+    check_allocation,
+    count,
+    real,
+    rigid_transform,
+    stations,
+)
 from ..equilibrium import Equilibrium, Stability
 from ..errors import ConvergenceError
 from ..loads import Gravity, Tendon, as_loads, batch_shape
@@ -41,6 +48,19 @@ _IDENTITY.setflags(write=False)
 _LOAD_LIMIT = 1e12
 #: Fewest load cases per thread of a batch: below it a thread costs more than it saves.
 CASES_PER_THREAD = 16
+#: Most load cases solved at once: a larger batch is solved in parts of this size, each
+#: with its own load channels and work arrays (about 1 kB a case beside the result,
+#: tests/test_memory.py), so that a batch needs its result's memory and one part's work.
+CASES_PER_PART = 1 << 15
+#: Bytes of work per case of a part besides its result (channels 8 P W, verdict, outputs)
+_WORK_PER_CASE = 2048
+
+
+def _part_work(cases: int, stations: int) -> float:
+    """Bytes a batch needs beside its result: one part's result and work, twice (the part
+    being solved, and what the allocator still holds of the part before: measured, a batch's
+    peak resident memory exceeds its result by up to 1.7 parts, tests/test_memory.py)."""
+    return 2.0 * min(cases, CASES_PER_PART) * (_WORK_PER_CASE + stations * BYTES_PER_STATION)
 
 
 def _kernels():
@@ -831,7 +851,8 @@ class Solver:
         shape = batch_shape(loads)
         for load in loads:
             load.check(self.arm)
-        check_allocation(math.prod(shape), self.s.size, "loads")
+        cases = math.prod(shape)
+        check_allocation(cases, self.s.size, "loads", work=_part_work(cases, self.s.size))
         return loads, shape
 
     def _prepare(self, loads, extra_cuts=(), *, checked=False):
@@ -915,11 +936,13 @@ class Solver:
         return self._solve(loads, chained=False, jacobians=jacobians)
 
     def _solve(self, loads, *, chained: bool, jacobians: bool, near: bool = False,
-               outputs: bool = True, checked: bool = False) -> Equilibrium | None:
+               outputs: bool = True, checked: bool = False,
+               part: tuple | None = None) -> Equilibrium | None:
         """``near``: a single case whose path starts at its own loads, from the memory
         :meth:`solve_near` wrote (λ = 0 and λ = 1 the same loads); ``outputs=False``: only
         the memory of a chained solve (the tip its one station, no verdict), None;
-        ``checked``: ``loads`` is what :meth:`check_loads` returned."""
+        ``checked``: ``loads`` is what :meth:`check_loads` returned; ``part``: (the whole
+        batch's shape, this part's first case) of a part of a larger batch (for messages)."""
         if not isinstance(jacobians, (bool, np.bool_)):
             raise TypeError(f"jacobians must be True or False, got {jacobians!r}")
         if not checked:
@@ -931,6 +954,15 @@ class Solver:
             if chained:
                 self.reset()
             return solve_displaced(self, loads, jacobians=jacobians)
+        if not near:
+            if not checked:
+                loads, shape = self.check_loads(loads)
+                checked = True
+            else:
+                shape = batch_shape(loads)
+            if math.prod(shape) > CASES_PER_PART:
+                return self._solve_in_parts(loads, shape, chained=chained,
+                                            jacobians=jacobians, outputs=outputs)
         k = _kernels()
         last = self._last if chained else None
         loads, shape, count, pieces, channels = self._prepare(
@@ -990,7 +1022,7 @@ class Solver:
         if len(failed):
             if chained:
                 self.reset()
-            raise _failure(k, failed[0], shape, status, info, self, near)
+            raise _failure(k, failed[0], shape, status, info, self, near, part)
         if chained and count:
             self._last = (pieces[0], channels.piece[-1].copy(), channels.tip_loads[-1].copy(),
                           channels.signature())
@@ -1029,6 +1061,26 @@ class Solver:
             compliance=compliance,
             **actuation,
         )
+
+    def _solve_in_parts(self, loads, shape, *, chained: bool, jacobians: bool,
+                        outputs: bool) -> Equilibrium | None:
+        """:meth:`_solve` of a batch larger than :data:`CASES_PER_PART`, part after part (in
+        the order of the flattened batch: a chained batch stays one path) into one result:
+        each part's channels and work arrays are freed before the next, its outputs copied
+        into the whole batch's arrays. The answer is the unparted one's to the bit (every case
+        is solved from its own loads, or the path goes on from the part before)."""
+        count = math.prod(shape)
+        whole = None
+        for first in range(0, count, CASES_PER_PART):
+            index = np.unravel_index(np.arange(first, min(first + CASES_PER_PART, count)),
+                                     shape)
+            result = self._solve([_part_of(load, shape, index) for load in loads],
+                                 chained=chained, jacobians=jacobians, outputs=outputs,
+                                 part=(shape, first))
+            if outputs:
+                whole = whole or _Parts(result, count)
+                whole.put(result, first)
+        return whole.equilibrium(shape, loads) if outputs else None
 
     def _unused(self, shape: tuple) -> np.ndarray:
         """A placeholder whose contents the kernel never uses (the argument of a feature not
@@ -1278,11 +1330,62 @@ def _input_channels(loads, pieces, data, width) -> tuple[np.ndarray, np.ndarray]
     return np.ascontiguousarray(piece), np.ascontiguousarray(tip)
 
 
-def _failure(k, b, shape, status, info, solver, near=False) -> ConvergenceError:
+def _part_of(load, shape, index):
+    """The load of the cases ``index`` (a tuple of index arrays into ``shape``, the whole
+    batch's) as a batch of shape (n,): its batched fields gathered (a broadcast field is not
+    expanded to the whole batch first)."""
+    if not load.batch_shape:
+        return load
+    changes = {}
+    for name, _, object_shape in load.arrays:
+        value = getattr(load, name)
+        if value is not None and np.ndim(value) > len(object_shape):
+            changes[name] = np.broadcast_to(value, (*shape, *object_shape))[index]
+    return load.replace(**changes)
+
+
+class _Parts:
+    """The whole batch's result assembled from its parts' (Solver._solve_in_parts): every
+    array field of the first part's Equilibrium with a leading case axis gets an array for
+    all ``count`` cases, and each part is copied in at its first case."""
+
+    def __init__(self, first: Equilibrium, count: int):
+        self.template = first
+        self.arrays = {}
+        for field in dataclasses.fields(Equilibrium):
+            value = getattr(first, field.name)
+            if isinstance(value, Stability):
+                value = np.stack([value.index, value.conservative], axis=-1)
+            if isinstance(value, np.ndarray) and field.name != "s":
+                self.arrays[field.name] = np.empty((count, *value.shape[1:]), value.dtype)
+
+    def put(self, part: Equilibrium, first: int) -> None:
+        for name, array in self.arrays.items():
+            value = getattr(part, name)
+            if isinstance(value, Stability):
+                value = np.stack([value.index, value.conservative], axis=-1)
+            array[first:first + len(value)] = value
+
+    def equilibrium(self, shape, loads) -> Equilibrium:
+        fields = {}
+        for name, array in self.arrays.items():
+            if name != "stability":
+                array.setflags(write=False)  # (before the view: Equilibrium takes it uncopied)
+            array = array.reshape(*shape, *array.shape[1:])
+            fields[name] = Stability.of(array[..., 0], array[..., 1].astype(bool), shape) \
+                if name == "stability" else array
+        return dataclasses.replace(self.template, loads=loads, **fields)
+
+
+def _failure(k, b, shape, status, info, solver, near=False, part=None) -> ConvergenceError:
     """The ConvergenceError of the first failed case (``near``: of :meth:`Solver.solve_near`,
-    whose path has no load to follow: a failure there means no solution near its start)."""
+    whose path has no load to follow: a failure there means no solution near its start;
+    ``part``: (the whole batch's shape, the first case of this part), for the case's index
+    in the whole batch)."""
     b = int(b)
-    where = f" for load case {np.unravel_index(b, shape)}" if shape else ""
+    whole, first = part if part is not None else (shape, 0)
+    where = f" for load case {tuple(int(i) for i in np.unravel_index(first + b, whole))}" \
+        if whole else ""
     residual, estimate, reached, shootings, N = info[b]
     code = int(status[b])
     tried = f"{int(shootings)} shootings, {2 * int(N)} RK4 steps"

@@ -1,0 +1,122 @@
+"""Memory: what a batch needs is what the guard assumes, and a large batch is solved in parts.
+
+A batch's peak memory is its result (:data:`softarm._validate.BYTES_PER_STATION` per case and
+station, :data:`~softarm._validate.BYTES_PER_CASE` per case) plus the work of one part
+(``statics.solver.CASES_PER_PART`` cases: load channels, work arrays, verdict): the guard
+(``check_allocation``) refuses what cannot fit before anything is allocated, and must never
+assume less than a batch really takes (measured here as the process's peak resident memory).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import softarm
+import softarm.statics.solver as solver_module
+
+SILICONE = softarm.Material(youngs_modulus=1.5e6, poisson_ratio=0.49, density=1070.0)
+ARM = softarm.Arm(0.3, softarm.Circle(0.01), SILICONE)
+
+
+def _loads(shape):
+    force = np.zeros((*shape, 3))
+    force[..., 1] = np.linspace(0.0, 0.05, int(np.prod(shape))).reshape(shape)
+    return [softarm.Gravity(), softarm.TipLoad(force=force)]
+
+
+def _same(a: softarm.Equilibrium, b: softarm.Equilibrium) -> None:
+    for field in dataclasses.fields(softarm.Equilibrium):
+        x, y = getattr(a, field.name), getattr(b, field.name)
+        if isinstance(x, np.ndarray):
+            assert x.shape == y.shape and np.array_equal(x, y), field.name
+    assert np.array_equal(a.stability.index, b.stability.index)
+    assert np.array_equal(a.stability.conservative, b.stability.conservative)
+
+
+@pytest.mark.parametrize("chained", [False, True])
+def test_a_batch_solved_in_parts_is_the_batch_to_the_bit(monkeypatch, chained):
+    loads = _loads((5, 8))
+    whole = softarm.statics.Solver(ARM, s=11)
+    one = (whole.solve if chained else whole.solve_from_unloaded)(loads, jacobians=True)
+    monkeypatch.setattr(solver_module, "CASES_PER_PART", 7)  # 40 cases in 6 parts
+    parted = softarm.statics.Solver(ARM, s=11)
+    parts = (parted.solve if chained else parted.solve_from_unloaded)(loads, jacobians=True)
+    _same(one, parts)
+    assert parts.loads[1].force.shape == (5, 8, 3)  # the loads as given
+    assert parts.poses.flags.writeable is False
+
+
+def test_a_failure_in_a_part_names_its_case_in_the_whole_batch(monkeypatch):
+    # a budget of shootings that only the smaller loads meet: the first case over it is
+    # (2, 3) of the (4, 5) batch, in the third part of 5 cases
+    monkeypatch.setattr(solver_module, "CASES_PER_PART", 5)
+    force = np.zeros((4, 5, 3))
+    force[..., 2] = -0.05
+    force[2, 3, 2] = -30.0  # bends the arm through several turns: more shootings
+    loads = [softarm.TipLoad(force=force), softarm.DistributedForce([0.0, 0.0, 0.0])]
+    counts = softarm.statics.Solver(ARM, s=3).solve_from_unloaded(
+        [softarm.TipLoad(force=[0.0, 0.0, -0.05]), softarm.DistributedForce([0.0, 0.0, 0.0])])
+    assert counts.residual < 1e-9
+    with pytest.raises(softarm.ConvergenceError, match=r"for load case \(2, 3\)"):
+        softarm.statics.Solver(ARM, s=3, max_shootings=40).solve_from_unloaded(loads)
+
+
+def test_a_zero_copy_broadcast_batch_too_large_is_a_value_error():
+    force = np.broadcast_to(np.array([0.0, 0.0, 1.0]), (10**6, 10**6, 3))
+    with pytest.raises(ValueError, match=r"TipLoad.force: an array of shape "
+                                         r"\(1000000, 1000000, 3\) would need 24 TB"):
+        softarm.TipLoad(force=force)
+
+
+def test_a_result_that_cannot_fit_is_refused_before_it_is_allocated():
+    # 10⁴ cases × (10⁵ stations × 224 B + 640 B) for the result, and twice as much for the
+    # one part (all 10⁴ cases) whose result is copied into it (_part_work): 672 GB
+    with pytest.raises(ValueError, match=r"loads: 10000 load cases × 100000 stations would "
+                                         r"need 672 GB of memory"):
+        softarm.solve(ARM, _loads((10_000,)), s=100_000)
+
+
+_MEASURE = """
+import json, resource, sys
+import numpy as np, softarm
+import softarm.statics.solver as solver
+from softarm._validate import check_allocation
+solver.CASES_PER_PART = 4096
+silicone = softarm.Material(youngs_modulus=1.5e6, poisson_ratio=0.49, density=1070.0)
+arm = softarm.Arm(0.3, softarm.Circle(0.01), silicone)
+count, stations = int(sys.argv[1]), int(sys.argv[2])
+s = stations if stations > 1 else [0.3]
+def loads(n):
+    force = np.zeros((n, 3)); force[:, 1] = np.linspace(0.0, 0.05, n)
+    return [softarm.Gravity(), softarm.TipLoad(force=force)]
+softarm.solve(arm, loads(20), s=s)          # compiled and warm
+given = loads(count)
+def rss():
+    return int(open("/proc/self/status").read().split("VmRSS:")[1].split()[0]) * 1024
+before = rss()
+eq = softarm.solve(arm, given, s=s)
+peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+guard = check_allocation(count, eq.s.size, work=solver._part_work(count, eq.s.size))
+print(json.dumps({"peak": peak - before, "guard": guard, "kept": rss() - before}))
+"""
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc (Linux)")
+@pytest.mark.parametrize("stations", [1, 101])
+def test_the_guard_assumes_at_least_what_a_batch_takes(stations):
+    count = 30_000
+    run = subprocess.run([sys.executable, "-c", _MEASURE, str(count), str(stations)],
+                         capture_output=True, text=True, timeout=600)
+    assert run.returncode == 0, run.stderr
+    figures = json.loads(run.stdout.splitlines()[-1])
+    # the process's peak resident memory over the batch (result, work of the parts)
+    assert figures["peak"] <= figures["guard"], figures
+    if stations > 1:  # where the result, not one part's work, is most of it: not much more
+        assert figures["guard"] <= 2.0 * figures["peak"], figures
