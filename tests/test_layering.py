@@ -102,7 +102,8 @@ LAYERS = (
     ("routing",),
     ("loads",),
     ("geometry", "view"),  # pictures from arrays: numpy (plotly when a page is written)
-    ("equilibrium",),  # the result type both routes build
+    ("equilibrium", "_admissible"),  # the result type both routes build, and the model's
+    # limits both routes check it against
     ("analytic", "statics"),  # two independent routes (see the tests above)
     ("dispatch",),
     ("stability", "control"),

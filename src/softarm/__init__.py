@@ -11,7 +11,12 @@ from .case import Case, CaseError, load_case
 from .control import ForwardResult, ForwardSolver, InverseResult, InverseSolver, inverse
 from .dispatch import solve
 from .equilibrium import Equilibrium, Stability
-from .errors import ApproximationWarning, ConvergenceError, StabilityWarning
+from .errors import (
+    ApproximationWarning,
+    ConvergenceError,
+    InadmissibleStateError,
+    StabilityWarning,
+)
 from .loads import (
     Chamber,
     DistributedForce,
@@ -43,6 +48,7 @@ __all__ = [
     "ForwardResult",
     "ForwardSolver",
     "Gravity",
+    "InadmissibleStateError",
     "InverseResult",
     "InverseSolver",
     "Load",

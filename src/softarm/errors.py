@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 __all__ = ["ApproximationWarning", "CaseError", "CaseTypeError", "ConvergenceError",
-           "StabilityWarning"]
+           "InadmissibleStateError", "StabilityWarning"]
 
 
 class ConvergenceError(RuntimeError):
-    """The numerical solver did not reach the requested tolerance.
+    """No admissible equilibrium was returned: the numerical solver did not reach the
+    requested tolerance, or the loads lead the arm out of the model
+    (:class:`InadmissibleStateError`).
 
     Attributes
     ----------
@@ -29,6 +31,26 @@ class ConvergenceError(RuntimeError):
         text = f"{message} (residual {self.residual:.3e}"
         text += f"; tried {tried})" if tried else ")"
         super().__init__(text)
+
+
+class InadmissibleStateError(ConvergenceError):
+    """The loads lead the arm out of the rod model, on every route: an axial stretch
+    v₁ <= 0 somewhere (the centreline's tangent p' = R v turns through the cross-section's
+    plane: the arm would be inside out), or a tendon whose path has no length left
+    (|w| -> 0, w = v + u × r + r'), or whose path runs backwards through the sections
+    (w₁ <= 0). The model has no equilibrium there: the message says where and how
+    (docs/solver.md, "The model's limits").
+
+    Attributes (besides :class:`ConvergenceError`'s)
+    ----------
+    station : float or None
+        The arc length s (m) where the state leaves the model, when known.
+    """
+
+    def __init__(self, message: str, residual: float, tried: str = "", *,
+                 load_factor: float | None = None, station: float | None = None):
+        super().__init__(message, residual, tried, load_factor=load_factor)
+        self.station = station
 
 
 class ApproximationWarning(UserWarning):

@@ -16,6 +16,7 @@ from __future__ import annotations
 import abc
 import copy
 import dataclasses
+import functools
 from dataclasses import dataclass, field
 from typing import ClassVar, Protocol
 
@@ -26,6 +27,7 @@ from .routing import Routing
 
 __all__ = [
     "LOAD_KINDS",
+    "LOAD_LIMIT",
     "Chamber",
     "DistributedForce",
     "DistributedMoment",
@@ -39,6 +41,8 @@ __all__ = [
     "TipLoad",
     "as_loads",
     "batch_shape",
+    "check_magnitudes",
+    "path_tangent",
 ]
 
 
@@ -631,6 +635,16 @@ def _check_tangent(obj, arm) -> None:
     _CHECKED_PATHS[key] = arm
 
 
+def path_tangent(position, derivative, strain) -> np.ndarray:
+    """w = v + u × r + r', the tangent of a path r(s) (a tendon's, a chamber's centroid's)
+    through the sections: d(p + R r)/ds in material components, m/m, shape (..., 3), from
+    the path's ``position`` r and ``derivative`` r' (m, m/m, material: a routing's
+    ``position(s)`` and ``derivative(s)``) and the total strain ``strain`` ε = (v; u)
+    (..., 6; f⁰ in the unloaded arm) at the same arc lengths, all broadcasting."""
+    strain = np.asarray(strain, dtype=np.float64)
+    return strain[..., :3] + np.cross(strain[..., 3:], position) + derivative
+
+
 def _check_path(obj, arm, start, end) -> None:
     bounds = arm.boundaries
     for k, segment in enumerate(arm.segments):
@@ -638,8 +652,8 @@ def _check_path(obj, arm, start, end) -> None:
         if lo >= hi:
             continue
         s = np.linspace(lo, hi, 257)
-        f0 = segment.reference_strain
-        w = f0[:3] + np.cross(f0[3:], obj.routing.position(s)) + obj.routing.derivative(s)
+        w = path_tangent(obj.routing.position(s), obj.routing.derivative(s),
+                         segment.reference_strain)
         norm = np.linalg.norm(w, axis=-1)
         if np.min(norm) < 1e-6:
             raise ValueError(
@@ -959,3 +973,138 @@ def batch_shape(loads) -> tuple[int, ...]:
     except ValueError as error:
         raise ValueError(f"loads have batch shapes {shapes} that do not broadcast") from error
 
+
+
+#: The largest load accepted, in units of the arm's bending scale (EI/L² for a force, EI/L
+#: for a moment, EI the largest bending or torsional stiffness of its segments): beyond it the
+#: rod is a string whose shape double precision cannot follow, and closed forms overflow.
+LOAD_LIMIT = 1e12
+
+
+def _largest(value) -> float:
+    """max |value| over every component and case (0 for None or an empty array)."""
+    if value is None:
+        return 0.0
+    value = np.asarray(value)
+    if value.size <= 16:  # (one case: in Python, a third of numpy's call overhead)
+        return max(map(abs, value.ravel().tolist()), default=0.0)
+    return float(np.abs(value).max())
+
+
+@functools.lru_cache(maxsize=256)
+def _reach(routing, length: float) -> float:
+    """``routing.bound(length)``, remembered (routings are frozen and hashable)."""
+    return routing.bound(length)
+
+
+@functools.lru_cache(maxsize=64)
+def _cached_scales(arm) -> tuple[float, ...]:
+    return _scales(arm)
+
+
+def _scales(arm) -> tuple[float, ...]:
+    """(EI/L² in N, EI/L in N m, the largest mass per length in kg/m, magnetisation per
+    length in A m²/m and tip dipole in A m²) of an arm, for :func:`check_magnitudes`."""
+    segments = arm.segments
+    length = float(arm.length)
+    bending = max(float(np.max(np.diagonal(seg.stiffness)[3:])) for seg in segments)
+    mass = max(seg.linear_density or 0.0 for seg in segments)
+    magnets = [max(_largest(getattr(seg, name, None)) for seg in segments)
+               for name in ("magnetization", "tip_magnet")]
+    return bending / length**2, bending / length, mass, *magnets
+
+
+class _Sizes:
+    """A :class:`LoadTarget` that measures a load against the arm's bending scale: the
+    largest force over EI/L² and moment over EI/L it brings (a distributed one over the
+    arm's length, an actuator's pull and its moment arm, a field's torque and force on the
+    arm's magnets), over its whole batch."""
+
+    def __init__(self, arm, scales):
+        self.arm, self.length = arm, float(arm.length)
+        self.force_scale, self.moment_scale, self.mass, self.magnetization, self.dipole = \
+            scales
+        self.size = 0.0
+
+    def _force(self, value: float) -> None:
+        self.size = max(self.size, value / self.force_scale)
+
+    def _moment(self, value: float) -> None:
+        self.size = max(self.size, value / self.moment_scale)
+
+    def distributed(self, *, force=None, moment=None, follower=False, span=None,
+                    per_mass=False):
+        self._force(_largest(force) * (self.mass if per_mass else 1.0) * self.length)
+        self._moment(_largest(moment) * self.length)
+
+    def point(self, s, *, force=None, moment=None):
+        self._force(_largest(force))
+        self._moment(_largest(moment))
+
+    def tip(self, *, force=None, moment=None, follower=False):
+        self.point(self.length, force=force, moment=moment)
+
+    def actuator(self, kind, magnitude, routing, span):
+        pull = _largest(magnitude)
+        self._force(pull)
+        try:
+            reach = _reach(routing, self.length)
+        except TypeError:  # a user's routing class that cannot be hashed
+            reach = routing.bound(self.length)
+        self._moment(pull * reach)
+
+    def displaced_tendon(self, displacement, routing, span):
+        # a length change, measured against the arm's length (the tension is solved)
+        self.size = max(self.size, _largest(displacement) / self.length)
+
+    def field(self, field, gradient=None):
+        # B over the arm: |B0| + |G| L; the torque m × B and the force Gᵀ m on the magnets
+        spread = _largest(gradient) * 3.0
+        B = _largest(field) * 3.0 ** 0.5 + spread * self.length
+        self._moment(B * (self.magnetization * self.length + self.dipole))
+        self._force(spread * (self.magnetization * self.length + self.dipole))
+
+
+def _size(load, arm, scales, target=None) -> float:
+    """A load's size in units of the bending scale (``target``: a :class:`_Sizes` to reuse)."""
+    target = _Sizes(arm, scales) if target is None else target
+    target.size = 0.0
+    load.apply(target)
+    return target.size
+
+
+def check_magnitudes(arm, loads, function: str = "") -> None:
+    """ValueError naming the load (and its field) whose size exceeds :data:`LOAD_LIMIT`
+    times the arm's bending scale: every kind of load, every route (the closed forms and the
+    numerical solver call it before computing anything). ``function``: a prefix for the
+    message (the closed form called)."""
+    try:
+        scales = _cached_scales(arm)
+    except TypeError:  # an unhashable field (never with the model's own types)
+        scales = _scales(arm)
+    if not all(np.isfinite(scales[:2])) or min(scales[:2]) <= 0.0:
+        return  # an arm without a bending scale: its own checks say so
+    target = _Sizes(arm, scales)
+    for load in as_loads(loads):
+        size = _size(load, arm, scales, target)
+        if size <= LOAD_LIMIT:  # (NaN cannot occur: loads and arms are finite)
+            continue
+        size, name, unit = max(_field_sizes(load, arm, scales), default=(size, "", ""))
+        value = _largest(getattr(load, name)) if name else size
+        raise ValueError(
+            f"{function + ': ' if function else ''}{type(load).__name__}"
+            f"{'.' + name if name else ''}: a load of {value:.3g}{' ' + unit if unit else ''} "
+            f"is not representable on this arm: it exceeds {LOAD_LIMIT:.0e} times the bending "
+            f"scale (EI/L² = {scales[0]:.3g} N, EI/L = {scales[1]:.3g} N m), where double "
+            "precision cannot follow the shape")
+
+
+def _field_sizes(load, arm, scales):
+    """(size, field name, unit) of each batchable field of ``load`` alone (the others at
+    zero): which of them makes a load too large (a rare path: the error message's)."""
+    present = [(name, unit) for name, unit, _ in load.arrays
+               if getattr(load, name) is not None]
+    for name, unit in present:
+        others = {other: np.zeros_like(getattr(load, other)) for other, _ in present
+                  if other != name}
+        yield _size(load.replace(**others) if others else load, arm, scales), name, unit

@@ -83,6 +83,9 @@ def critical_load(arm, loads, vary=None, *, max_factor=10.0, steps=STEPS, tol=1e
     ------
     ValueError
         Follower loads or dead couples (nonconservative: no static critical load is claimed).
+    InadmissibleStateError
+        The equilibrium at the critical point, or at ``max_factor`` if none is met, is
+        outside the model (an axial stretch v₁ <= 0: the arm would be inside out).
     """
     max_factor = real(max_factor, "max_factor")
     if not max_factor > 0:
@@ -102,8 +105,12 @@ def critical_load(arm, loads, vary=None, *, max_factor=10.0, steps=STEPS, tol=1e
         if start_index != 0:
             raise ValueError(f"the equilibrium at λ = 0 (the held loads alone) is already "
                              f"unstable (Morse index {start_index})")
-        _, _, critical = follow(path, z0, max_factor, stop_at_critical=True)
+        points, _, critical = follow(path, z0, max_factor, stop_at_critical=True)
         point = critical[0] if critical else None
+        # (the last point followed, or the critical one, inside the model: Path.record
+        # refuses an axial stretch v₁ <= 0, an arm that would be inside out before it
+        # buckles, or before max_factor)
+        path.record(points[-1:] if point is None else path.z(point.x, point.factor)[None])
         if point is None:
             return previous
         if previous is not None and abs(point.factor - previous.factor) <= \

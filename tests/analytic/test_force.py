@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from softarm import Arm
+from softarm import Arm, InadmissibleStateError
 from softarm.analytic import axial_force, elastica, shear_force
 
 # Grazioso et al. 2018, §IV.B (Princeton beam as printed): EIy = 36.28 N m²,
@@ -47,7 +47,8 @@ def test_axial_force_bad_inputs():
         axial_force(_arm(curvature=(0.0, 1.0, 0.0)), [1.0, 0.0, 0.0])
     with pytest.raises(ValueError, match="force must be axial"):
         axial_force(_arm(), [1.0, 0.1, 0.0])
-    with pytest.raises(ValueError, match="-EA"):
+    # EA = 100 N: a compression of EA leaves v₁ = 1 - 100/100 = 0, the arm inside out
+    with pytest.raises(InadmissibleStateError, match=r"axial stretch v₁ = 0 <= 0 at s = 0 m"):
         axial_force(_arm(), [-100.0, 0.0, 0.0])
     with pytest.raises(ValueError, match="force"):
         axial_force(_arm(), 1.0)
@@ -123,8 +124,8 @@ def test_shear_force_bad_inputs():
         shear_force(_arm(curvature=(0.1, 0.0, 0.0)), [0.0, 0.0, 1.0])
     with pytest.raises(ValueError, match="force"):
         shear_force(_arm(), [[0.0, 1.0]])
-    with pytest.raises(ValueError, match="-EA"):
-        shear_force(_arm(), [-200.0, 0.0, 1.0])
+    with pytest.raises(InadmissibleStateError, match=r"axial stretch v₁ = -1 <= 0"):
+        shear_force(_arm(), [-200.0, 0.0, 1.0])  # v₁ = 1 - 200/100
     with pytest.raises(ValueError, match="s must"):
         shear_force(_arm(), [0.0, 0.0, 1.0], s=[0.5, 0.2])
 

@@ -14,6 +14,7 @@ import math
 
 import numpy as np
 
+from .._admissible import check_finite, check_stretch
 from .._threads import THREADS_VARIABLE, in_threads, thread_setting, threads_for
 from .._validate import as_vectors, stations
 from ..equilibrium import Equilibrium
@@ -309,6 +310,11 @@ def build(arm: Arm, s: np.ndarray, poses, strains, loads, method: str, exact: bo
     ``poses``, ``strains`` and ``stresses`` must be fresh arrays (or read-only views of them)
     that nothing else writes to: arrays that own their data are made read-only in place and
     handed to the Equilibrium without a copy. ``stresses`` defaults to σ = K ε.
+
+    Every closed form's answer passes here, so the model's limits are checked here once:
+    ConvergenceError for NaN or inf anywhere (a formula beyond its range in double
+    precision), :class:`~softarm.InadmissibleStateError` for an axial stretch v₁ <= 0 at a
+    station (``softarm._admissible``).
     ``error_estimate`` defaults to 0 for exact results and NaN (unknown) for approximations, as
     :class:`~softarm.Equilibrium` documents.
     """
@@ -319,6 +325,11 @@ def build(arm: Arm, s: np.ndarray, poses, strains, loads, method: str, exact: bo
     if stresses is None:
         stresses = strains * stiffness_diagonal(arm)  # K ε
     stresses = _owned(stresses)
+    # the model's limits (_admissible): an answer, finite, and an arm that is not inside out
+    check_finite(method, poses, 3)
+    check_finite(method, strains, 2)
+    check_finite(method, stresses, 2)
+    check_stretch(strains, s, stresses=stresses, what=f"the equilibrium ({method})")
     shapes = (poses.shape[:-3], strains.shape[:-2], stresses.shape[:-2])
     batch = shapes[0] if shapes[0] == shapes[1] == shapes[2] else np.broadcast_shapes(*shapes)
     poses = _broadcast(poses, (*batch, n, 4, 4))

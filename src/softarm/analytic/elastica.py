@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from ..loads import TipLoad
+from ..loads import TipLoad, check_magnitudes
 from ._common import (
     ROUNDOFF,
     build,
@@ -119,8 +119,10 @@ def elastica(arm, force, s=None, *, extensible=True):
     force = vectors(force, "force", function)
     if not isinstance(extensible, (bool, np.bool_)):
         raise TypeError(f"{function}: extensible must be True or False, got {extensible!r}")
+    loads = (TipLoad(force=force),)
+    check_magnitudes(arm, loads, function)
     return solve_elastica(arm, force, checked_stations(s, arm.length), bool(extensible),
-                          (TipLoad(force=force),), function)
+                          loads, function)
 
 
 def _any(condition) -> bool:

@@ -6,10 +6,10 @@ import dataclasses
 
 import numpy as np
 
-from ..loads import as_loads, batch_shape
+from ..loads import as_loads, batch_shape, check_magnitudes
 from ..model import SegmentedArm, StiffnessMatrix
 from ._common import check_arm, checked_stations, moment_is_principal
-from .actuation import actuated
+from .actuation import solve_actuated
 from .elastica import solve_elastica
 from .force import axial_force
 from .moment import helix_applies, solve_tip_moment
@@ -107,6 +107,7 @@ def exact_closed_form(arm, loads, s=None):
     if not isinstance(arm, SegmentedArm):
         arm = check_arm(arm, "exact_closed_form")
     loads = as_loads(loads)
+    check_magnitudes(arm, loads, "exact_closed_form")
     s = checked_stations(s, arm.length)
     return closed_form(arm, loads, s, batch_shape(loads)) if loads else None
 
@@ -118,7 +119,7 @@ def closed_form(arm, loads: tuple, s: np.ndarray, shape: tuple):
     (never written; the result may keep them)."""
     if not loads:
         return None
-    result = actuated(arm, loads, s)
+    result = solve_actuated(arm, loads, s)
     if result is not None:
         return result
     if isinstance(arm, SegmentedArm) or isinstance(arm.section, StiffnessMatrix):

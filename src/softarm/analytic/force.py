@@ -6,20 +6,10 @@ import numpy as np
 
 from .._validate import stations
 from ..lie import se3, so3
-from ..loads import TipLoad
+from ..loads import TipLoad, check_magnitudes
 from ._common import build, check_arm, constant_strain_poses, negligible, vectors
 
 __all__ = ["axial_force", "shear_force"]
-
-
-def _stretch_check(arm, force, function):
-    """The axial strain F/EA must keep the stretch 1 + F/EA positive."""
-    EA = arm.rigidities.EA
-    if np.any(force[..., 0] <= -EA):
-        raise ValueError(
-            f"{function}: force[..., 0] must exceed -EA = {-EA!r} N (a compression of EA or "
-            f"more inverts the arm), got min {float(np.min(force[..., 0]))!r} N"
-        )
 
 
 def axial_force(arm, force, s=None):
@@ -42,7 +32,9 @@ def axial_force(arm, force, s=None):
         A uniform arm with κ⁰₂ = κ⁰₃ = 0.
     force : array_like, shape (..., 3)
         Tip force in N, (F, 0, 0): tension positive; the y and z components must be zero
-        (use :func:`shear_force`, :func:`linear` or :func:`elastica` otherwise). F > -EA.
+        (use :func:`shear_force`, :func:`linear` or :func:`elastica` otherwise). F > -EA:
+        a compression of EA or more turns the arm inside out (v₁ = 1 + F/EA <= 0), an
+        :class:`~softarm.InadmissibleStateError`.
     s : array_like, shape (N,), or int, optional
         Stations in m (default 101 uniform stations on [0, L]).
 
@@ -79,14 +71,15 @@ def axial_force(arm, force, s=None):
             f"{function}: force must be axial, (F, 0, 0) in N, got a transverse component in "
             f"{force!r}; use shear_force, linear or elastica for transverse forces"
         )
-    _stretch_check(arm, force, function)
+    loads = (TipLoad(force=force),)
+    check_magnitudes(arm, loads, function)
     s = stations(s, arm.length)
     strain = np.zeros((*force.shape[:-1], 6))
     strain[..., 0] = force[..., 0] / arm.rigidities.EA
     poses = constant_strain_poses(arm.reference_strain + strain, s)
     strain.setflags(write=False)  # fresh: its broadcast view goes to the result uncopied
     strains = np.broadcast_to(strain[..., None, :], (*strain.shape[:-1], s.size, 6))
-    return build(arm, s, poses, strains, (TipLoad(force=force),), "analytic.axial_force", True)
+    return build(arm, s, poses, strains, loads, "analytic.axial_force", True)
 
 
 def shear_force(arm, force, s=None):
@@ -113,7 +106,8 @@ def shear_force(arm, force, s=None):
     arm : Arm
         A uniform, initially straight arm (curvature (0, 0, 0)).
     force : array_like, shape (..., 3)
-        Tip force in N (spatial = tip material components to first order). Fx > -EA.
+        Tip force in N (spatial = tip material components to first order). Fx > -EA
+        (else :class:`~softarm.InadmissibleStateError`, as for :func:`axial_force`).
     s : array_like, shape (N,), or int, optional
         Stations in m (default 101 uniform stations on [0, L]).
 
@@ -150,7 +144,8 @@ def shear_force(arm, force, s=None):
             f"{function}: arm must be initially straight, curvature (0, 0, 0), got "
             f"{arm.curvature}; use linear() for a curved arm"
         )
-    _stretch_check(arm, force, function)
+    loads = (TipLoad(force=force),)
+    check_magnitudes(arm, loads, function)
     s = stations(s, arm.length)
     L, r = arm.length, arm.rigidities
     Fx, Fy, Fz = (force[..., i, None] for i in range(3))                 # (B..., 1)
@@ -167,8 +162,7 @@ def shear_force(arm, force, s=None):
     # Leading neglected effect: the shortening ½ ∫ |θ|² ds = (L⁵/15)((Fz/EIy)² + (Fy/EIz)²).
     shortening = L**5 / 15 * ((force[..., 2] / r.EIy) ** 2 + (force[..., 1] / r.EIz) ** 2)
     poses = se3.from_rotation_translation(so3.exp(theta), p)
-    load = (TipLoad(force=force),)
-    return build(arm, s, poses, strains, load, "analytic.shear_force", exact,
+    return build(arm, s, poses, strains, loads, "analytic.shear_force", exact,
                  error_estimate=shortening)
 
 

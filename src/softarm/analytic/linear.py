@@ -6,7 +6,7 @@ import numpy as np
 
 from .._validate import stations
 from ..lie import se3, so3
-from ..loads import TipLoad
+from ..loads import TipLoad, check_magnitudes
 from ._common import (
     build,
     check_arm,
@@ -111,6 +111,7 @@ def linear(arm, force=(0.0, 0.0, 0.0), moment=(0.0, 0.0, 0.0), s=None, *, follow
     follower = check_follower(follower, function)
     s = stations(s, arm.length)
     loads = (TipLoad(force=force, moment=moment, follower=follower),)
+    check_magnitudes(arm, loads, function)
     force, moment = np.broadcast_arrays(force, moment)
     if not follower:
         Rt = so3.exp(arm.length * np.asarray(arm.curvature)).T

@@ -8,7 +8,7 @@ import warnings
 import numpy as np
 
 from ..errors import ApproximationWarning
-from ..loads import TipLoad
+from ..loads import TipLoad, check_magnitudes
 from ._common import (
     E1,
     ROUNDOFF,
@@ -195,8 +195,9 @@ def tip_moment(arm, moment, s=None, *, follower=False):
     arm = check_arm(arm, function)
     moment = vectors(moment, "moment", function)
     follower = check_follower(follower, function)
-    return solve_tip_moment(arm, moment, checked_stations(s, arm.length), follower,
-                            (TipLoad(moment=moment, follower=follower),))
+    loads = (TipLoad(moment=moment, follower=follower),)
+    check_magnitudes(arm, loads, function)
+    return solve_tip_moment(arm, moment, checked_stations(s, arm.length), follower, loads)
 
 
 def solve_tip_moment(arm, moment, s, follower, loads):

@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._admissible import check_stretch, inside_out
 from ..equilibrium import Equilibrium
 from ..errors import ConvergenceError
 from ..loads import as_loads
@@ -237,7 +238,9 @@ class Path:
 
     def record(self, zs) -> Equilibrium:
         """The equilibria at the points zs (one batched Equilibrium, stations of the
-        solver), with their stability."""
+        solver), with their stability; an :class:`~softarm.InadmissibleStateError` for the
+        first point whose axial stretch v₁ <= 0 at a station (the arm inside out: the
+        branch has left the model there)."""
         k, solver = self.k, self.solver
         zs = np.atleast_2d(zs)
         B = zs.shape[0]
@@ -254,6 +257,12 @@ class Path:
         k.record_points(self.base, *self.arm, (np.ascontiguousarray(piece),
                                               np.ascontiguousarray(tip)),
                         xs, self.steps, solver._s_kernel, out)
+        outside = inside_out(strains).any(axis=-1)
+        if outside.any():
+            first = int(np.argmax(outside))
+            check_stretch(strains[first], solver.s, info[first, 0], stresses[first],
+                          f"the branch's point at load factor λ = {lam[first]:.6g}",
+                          float(lam[first]))
         index = np.array([self.index(z)[0] for z in zs])
         for array in (poses, strains, stresses):
             array.setflags(write=False)

@@ -16,6 +16,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .._admissible import batch_part, check_stretch, load_case, tendon_limit
 from .._threads import in_threads, threads_for
 from .._validate import (
     BYTES_PER_STATION,
@@ -26,8 +27,8 @@ from .._validate import (
     stations,
 )
 from ..equilibrium import Equilibrium, Stability
-from ..errors import ConvergenceError
-from ..loads import Gravity, Tendon, as_loads, batch_shape
+from ..errors import ConvergenceError, InadmissibleStateError
+from ..loads import Gravity, Tendon, as_loads, batch_shape, check_magnitudes, path_tangent
 from ..model import Arm, Circle, Material, SegmentedArm
 from ..routing import Straight
 from . import _prefetch
@@ -43,9 +44,6 @@ METHOD = "numeric.shooting"
 _N_MAX = 1 << 15  # largest step count of the fine solution is 2 * _N_MAX / 2
 _IDENTITY = np.eye(4)
 _IDENTITY.setflags(write=False)
-#: The largest load accepted, in units of the bending scale (EI/L², EI/L): beyond it the rod
-#: is a string whose shape double precision cannot follow.
-_LOAD_LIMIT = 1e12
 #: Fewest load cases per thread of a batch: below it a thread costs more than it saves.
 CASES_PER_THREAD = 16
 #: Most load cases solved at once: a larger batch is solved in parts of this size, each
@@ -614,7 +612,17 @@ class PreparedSolve:
         if status[0] != k.OK:
             solver.reset()
             self._last = None
-            raise _failure(k, 0, (), status, self._outs[3], solver, near is not None)
+            error = _failure(k, 0, (), status, self._outs[3], solver, near is not None)
+            if status[0] == k.PATH_FAILED and near is None:
+                error = _tendon_limit(solver, self.loads_at(self.inputs), (), 0, None,
+                                      error.residual) or error
+            raise error
+        try:
+            _admissible(solver, self.strains, self.stresses, solver._s_kernel, (),
+                        self.info[0], True)
+        except InadmissibleStateError:
+            self._last = None
+            raise
         np.copyto(start_piece, piece[0])
         np.copyto(start_tip, tip[0])
         np.copyto(self._q_last, self.inputs)
@@ -853,6 +861,7 @@ class Solver:
             load.check(self.arm)
         cases = math.prod(shape)
         check_allocation(cases, self.s.size, "loads", work=_part_work(cases, self.s.size))
+        check_magnitudes(self.arm, loads)
         return loads, shape
 
     def _prepare(self, loads, extra_cuts=(), *, checked=False):
@@ -867,35 +876,7 @@ class Solver:
         channels = _Channels(data, pieces, shape, count)
         for load in loads:
             load.apply(channels)
-        self._check_magnitudes(loads, channels)
         return loads, shape, count, pieces, channels
-
-    def _check_magnitudes(self, loads, channels) -> None:
-        """ValueError naming the load whose size is not representable against the arm."""
-        k = self.length
-        fs, ms = self._data.scale[0], self._data.scale[3]
-        # a cheap bound first: every channel at its largest, summed (finite loads: no
-        # overflow here)
-        largest = max(_largest(channels.piece), _largest(channels.tip_loads))
-        if largest * 12.0 * max(k, 1.0) / min(fs, ms) <= _LOAD_LIMIT:
-            return
-        with np.errstate(over="ignore", invalid="ignore"):
-            piece = np.abs(channels.piece)
-            tip = np.abs(channels.tip_loads)
-            sizes = np.concatenate([
-                (piece[..., :3] + piece[..., 3:6]).sum(-1).ravel() * k / fs,
-                (piece[..., 6:9] + piece[..., 9:12]).sum(-1).ravel() * k / ms,
-                piece[..., 12:15].sum(-1).ravel() / fs, piece[..., 15:18].sum(-1).ravel() / ms,
-                tip[..., [0, 1, 2, 6, 7, 8]].sum(-1).ravel() / fs,
-                tip[..., [3, 4, 5, 9, 10, 11]].sum(-1).ravel() / ms])
-        if sizes.size and not np.max(sizes) <= _LOAD_LIMIT:
-            load, name = max(((load, name) for load in loads for name, _ in load.vectors),
-                             key=lambda pair: _largest(getattr(*pair)))
-            raise ValueError(
-                f"{type(load).__name__}.{name}: a load of {_largest(getattr(load, name)):.3g} "
-                f"(SI units) is not representable on this arm: it exceeds {_LOAD_LIMIT:.0e} "
-                f"times the bending scale (EI/L² = {fs:.3g} N, EI/L = {ms:.3g} N m), where "
-                "double precision cannot follow the shape")
 
     def _options(self, near: bool = False) -> np.ndarray:
         n_fixed = self.steps if self.steps is not None else 0
@@ -936,13 +917,11 @@ class Solver:
         return self._solve(loads, chained=False, jacobians=jacobians)
 
     def _solve(self, loads, *, chained: bool, jacobians: bool, near: bool = False,
-               outputs: bool = True, checked: bool = False,
-               part: tuple | None = None) -> Equilibrium | None:
+               outputs: bool = True, checked: bool = False) -> Equilibrium | None:
         """``near``: a single case whose path starts at its own loads, from the memory
         :meth:`solve_near` wrote (λ = 0 and λ = 1 the same loads); ``outputs=False``: only
         the memory of a chained solve (the tip its one station, no verdict), None;
-        ``checked``: ``loads`` is what :meth:`check_loads` returned; ``part``: (the whole
-        batch's shape, this part's first case) of a part of a larger batch (for messages)."""
+        ``checked``: ``loads`` is what :meth:`check_loads` returned."""
         if not isinstance(jacobians, (bool, np.bool_)):
             raise TypeError(f"jacobians must be True or False, got {jacobians!r}")
         if not checked:
@@ -1022,7 +1001,13 @@ class Solver:
         if len(failed):
             if chained:
                 self.reset()
-            raise _failure(k, failed[0], shape, status, info, self, near, part)
+            error = _failure(k, failed[0], shape, status, info, self, near)
+            if status[failed[0]] == k.PATH_FAILED and not near:
+                error = _tendon_limit(self, loads, shape, int(failed[0]),
+                                      None if chained else info[failed[0], 2],
+                                      error.residual) or error
+            raise error
+        _admissible(self, strains, stresses, s_kernel, shape, info[:, 0], chained)
         if chained and count:
             self._last = (pieces[0], channels.piece[-1].copy(), channels.tip_loads[-1].copy(),
                           channels.signature())
@@ -1074,9 +1059,9 @@ class Solver:
         for first in range(0, count, CASES_PER_PART):
             index = np.unravel_index(np.arange(first, min(first + CASES_PER_PART, count)),
                                      shape)
-            result = self._solve([_part_of(load, shape, index) for load in loads],
-                                 chained=chained, jacobians=jacobians, outputs=outputs,
-                                 part=(shape, first))
+            with batch_part(shape, first):  # (messages name a case of the whole batch)
+                result = self._solve([_part_of(load, shape, index) for load in loads],
+                                     chained=chained, jacobians=jacobians, outputs=outputs)
             if outputs:
                 whole = whole or _Parts(result, count)
                 whole.put(result, first)
@@ -1243,12 +1228,6 @@ def _unloaded_length(pieces, actuator) -> float:
 _NODES, _WEIGHTS = np.polynomial.legendre.leggauss(24)
 
 
-def _largest(vector) -> float:
-    """max |vector|, 0 if empty (``np.max(..., initial=0.0)`` costs twice as much)."""
-    vector = np.asarray(vector)
-    return float(np.abs(vector).max()) if vector.size else 0.0
-
-
 def _recut(old_starts, old_piece, new_starts) -> np.ndarray:
     """Piece loads given on the cut ``old_starts`` re-expressed on ``new_starts`` (a cut that
     contains every old cut): distributed channels from the old piece that contains the new
@@ -1377,15 +1356,11 @@ class _Parts:
         return dataclasses.replace(self.template, loads=loads, **fields)
 
 
-def _failure(k, b, shape, status, info, solver, near=False, part=None) -> ConvergenceError:
+def _failure(k, b, shape, status, info, solver, near=False) -> ConvergenceError:
     """The ConvergenceError of the first failed case (``near``: of :meth:`Solver.solve_near`,
-    whose path has no load to follow: a failure there means no solution near its start;
-    ``part``: (the whole batch's shape, the first case of this part), for the case's index
-    in the whole batch)."""
+    whose path has no load to follow: a failure there means no solution near its start)."""
     b = int(b)
-    whole, first = part if part is not None else (shape, 0)
-    where = f" for load case {tuple(int(i) for i in np.unravel_index(first + b, whole))}" \
-        if whole else ""
+    where = load_case(b, shape)
     residual, estimate, reached, shootings, N = info[b]
     code = int(status[b])
     tried = f"{int(shootings)} shootings, {2 * int(N)} RK4 steps"
@@ -1420,6 +1395,121 @@ def _failure(k, b, shape, status, info, solver, near=False, part=None) -> Conver
     return ConvergenceError(
         f"Newton's method on the base wrench did not converge at the full load{where}",
         residual, tried)
+
+
+def _admissible(solver, strains, stresses, s, shape, residual, chained: bool) -> None:
+    """The model's limits on what the kernel returned (``softarm._admissible``): an
+    :class:`~softarm.InadmissibleStateError` where the axial stretch v₁ <= 0 at a station
+    (the shooting passes through v₁ = 0 without noticing: the equations stay smooth there);
+    a chained Solver then returns to the unloaded arm, as after a failure."""
+    try:
+        check_stretch(strains.reshape(*shape, *strains.shape[-2:]), s, residual,
+                      stresses.reshape(*shape, *stresses.shape[-2:]))
+    except InadmissibleStateError:
+        if chained:
+            solver.reset()
+        raise
+
+
+#: Load factors, relative to the one the path reached, at which :func:`_tendon_limit` looks
+#: at the tendons' paths: two equilibria just before the failure.
+_PROBES = np.array([1.0 - 1e-3, 1.0 - 2e-3])
+
+
+def _tendon_limit(solver, loads, shape, b: int, reached, residual: float
+                  ) -> ConvergenceError | None:
+    """Why the loading path of case ``b`` failed, if a tendon's path leaves the model
+    there: its length |w| (w = v + u × r + r') or its forward component w₁ reaching 0 at the
+    load factor λ the path reached, ``reached`` (None: the path was not from the unloaded
+    arm; then the case is solved from it, which diagnoses its own failure).
+
+    The kernel says only that its path could not be followed (PATH_FAILED: the constitutive
+    law has no root past that point). Here the equilibria at two load factors just before it
+    are solved again (a Solver of its own, stations every L/200, that diagnoses nothing
+    itself) and each tendon's |w| and w₁ extrapolated linearly to zero in λ
+    (:func:`_tendon_zero`): an :class:`~softarm.InadmissibleStateError` if that zero is where
+    the path stopped (within 1 %); a ConvergenceError that says so if the path stopped short
+    of it with the tendon's path already short (the kernel's law lost its root there). None
+    otherwise (a fold of the arm, or a failure of a path that did not start from the
+    unloaded arm)."""
+    tendons = [load for load in loads if load.kind == "tendon"]
+    if not tendons or getattr(solver, "_probe", False):
+        return None
+    case = _case_loads(loads, shape, b)
+    if reached is None:  # from the unloaded arm, diagnosed by its own failure
+        try:
+            Solver(solver.arm, s=2, tol=solver.tol, base=solver.base,
+                   stability=False).solve_from_unloaded(case)
+        except InadmissibleStateError as error:
+            return error
+        except ConvergenceError:
+            pass
+        return None
+    probe = Solver(solver.arm, s=201, tol=solver.tol, base=solver.base, stability=False)
+    probe._probe = True
+    factors = reached * _PROBES
+    try:
+        eq = probe.solve_from_unloaded([load.scaled(factors) for load in case])
+    except ConvergenceError:
+        return None
+    lam, number, station, vanishes, left = _tendon_zero(eq, tendons, factors)
+    tendon = tendons[number]
+    tension = float(np.asarray(case[loads.index(tendon)].tension))
+    if abs(lam - reached) <= 1e-2 * reached:
+        return tendon_limit(number, tendon.describe(), tension, load_case(b, shape), lam,
+                            f"s = {station:.4g} m", residual, vanishes, station)
+    if lam > reached and left < 0.2:
+        # the kernel's constitutive law lost its root before the limit (its Newton method,
+        # from the tendons-along-d1 guess, can overshoot a tendon's kink where K couples
+        # extension, shear and bending): say so, and where the limit is
+        what = "length" if vanishes else "forward component w₁/|w|"
+        return ConvergenceError(
+            f"the loading path could not be followed beyond load factor λ = {reached:.6g}"
+            f"{load_case(b, shape)}: the constitutive law found no root near tendon {number}'s "
+            f"limit ({tendon.describe()}; its path's {what} has fallen to {left:.3g} of the "
+            f"unloaded arm's at s = {station:.4g} m and would vanish at λ ≈ {lam:.4g}, a "
+            f"tension of about {lam * tension:.4g} N)", residual, load_factor=float(reached))
+    return None
+
+
+def _case_loads(loads, shape, b: int) -> list:
+    """The loads of case ``b`` (C order) of a batch of shape ``shape``, unbatched."""
+    index = np.unravel_index(b, shape) if shape else ()
+    return [load if not load.batch_shape else load.take(
+        tuple(i if n > 1 else 0 for i, n in zip(index[len(index) - len(load.batch_shape):],
+                                                load.batch_shape, strict=True)))
+            for load in loads]
+
+
+def _tendon_zero(eq, tendons, factors) -> tuple:
+    """(λ, tendon number, s, vanishes, value) of the first zero in λ of any tendon's path
+    length |w|/|w₀| (``vanishes``) or forward component w₁/|w| at any station, extrapolated
+    linearly from the equilibria ``eq`` (2, S) at the load factors ``factors`` (2,), and that
+    quantity's value at the first of them."""
+    found = (np.inf, 0, 0.0, True, 1.0)
+    for number, tendon in enumerate(tendons):
+        on = eq.s <= tendon.path_span(eq.arm.length)[1]
+        s = eq.s[on]
+        position, derivative = tendon.routing.position(s), tendon.routing.derivative(s)
+        unloaded = _reference_strains(eq.arm, s)
+        w = path_tangent(position, derivative, eq.strains[:, on] + unloaded)  # (2, S, 3)
+        length = np.linalg.norm(w, axis=-1)
+        w0 = np.linalg.norm(path_tangent(position, derivative, unloaded), axis=-1)
+        for values, vanishes in ((length / w0, True), (w[..., 0] / length, False)):
+            with np.errstate(divide="ignore", invalid="ignore"):
+                zero = np.where(values[0] < values[1], factors[0] + values[0] * (
+                    factors[0] - factors[1]) / (values[1] - values[0]), np.inf)
+            j = int(np.argmin(zero))
+            if zero[j] < found[0]:
+                found = (float(zero[j]), number, float(s[j]), vanishes, float(values[0, j]))
+    return found
+
+
+def _reference_strains(arm, s) -> np.ndarray:
+    """f⁰ (N, 6) of the segment each station s (N,) lies in."""
+    bounds = np.asarray(arm.boundaries)
+    segment = np.clip(np.searchsorted(bounds, s, side="right") - 1, 0, len(arm.segments) - 1)
+    return np.array([seg.reference_strain for seg in arm.segments])[segment]
 
 
 def solve_numeric(arm, loads, *, s=None, tol=1e-8, base=None, jacobians=False,
