@@ -12,8 +12,11 @@ least-squares problem solved by an active-set method, the forward solves followi
 quasi-statically from its last equilibrium. With more inputs than task dimensions the
 minimum-effort solution is returned: the one with the least Σ (q_i / s_i)² (s_i the input
 scales, default 1 in SI units) among those that reach the target, reached by a small
-effort term in every step (its bias on the task error is below 1e-8 of the target tolerance).
-An unreachable target gives the closest reachable point with ``reached=False``.
+effort term in every step of a redundant task (its bias on the task error grows as the
+square of the condition of J diag(s): keep the scaled Jacobian's condition well below 1e6).
+A target missed from the first guess is tried from other starts (the answer without the
+bounds given, projected onto them; Halton points in the bounds) before it is called
+unreachable: then the closest point found, with ``reached=False``.
 """
 
 from __future__ import annotations
@@ -673,8 +676,9 @@ class InverseSolver:
     def solve(self, target, orientation=None) -> InverseResult:
         """The inputs that bring the tip to ``target`` (m, spatial, shape (3,)) or, with
         ``orientation`` (3 × 3 rotation), to that pose, starting from the current inputs and
-        the last equilibrium (quasi-static). A :class:`~softarm.StabilityWarning` if the
-        equilibrium reached is unstable."""
+        the last equilibrium (quasi-static), or after a missed target from the last answer
+        that reached its target, from the unloaded arm. A :class:`~softarm.StabilityWarning`
+        if the equilibrium reached is unstable."""
         result = self._solve(target, orientation)
         warn_unstable(result.equilibrium, 3)
         return result
@@ -829,7 +833,8 @@ class InverseSolver:
 
     def track(self, targets, orientations=None) -> InverseResult:
         """Solve a sequence of targets, (N, 3) positions or (N, 4, 4) poses, each from the
-        last answer: batched fields (``inputs`` (N, n), ``reached`` (N,), ...) and the
+        last answer (after a missed target, from the last answer that reached its target, as
+        :meth:`solve`): batched fields (``inputs`` (N, n), ``reached`` (N,), ...) and the
         equilibria batched along N (their loads: the actuators with inputs of batch shape
         (N,)). One :class:`~softarm.StabilityWarning` if any equilibrium reached is
         unstable, naming the first."""
