@@ -12,11 +12,17 @@ Measures, with wall time (``perf_counter``) beside CPU time (``process_time``):
 - ``InverseSolver.track`` along a smooth path of targets (warm), with 101 output stations
   and with the tip alone;
 - ``scipy.optimize.least_squares`` (bounds τ >= 0, finite-difference Jacobian) on the same
-  targets, each residual evaluation a ``softarm.solve``.
+  targets, each residual evaluation a ``softarm.solve``;
+- (issue 30) a tracked path with one unreachable target in its middle, against the same path
+  without it; ``inverse`` on random reachable targets made by tensions in [0, 10] N, with
+  the bounds (0, 10) N of examples/tendon_robot.toml and without upper bounds, from the
+  first guess alone (``starts=1``) and with the extra starts after a miss (the default);
+  and the cost of the starts on an unreachable target.
 
 Run::
 
     python benchmarks/control.py [--targets 1000] [--track 1000] [--scipy 20]
+                                 [--bounded 300] [--unbounded 100] [--path 100]
 """
 
 from __future__ import annotations
@@ -50,6 +56,9 @@ def main(argv=None):
     parser.add_argument("--targets", type=int, default=1000)
     parser.add_argument("--track", type=int, default=1000)
     parser.add_argument("--scipy", type=int, default=20)
+    parser.add_argument("--bounded", type=int, default=300)
+    parser.add_argument("--path", type=int, default=100)
+    parser.add_argument("--unbounded", type=int, default=100)
     args = parser.parse_args(argv)
     arm = robot()
     gravity = softarm.Gravity(GRAVITY)
@@ -175,6 +184,83 @@ def main(argv=None):
           f"{good}/{args.scipy}; median {1e3 * statistics.median(times):.1f} ms wall / "
           f"{1e3 * statistics.median(cpus):.1f} ms CPU "
           f"({statistics.median(cpus) / inverse_cpu:.1f}× softarm.inverse's CPU)")
+
+    missed_targets(arm, tendons, gravity, args)
+
+
+def missed_targets(arm, tendons, gravity, args):
+    """issue 30: a path with one unreachable target, the extra starts after a miss."""
+    # --- a tracked path with one unreachable target (below the base) in its middle ---------
+    phase = np.linspace(0.0, 2 * np.pi * args.path / 1000, args.path)
+    pattern = 1.5 + 1.2 * np.cos(phase[:, None] - 2 * np.pi * np.arange(3) / 3)
+    path = softarm.solve(arm, loads(pattern), tol=1e-10).tip_position
+    broken = path.copy()
+    broken[args.path // 2] = [0.1, 0.0, -0.2]
+    for targets, label in ((path, "reachable"), (broken, "one unreachable in the middle")):
+        walls, cpus = [], []
+        for _ in range(3):
+            tracker = softarm.InverseSolver(arm, tendons, [gravity], s=[L])
+            start = _clock()
+            result = tracker.track(targets)
+            wall, cpu = _since(start)
+            walls.append(wall)
+            cpus.append(cpu)
+        after = slice(args.path // 2 + 1, None)
+        again = softarm.solve(arm, loads(result.inputs[after]), tol=1e-10).tip_position
+        print(f"track, {args.path} targets, {label}: reached "
+              f"{int(result.reached.sum())}/{args.path} (after the middle "
+              f"{int(result.reached[after].sum())}/{len(again)}, largest tip error re-solved "
+              f"{np.max(np.linalg.norm(again - targets[after], axis=-1)) / L:.1e} L); best of "
+              f"3: {min(walls):.3f} s wall / {min(cpus):.3f} s CPU")
+
+    # --- random reachable targets made by tensions in [0, 10] N, with the bounds (0, 10) N
+    # and without upper bounds: from the first guess alone and with the extra starts ------
+    rng = np.random.default_rng(2)
+    hidden = rng.uniform(0.0, 10.0, size=(max(args.bounded, args.unbounded), 3))
+    hidden[rng.random(hidden.shape) < 0.25] = 0.0  # some slack tendons
+    targets = softarm.solve(arm, loads(hidden), tol=1e-10).tip_position
+    for bounds, count in (((0.0, 10.0), args.bounded), (None, args.unbounded)):
+        outcome = {}
+        for starts in (1, 6):
+            rows = []
+            for target in targets[:count]:
+                start = _clock()
+                answer = softarm.inverse(arm, tendons, target, loads=[gravity], bounds=bounds,
+                                         starts=starts)
+                rows.append((*_since(start), bool(answer.reached), answer.starts))
+            outcome[starts] = rows
+            walls, cpus = [r[0] for r in rows], [r[1] for r in rows]
+            print(f"inverse, bounds {bounds}, {count} targets made by tensions in [0, 10] N, "
+                  f"starts={starts}: reached {sum(r[2] for r in rows)}/{count}; starts used "
+                  f"{np.bincount([r[3] for r in rows]).tolist()} (index: count); median "
+                  f"{1e3 * statistics.median(walls):.1f} ms wall / "
+                  f"{1e3 * statistics.median(cpus):.1f} ms CPU, total {sum(walls):.2f} s wall"
+                  f" / {sum(cpus):.2f} s CPU")
+        missed = [k for k, row in enumerate(outcome[1]) if not row[2]]
+        if missed:
+            first = [outcome[1][k] for k in missed]
+            more = [outcome[6][k] for k in missed]
+            print(f"  the {len(missed)} missed from the first guess: "
+                  f"{sum(r[2] for r in more)} reached with more starts (starts used "
+                  f"{np.bincount([r[3] for r in more]).tolist()}); their median "
+                  f"{1e3 * statistics.median(r[0] for r in first):.1f} → "
+                  f"{1e3 * statistics.median(r[0] for r in more):.1f} ms wall, "
+                  f"{1e3 * statistics.median(r[1] for r in first):.1f} → "
+                  f"{1e3 * statistics.median(r[1] for r in more):.1f} ms CPU")
+
+    # --- what the starts cost on an unreachable target ------------------------------------
+    for bounds in (None, (0.0, 10.0)):
+        for starts in (1, 6):
+            times = []
+            for _ in range(5):
+                start = _clock()
+                answer = softarm.inverse(arm, tendons, [0.1, 0.0, -0.2], loads=[gravity],
+                                         bounds=bounds, starts=starts)
+                times.append(_since(start))
+            print(f"inverse, an unreachable target (below the base), bounds {bounds}, "
+                  f"starts={starts}: error {answer.error:.3g} L after {answer.starts} "
+                  f"start(s); median {1e3 * statistics.median(t[0] for t in times):.1f} ms "
+                  f"wall / {1e3 * statistics.median(t[1] for t in times):.1f} ms CPU")
 
 
 if __name__ == "__main__":

@@ -12,8 +12,11 @@ least-squares problem solved by an active-set method, the forward solves followi
 quasi-statically from its last equilibrium. With more inputs than task dimensions the
 minimum-effort solution is returned: the one with the least Σ (q_i / s_i)² (s_i the input
 scales, default 1 in SI units) among those that reach the target, reached by a small
-effort term in every step (its bias on the task error is below 1e-8 of the target tolerance).
-An unreachable target gives the closest reachable point with ``reached=False``.
+effort term in every step of a redundant task (its bias on the task error grows as the
+square of the condition of J diag(s): keep the scaled Jacobian's condition well below 1e6).
+A target missed from the first guess is tried from other starts (the answer without the
+bounds given, projected onto them; Halton points in the bounds) before it is called
+unreachable: then the closest point found, with ``reached=False``.
 """
 
 from __future__ import annotations
@@ -100,13 +103,17 @@ class InverseResult:
         The remaining task error: the distance to the target / L, or with an orientation the
         larger of that and the rotation angle to the target orientation in rad.
     iterations : int or ndarray (B...)
-        Forward solves with Jacobians used after the first (the full route), or
-        integrations with the input columns (the fast route from a prepared solver's last
-        equilibrium; docs/control.md).
+        Of the start that gave the answer: forward solves with Jacobians used after the
+        first (the full route), or integrations with the input columns (the fast route from
+        a prepared solver's last equilibrium; docs/control.md).
     at_bound : ndarray of bool, shape (B..., n)
         Which inputs sit at a bound (a slack tendon: tension 0).
     condition : float or ndarray (B...)
         The condition number of the weighted task Jacobian at the answer.
+    starts : int or ndarray (B...)
+        How many starting points were tried: 1 when the first guess reached the target;
+        after a miss, up to ``InverseSolver``'s ``starts`` (an answer with ``reached=False``
+        tried them all).
     """
 
     inputs: np.ndarray
@@ -116,6 +123,7 @@ class InverseResult:
     iterations: int | np.ndarray
     at_bound: np.ndarray
     condition: float | np.ndarray
+    starts: int | np.ndarray
 
 
 class ForwardResult(NamedTuple):
@@ -319,19 +327,29 @@ class InverseSolver:
     bounds : (lower, upper), optional
         Per input (arrays of shape (n,), ±inf allowed). Tensions are always >= 0;
         displacement inputs take no bound (±inf).
-    scales : array_like, shape (n,), optional
-        Input scales s_i of the effort Σ (q_i/s_i)² minimised when the task is redundant, and
-        of the Levenberg–Marquardt damping (default: 1 in SI units for every input).
+    scales : float or array_like, shape (n,), optional
+        Input scales s_i (in [1e-100, 1e100]) of the effort Σ (q_i/s_i)² minimised when the
+        task is redundant, and of the Levenberg–Marquardt damping (default: 1 in SI units
+        for every input).
     tol : float
         Position tolerance relative to L (orientation: rad).
     max_iterations : int
-        Forward solves with Jacobians per target.
+        Forward solves with Jacobians per start.
+    starts : int
+        The most starting points tried for a target before it is called unreachable
+        (default 6): the first guess; after a miss, the answer without the bounds given
+        (tensions stay >= 0) projected onto them, then points of a Halton sequence in the
+        bounds (docs/control.md, "Local minima"). 1: the first guess only.
     s, solver_tol : stations and the forward solver's tolerance (relative to L; default
         tol / 10).
+
+    After a target that is not reached, the next one starts from the last answer that
+    reached its target (or the first guess), from the unloaded arm: the closest point to an
+    unreachable target can be far from everything else.
     """
 
     def __init__(self, arm, actuators, loads=(), *, bounds=None, scales=None, tol=1e-6,
-                 max_iterations=10, s=None, solver_tol=None):
+                 max_iterations=10, starts=6, s=None, solver_tol=None):
         self.arm = arm
         self.actuators = _actuator_loads(actuators)
         self.loads = as_loads(loads)
@@ -339,6 +357,7 @@ class InverseSolver:
         if not self.tol > 0.0:
             raise ValueError(f"tol must be > 0, got {self.tol!r}")
         self.max_iterations = count(max_iterations, "max_iterations", 1)
+        self.starts = count(starts, "starts", 1)
         self.length = float(arm.length)
         solver_tol = 0.1 * self.tol if solver_tol is None else solver_tol
         # displacement-controlled tendons are solved in their tensions (self._actuators)
@@ -387,12 +406,15 @@ class InverseSolver:
             raise ValueError(f"bounds must satisfy lower <= upper (tensions >= 0), got "
                              f"lower {lower.tolist()}, upper {upper.tolist()}")
         self.lower, self.upper = lower, upper
-        self.scales = np.ones(n) if scales is None else np.broadcast_to(
-            np.asarray(scales, dtype=float), (n,)).copy()
-        if not np.all(self.scales > 0):
-            raise ValueError(f"scales must be > 0, got {self.scales.tolist()}")
+        # the bounds of the model alone (tensions >= 0): a start after a miss drops the others
+        self._model_bounds = (np.where(tension, 0.0, -np.inf), np.full(n, np.inf))
+        self.scales = np.ones(n) if scales is None else _scales(scales, n)
         self.q = np.clip(self.q, lower, upper)
         self.solver = Solver(arm, s=s, tol=solver_tol)
+        # where a target after a miss starts (_solve): the last answer that reached its
+        # target, at first the first target's first guess (None until then)
+        self._sane = None
+        self._missed = None  # self.q after a miss (its closest point), until the next target
 
     def _in_tensions(self, arm, s, solver_tol):
         """The actuators with each displacement-controlled tendon under tension control,
@@ -495,19 +517,43 @@ class InverseSolver:
     def _singular(self, J) -> np.ndarray:
         """The singular values of the weighted task Jacobian J (task × inputs) in scaled
         inputs (J diag(s)), largest first."""
-        return np.linalg.svd(J * self.scales, compute_uv=False)
+        try:
+            return np.linalg.svd(J * self.scales, compute_uv=False)
+        except np.linalg.LinAlgError as error:  # not finite (overflow) or no convergence
+            raise ConvergenceError(
+                f"inverse statics: no singular values of the task Jacobian in scaled inputs "
+                f"({error}; largest entry {np.max(np.abs(J)):.3g}, scales "
+                f"{self.scales.tolist()})", np.nan, "the singular value decomposition "
+                "of the Jacobian at the current inputs") from None
 
     def _redundant(self, J) -> bool:
         """More inputs than the rank of the weighted task Jacobian J in scaled inputs (the
         kernel's ``redundant_task``, the fast route's rule)."""
         return bool(_kernels().redundant_task(self._singular(J), self.n_inputs))
 
-    def _step(self, J, b, q, mu):
+    def _step(self, J, b, q, mu, redundant):
         """The bounded Gauss–Newton step δq for the weighted task Jacobian J and right-hand
         side b: in scaled inputs u = q/s, min |J δu - b|² + μ σ² |δu|² + ε σ² |u + δu|²
-        (σ = |J|_F) within the bounds; ε (1e-12) picks the least effort along the task's
-        null space and moves the task solution by ~1e-12 relative."""
-        return regularised_step(J, b, q, self.scales, mu, self.lower, self.upper)
+        (σ = |J s|_F) within the bounds; ε (1e-12) picks the least effort along the task's
+        null space when the task is ``redundant``, and is 0 when it is not.
+
+        (Not redundant, the effort term has nothing to pick, and it would bias the answer:
+        along the weakest direction of J s, of singular value σ / c, it weighs ε c² against
+        the task. The nitinol robot has c ≈ 8e3 with unit scales; scales 100 apart make
+        c ≈ 1e6, ε c² ≈ 1, and every target was missed by 3e-5 L, ``tests/test_control.py``.
+        A redundant task keeps the term, and that limit: c² well below 1/ε.)"""
+        if redundant:
+            return regularised_step(J, b, q, self.scales, mu, self.lower, self.upper)
+        scales = self.scales
+        Js = J * scales
+        n = scales.size
+        sigma = max(math.sqrt(float(np.sum(Js * Js))), 1e-300)
+        u = q / scales
+        step, _ = _kernels().box_least_squares(
+            np.vstack([Js, math.sqrt(mu) * sigma * np.eye(n)]),
+            np.concatenate([b, np.zeros(n)]), self.lower / scales - u,
+            self.upper / scales - u, 100)
+        return step * scales
 
     def _shooting_newton(self, q, target, orientation, snapshot=False):
         """The fast route: Newton on the base reaction x and the inputs q together, one
@@ -588,9 +634,12 @@ class InverseSolver:
                    zeros[2] if miss is None else miss[1],
                    zeros[3] if miss is None else miss[2])
         info = work.info
-        k.inverse_newton(x, q, every, first, steps, base, *arm, units, goal,
-                         (self.lower, self.upper, self.scales), work.settings, warm_in,
-                         (work.A, work.G, work.J, work.linear, work.singular), info)
+        try:
+            k.inverse_newton(x, q, every, first, steps, base, *arm, units, goal,
+                             (self.lower, self.upper, self.scales), work.settings, warm_in,
+                             (work.A, work.G, work.J, work.linear, work.singular), info)
+        except np.linalg.LinAlgError:  # (its SVD of a Jacobian that overflowed): the full
+            return None               # route, whose forward solves check their own values
         if info[0] != k.NEWTON_DONE:
             return None  # diverging, or the cap: the full-solve route, damped, from q
         try:
@@ -622,13 +671,14 @@ class InverseSolver:
         at_bound = (q <= self.lower) | (q >= self.upper)
         # (track builds one batched Equilibrium from its targets' snapshots at the end)
         eq = confirm.snapshot() if snapshot else confirm.equilibrium()
-        return InverseResult(q.copy(), eq, True, size, int(info[1]), at_bound, condition)
+        return InverseResult(q.copy(), eq, True, size, int(info[1]), at_bound, condition, 1)
 
     def solve(self, target, orientation=None) -> InverseResult:
         """The inputs that bring the tip to ``target`` (m, spatial, shape (3,)) or, with
         ``orientation`` (3 × 3 rotation), to that pose, starting from the current inputs and
-        the last equilibrium (quasi-static). A :class:`~softarm.StabilityWarning` if the
-        equilibrium reached is unstable."""
+        the last equilibrium (quasi-static), or after a missed target from the last answer
+        that reached its target, from the unloaded arm. A :class:`~softarm.StabilityWarning`
+        if the equilibrium reached is unstable."""
         result = self._solve(target, orientation)
         warn_unstable(result.equilibrium, 3)
         return result
@@ -645,7 +695,91 @@ class InverseSolver:
             if orientation.shape != (3, 3) or not np.allclose(
                     orientation @ orientation.T, np.eye(3), atol=1e-9):
                 raise ValueError("orientation must be a 3 × 3 rotation matrix")
+        if self._missed is not None and self.q is self._missed:
+            # the last target was missed: its closest point can be anywhere (tensions of
+            # 1e4 N pulling towards a target off the workspace), and a path followed from
+            # there misses every later target too. Start from the last answer that reached
+            # its target instead, from the unloaded arm
+            self.q = self._sane.copy()
+            self._from_unloaded()
+        self._missed = None
         q = np.minimum(np.maximum(self.q, self.lower), self.upper)  # (np.clip: 3× the cost)
+        if self._sane is None:
+            self._sane = q.copy()  # the first guess, until a target is reached
+        result = self._attempt(q, target, orientation, snapshot)
+        if not result.reached and self.starts > 1:
+            result = self._more_starts(q, target, orientation, snapshot, result)
+        if result.reached:
+            self._sane = self.q.copy()
+        else:
+            self._missed = self.q
+        return result
+
+    def _from_unloaded(self) -> None:
+        """Forget the last equilibrium: the next solve starts from the unloaded arm."""
+        self.solver.reset()
+        self._warm = None
+
+    def _more_starts(self, first_guess, target, orientation, snapshot, missed):
+        """After a miss from ``first_guess``: the same target from other starting points,
+        each from the unloaded arm (docs/control.md, "Local minima"), until one reaches it
+        or ``starts`` were tried; the answer that reached it, else the closest one found. A
+        start whose forward solve fails is counted and left.
+
+        The starts, in order: if bounds narrower than the model's (tensions >= 0) were
+        given, the answer without them from the first guess, taken if it lies within them,
+        else projected onto them as the next start; then the Halton points
+        (:func:`_halton`) in the box of the bounds, each infinite side of the box at the
+        largest magnitude of that input among the first guess, the last answer that reached
+        its target and the input's scale (not the answers of this target: a miss can run
+        far out, e.g. to tensions of 1e4 N compressing the arm)."""
+        best, best_q, tried = missed, self.q, 1
+        lower, upper = self.lower, self.upper
+
+        def attempt(start, bounds=(lower, upper)):
+            """The answer from ``start`` within ``bounds``, or None if a forward solve
+            failed."""
+            nonlocal tried
+            tried += 1
+            self._from_unloaded()
+            self.lower, self.upper = bounds
+            try:
+                return self._attempt(start, target, orientation, snapshot)
+            except (ConvergenceError, ValueError):  # (ValueError: the solver's check of
+                return None                         # the loads' magnitude)
+            finally:
+                self.lower, self.upper = lower, upper
+
+        def better(result):
+            nonlocal best, best_q
+            if result is not None and (result.reached or result.error < best.error):
+                best, best_q = result, self.q
+            return best.reached
+
+        model = self._model_bounds
+        if np.any(lower > model[0]) or np.any(upper < model[1]):
+            free = attempt(first_guess, model)
+            if free is not None:
+                q = self.q
+                if np.all((q >= lower) & (q <= upper)):  # an answer of the bounded problem
+                    better(dataclasses.replace(free, at_bound=(q <= lower) | (q >= upper)))
+                elif tried < self.starts:
+                    better(attempt(np.minimum(np.maximum(q, lower), upper)))
+        if not best.reached and tried < self.starts:
+            largest = np.maximum(np.max(np.abs([first_guess, self._sane]), axis=0),
+                                 self.scales)
+            low = np.where(np.isfinite(lower), lower, -largest)
+            high = np.where(np.isfinite(upper), upper, largest)
+            for point in _halton(self.starts - tried, self.n_inputs):
+                if better(attempt(low + point * (high - low))):
+                    break
+        self.q = best_q
+        return dataclasses.replace(best, starts=tried)
+
+    def _attempt(self, q, target, orientation, snapshot) -> InverseResult:
+        """The answer from the first guess q (within the bounds), from the Solver's last
+        equilibrium (or one solve at q when it has none): the fast route, else the full
+        route. Sets ``self.q`` to the answer's inputs (in tensions)."""
         if self.solver.last_solution() is None and not self._displaced:
             # cold: one solve at the current inputs (its memory only: tip station, no
             # verdict) puts the fast route in reach (a cold inverse of the nitinol robot:
@@ -669,7 +803,7 @@ class InverseSolver:
             # in scaled inputs u = q/s: min |J δu - e|² + μ σ² |δu|² + ε σ² |u + δu|²,
             # within the bounds; ε (1e-12) picks the least effort along the task's null
             # space and moves the task solution by ~1e-12 relative
-            step = self._step(w[:, None] * A[:e.size], e, q, mu)
+            step = self._step(w[:, None] * A[:e.size], e, q, mu, redundant)
             trial = np.clip(q + step, self.lower, self.upper)
             try:
                 eq_t, A_t = self._forward(trial)
@@ -695,11 +829,12 @@ class InverseSolver:
         at_bound = (q <= self.lower) | (q >= self.upper)
         inputs, eq = self._displacement_answer(q, eq)
         return InverseResult(inputs, eq, bool(size <= self.tol), float(size), iterations,
-                             at_bound, condition)
+                             at_bound, condition, 1)
 
     def track(self, targets, orientations=None) -> InverseResult:
         """Solve a sequence of targets, (N, 3) positions or (N, 4, 4) poses, each from the
-        last answer: batched fields (``inputs`` (N, n), ``reached`` (N,), ...) and the
+        last answer (after a missed target, from the last answer that reached its target, as
+        :meth:`solve`): batched fields (``inputs`` (N, n), ``reached`` (N,), ...) and the
         equilibria batched along N (their loads: the actuators with inputs of batch shape
         (N,)). One :class:`~softarm.StabilityWarning` if any equilibrium reached is
         unstable, naming the first."""
@@ -725,7 +860,8 @@ class InverseSolver:
             inputs, equilibrium,
             np.array([r.reached for r in results]), np.array([r.error for r in results]),
             np.array([r.iterations for r in results]),
-            np.array([r.at_bound for r in results]), np.array([r.condition for r in results]))
+            np.array([r.at_bound for r in results]), np.array([r.condition for r in results]),
+            np.array([r.starts for r in results]))
 
     def _stacked(self, equilibria, inputs) -> Equilibrium:
         """The equilibria of a tracked path, one per target, batched along it (the
@@ -772,21 +908,61 @@ def _size(e) -> float:
     return math.sqrt(max(float(e[:3] @ e[:3]), float(e[3:] @ e[3:]) if e.size > 3 else 0.0))
 
 
+def _scales(scales, n) -> np.ndarray:
+    """The input scales: a number in [1e-100, 1e100], or n of them, as an array (n,). (The
+    iteration squares them, and their products with the Jacobian's entries: far outside
+    that range the squares underflow or overflow.)"""
+    try:
+        values = np.asarray(scales, dtype=np.float64)
+    except (TypeError, ValueError):
+        values = None
+    if values is None or values.shape not in ((), (n,)) or not (
+            np.all(values >= 1e-100) and np.all(values <= 1e100)):
+        raise ValueError(f"scales must be a positive number in [1e-100, 1e100] (each input's "
+                         f"unit of effort, in its SI unit) or {n} of them (one per input), got "
+                         f"{scales!r}")
+    return np.broadcast_to(values, (n,)).copy()
+
+
+def _halton(count, dimension) -> np.ndarray:
+    """The Halton points 1 .. count in [0, 1)^dimension, (count, dimension): coordinate j of
+    point k is the radical inverse of k in the j-th prime base (the digits of k mirrored
+    about the radix point), unscrambled: deterministic, and spread evenly from the first
+    points on (point 0, the corner at the origin, left out)."""
+    primes = []
+    candidate = 2
+    while len(primes) < dimension:
+        if all(candidate % p for p in primes):
+            primes.append(candidate)
+        candidate += 1
+    points = np.zeros((count, dimension))
+    for j, base in enumerate(primes):
+        for k in range(1, count + 1):
+            rest, unit = k, 1.0 / base
+            while rest:
+                rest, digit = divmod(rest, base)
+                points[k - 1, j] += digit * unit
+                unit /= base
+    return points
+
+
 def _input_count(load) -> int:
     return sum(int(np.prod(np.shape(getattr(load, name))[len(load.batch_shape):]) or 1)
                for name in load.inputs)
 
 
 def inverse(arm, actuators, target, *, loads=(), bounds=None, orientation=None, scales=None,
-            x0=None, tol=1e-6, max_iterations=10) -> InverseResult:
+            x0=None, tol=1e-6, max_iterations=10, starts=6) -> InverseResult:
     """The actuation inputs that bring the tip of ``arm`` to ``target`` (m, spatial), or to
     the pose (``target``, ``orientation``), under the other ``loads``.
 
     ``actuators`` are the actuation loads (e.g. three :class:`~softarm.Tendon`); their
     current values (or ``x0``, shape (n,)) are the first guess. Tensions stay >= 0; other
-    inputs within ``bounds`` = (lower, upper) if given. See :class:`InverseSolver` and
-    :class:`InverseResult`. An unreachable target returns the closest reachable point with
-    ``reached=False``; a ConvergenceError only if the forward solver fails.
+    inputs within ``bounds`` = (lower, upper) if given. After a miss from the first guess,
+    other starts are tried, ``starts`` in all (``InverseResult.starts`` says how many were).
+    See :class:`InverseSolver` and :class:`InverseResult`. An unreachable target returns the
+    closest reachable point found with ``reached=False``; a ConvergenceError only if the
+    forward solver fails from the first guess.
 
     Examples
     --------
@@ -802,7 +978,7 @@ def inverse(arm, actuators, target, *, loads=(), bounds=None, orientation=None, 
     (True, [1.2, 0.4])
     """
     solver = InverseSolver(arm, actuators, loads, bounds=bounds, scales=scales, tol=tol,
-                           max_iterations=max_iterations)
+                           max_iterations=max_iterations, starts=starts)
     if x0 is not None:
         x0 = np.asarray(x0, dtype=float)
         if x0.shape != (solver.n_inputs,) or not np.all(np.isfinite(x0)):
@@ -810,7 +986,8 @@ def inverse(arm, actuators, target, *, loads=(), bounds=None, orientation=None, 
                              f"got {x0!r}")
         if solver._displaced:  # a displacement first guess: its tensions, solved again
             solver = InverseSolver(arm, solver.actuators_at(x0), loads, bounds=bounds,
-                                   scales=scales, tol=tol, max_iterations=max_iterations)
+                                   scales=scales, tol=tol, max_iterations=max_iterations,
+                                   starts=starts)
         else:
             solver.q = np.clip(x0, solver.lower, solver.upper)
     result = solver._solve(target, orientation)
