@@ -170,8 +170,29 @@ def test_convergence_failure_exit_1(tmp_path, capsys, monkeypatch):
     out = tmp_path / "out.csv"
     code, _, stderr = run(capsys, "solve", FIG2, "-o", out)
     assert code == 1
-    assert stderr.count("\n") == 1 and "residual 3.500e-02" in stderr
+    assert stderr == ("softarm: the solver did not converge: did not converge (residual "
+                      "3.500e-02; tried 30 iterations)\n")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_the_model_limits_message_reaches_the_command_line(tmp_path, capsys):
+    # a tip force of 1.5 EA (EA = π 1e-4 m² × 1 MPa) against the axis: the arm would be
+    # inside out (issue 30); the
+    # command says why, in one line, not only a residual
+    case = tmp_path / "inside_out.toml"
+    case.write_text("""
+[arm]
+length = 0.1
+section = { kind = "circle", radius = 0.01 }
+material = { E = 1.0e6, nu = 0.49 }
+[[load]]
+kind = "tip"
+force = [-471.23889803846896, 0.0, 0.0]
+""")
+    code, _, stderr = run(capsys, "solve", case)
+    assert code == 1 and stderr.count("\n") == 1
+    assert stderr.startswith("softarm: no equilibrium: the equilibrium is outside the rod "
+                             "model: the axial stretch v₁ = -0.5")
 
 
 def test_progress_bar_only_when_slow():

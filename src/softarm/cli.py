@@ -45,7 +45,7 @@ import numpy as np
 
 from . import __version__
 from .case import Case, CaseError, load_case
-from .errors import ConvergenceError, StabilityWarning
+from .errors import ConvergenceError, InadmissibleStateError, StabilityWarning
 from .io import FORMATS, load_saved, save_result
 from .sweep import solve_case
 
@@ -345,9 +345,10 @@ def _main(argv: Sequence[str] | None) -> int:
         return args.run(args)
     except CaseError as error:
         return _fail(2, f"softarm: error: {error}")
-    except ConvergenceError as error:
-        return _fail(1, f"softarm: the solver did not converge: residual {error.residual:.3e} "
-                     f"(N, N m){'; tried ' + error.tried if error.tried else ''}")
+    except InadmissibleStateError as error:  # the model has no equilibrium there
+        return _fail(1, f"softarm: no equilibrium: {error}")
+    except ConvergenceError as error:  # (its message says what and why, with the residual)
+        return _fail(1, f"softarm: the solver did not converge: {error}")
     except BrokenPipeError:  # e.g. `softarm solve case.toml | head`
         with contextlib.suppress(OSError):
             os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
@@ -367,7 +368,7 @@ def _main(argv: Sequence[str] | None) -> int:
 _FAILURES = {errno.ENOSPC, errno.EFBIG, errno.EIO, getattr(errno, "EDQUOT", errno.ENOSPC)}
 
 
-def _line(message: str, limit: int = 400) -> str:
+def _line(message: str, limit: int = 600) -> str:
     """``message`` on one line, cut to ``limit`` characters (no multi-line array dumps)."""
     text = " ".join(str(message).split())
     return text if len(text) <= limit else text[: limit - 1] + "…"
