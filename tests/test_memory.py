@@ -75,10 +75,10 @@ def test_a_zero_copy_broadcast_batch_too_large_is_a_value_error():
 
 
 def test_a_result_that_cannot_fit_is_refused_before_it_is_allocated():
-    # 10⁴ cases × (10⁵ stations × 224 B + 640 B) for the result, and twice as much for the
-    # one part (all 10⁴ cases) whose result is copied into it (_part_work): 672 GB
+    # 10⁴ cases × (10⁵ stations × 224 B + 640 B) for the result, and three parts' work
+    # (PART_BYTES, 64 MiB each): 224 GB
     with pytest.raises(ValueError, match=r"loads: 10000 load cases × 100000 stations would "
-                                         r"need 672 GB of memory"):
+                                         r"need 224 GB of memory"):
         softarm.solve(ARM, _loads((10_000,)), s=100_000)
 
 
@@ -87,15 +87,24 @@ import json, sys
 import numpy as np, softarm
 import softarm.statics.solver as solver
 from softarm._validate import check_allocation
-solver.CASES_PER_PART = 4096
+from softarm.routing import Straight
 silicone = softarm.Material(youngs_modulus=1.5e6, poisson_ratio=0.49, density=1070.0)
 arm = softarm.Arm(0.3, softarm.Circle(0.01), silicone)
-count, stations = int(sys.argv[1]), int(sys.argv[2])
+kind, count, stations = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
 s = stations if stations > 1 else [0.3]
-def loads(n):
-    force = np.zeros((n, 3)); force[:, 1] = np.linspace(0.0, 0.05, n)
-    return [softarm.Gravity(), softarm.TipLoad(force=force)]
-softarm.solve(arm, loads(20), s=s)          # compiled and warm
+def loads(n):  # each kind takes its own route: numeric, or a closed form
+    x, vector = np.linspace(0.001, 0.05, n), np.zeros((n, 3))
+    if kind == "numeric":
+        vector[:, 1] = x
+        return [softarm.Gravity(), softarm.TipLoad(force=vector)]
+    if kind == "elastica":
+        vector[:, 1], vector[:, 2] = x, -0.01
+        return [softarm.TipLoad(force=vector)]
+    if kind == "tendon":
+        return [softarm.Tendon(50 * x, Straight(0.0, 0.005))]
+    vector[:, 1], vector[:, 0] = x * 0.2, x * 0.05  # a helix
+    return [softarm.TipLoad(moment=vector)]
+warm = softarm.solve(arm, loads(20), s=s)  # compiled and warm
 given = loads(count)
 def status(key):  # resident memory now (VmRSS) or at its peak (VmHWM), bytes
     return int(open("/proc/self/status").read().split(key + ":")[1].split()[0]) * 1024
@@ -104,20 +113,25 @@ with open("/proc/self/clear_refs", "w") as file:  # the peak from here on (Linux
 before = status("VmRSS")
 eq = softarm.solve(arm, given, s=s)
 peak = status("VmHWM")
-guard = check_allocation(count, eq.s.size, work=solver._part_work(count, eq.s.size))
-print(json.dumps({"peak": peak - before, "guard": guard, "kept": status("VmRSS") - before}))
+guard = check_allocation(count, eq.s.size)
+print(json.dumps({"method": eq.method, "peak": peak - before, "guard": guard,
+                  "kept": status("VmRSS") - before}))
 """
 
 
 @pytest.mark.slow
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc (Linux)")
 @pytest.mark.parametrize("stations", [1, 101])
-def test_the_guard_assumes_at_least_what_a_batch_takes(stations):
+@pytest.mark.parametrize(("kind", "method"), [
+    ("numeric", "numeric.shooting"), ("elastica", "analytic.elastica"),
+    ("tendon", "analytic.actuated"), ("moment", "analytic.tip_moment.helix")])
+def test_the_guard_assumes_at_least_what_a_batch_takes(kind, method, stations):
     count = 30_000
-    run = subprocess.run([sys.executable, "-c", _MEASURE, str(count), str(stations)],
+    run = subprocess.run([sys.executable, "-c", _MEASURE, kind, str(count), str(stations)],
                          capture_output=True, text=True, timeout=600)
     assert run.returncode == 0, run.stderr
     figures = json.loads(run.stdout.splitlines()[-1])
+    assert figures["method"] == method  # (the route meant)
     # the process's peak resident memory over the batch (result, work of the parts)
     assert figures["peak"] <= figures["guard"], figures
     if stations > 1:  # where the result, not one part's work, is most of it: not much more

@@ -46,6 +46,12 @@ BYTES_PER_STATION = 28 * 8
 #: Bytes of a result per load case besides its stations (residual, error estimate, base
 #: wrench, verdict, ...): measured 200-610 B (tests/test_memory.py)
 BYTES_PER_CASE = 640
+#: The work (bytes) one part of a batch may take beside the result: every route cuts a large
+#: batch into parts of this much work (load channels, solver or closed-form arrays, a part's
+#: own result before it is copied in), so that a batch needs its result's memory and at most
+#: three times this (measured up to 2.2: the part being solved with its result, and what the
+#: allocator still holds of the one before, tests/test_memory.py)
+PART_BYTES = 1 << 26
 
 #: Largest deviation ‖RᵀR − I‖ (max entry) of a base rotation that is re-orthonormalised; a
 #: rotation off by more is rejected.
@@ -319,13 +325,13 @@ def check_array_size(shape, name: str) -> None:
 
 def check_allocation(cases, stations, name: str = "the result", *,
                      per_station: float = BYTES_PER_STATION,
-                     per_case: float = BYTES_PER_CASE, work: float = 0.0) -> int:
+                     per_case: float = BYTES_PER_CASE, work: float = 3 * PART_BYTES) -> int:
     """Reject, before allocating, a result of ``cases`` × ``stations`` that cannot fit in memory.
 
     The output of one solve is a pose, strains and stresses per load case and station
     (:data:`BYTES_PER_STATION`; more with Jacobians: ``per_station``) and a few numbers per
     case (``per_case``), plus the ``work`` (bytes) the solve needs beside it (a batch is
-    solved in parts of bounded size, statics.solver). ValueError naming the sizes and the
+    solved in parts of :data:`PART_BYTES` of work). ValueError naming the sizes and the
     memory they would need if that exceeds :func:`memory_limit`; else the number of bytes.
 
     Examples

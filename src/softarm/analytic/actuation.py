@@ -38,6 +38,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .._admissible import check_stretch, load_case, tendon_limit
+from .._validate import PART_BYTES, check_allocation
 from ..errors import ConvergenceError
 from ..loads import as_loads, batch_shape, check_magnitudes, path_tangent
 from ._common import build, checked_stations, constant_strain_poses
@@ -462,9 +463,11 @@ def solve_actuated(arm, loads, s=None):
     check_stretch(np.stack([eps - piece.f0 for piece, eps in zip(pieces, roots, strict=True)],
                            axis=1).reshape(*shape, len(pieces), 6),
                   [piece.s0 for piece in pieces], what="the equilibrium (analytic.actuated)")
-    poses = np.empty((count, s.size, 4, 4))
-    strains = np.empty((count, s.size, 6))
-    stresses = np.empty((count, s.size, 6))
+    check_allocation(count, s.size, "loads")  # (softarm.solve checked it already)
+    # the result's own arrays (build freezes them: no copy), written through flat views
+    fields = (np.empty((*shape, s.size, 4, 4)), np.empty((*shape, s.size, 6)),
+              np.empty((*shape, s.size, 6)))
+    poses, strains, stresses = (a.reshape(count, *a.shape[len(shape):]) for a in fields)
     start_pose = np.broadcast_to(np.eye(4), (count, 4, 4)).copy()
     tendons = [a for a, act in enumerate(target.actuators) if act[0]]
     lengths = np.zeros((count, len(tendons)))
@@ -472,8 +475,11 @@ def solve_actuated(arm, loads, s=None):
     for piece, eps in zip(pieces, roots, strict=True):
         s0, s1, K, f0 = piece.s0, piece.s1, piece.K, piece.f0
         at = (s >= s0) & ((s < s1) | ((s1 == arm.length) & (s == s1)))
-        local = constant_strain_poses(eps, s[at] - s0)
-        poses[:, at] = start_pose[:, None] @ local
+        part = max(1, PART_BYTES // (256 * max(1, int(at.sum()))))  # (its work: 2 poses)
+        for first in range(0, count, part):
+            cases = slice(first, first + part)
+            poses[cases, at] = start_pose[cases, None] @ constant_strain_poses(eps[cases],
+                                                                              s[at] - s0)
         strains[:, at] = (eps - f0)[:, None, :]
         stresses[:, at] = ((eps - f0) @ K.T)[:, None, :]
         start_pose = start_pose @ constant_strain_poses(eps, np.array([s1 - s0]))[:, 0]
@@ -482,9 +488,7 @@ def solve_actuated(arm, loads, s=None):
         for k, i in enumerate(numbers):
             lengths[:, i] += (s1 - s0) * np.linalg.norm(w[k], axis=-1)
             unloaded[i] += (s1 - s0) * float(np.linalg.norm(w0[k, 0]))
-    result = build(arm, s, poses.reshape(*shape, s.size, 4, 4),
-                   strains.reshape(*shape, s.size, 6), loads, "analytic.actuated", True,
-                   stresses=stresses.reshape(*shape, s.size, 6))
+    result = build(arm, s, *fields[:2], loads, "analytic.actuated", True, stresses=fields[2])
     extra = {"base_wrench": _frozen(np.zeros((*shape, 6)))}
     if tendons:
         tensions = np.stack([target.actuators[a][1].reshape(shape) for a in tendons], axis=-1)

@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 
+from .._validate import PART_BYTES, check_allocation
 from ..loads import TipLoad, check_magnitudes
 from ._common import (
     ROUNDOFF,
@@ -190,9 +191,11 @@ def solve_elastica(arm, force: np.ndarray, s: np.ndarray, extensible: bool, load
     if one is not None:  # one load, compiled: (N, 28) fields written by the kernel
         fields = np.empty((s.shape[0], 28))
         compiled().fields(b[1], b[2], L, stiffness_diagonal(arm), one[0], fields)
-    else:  # a batch, or a load planar_elastica refuses (with its message)
+    elif lone:  # a load the compiled route refuses: planar_elastica says why
         sol = planar_elastica(k, phi, s / L, axial_ratio=axial_ratio, shear_ratio=shear_ratio)
-        fields = _fields(sol, *((b[1], b[2]) if lone else (b[..., 1], b[..., 2])), L, r)
+        fields = _fields(sol, b[1], b[2], L, r)
+    else:
+        fields = _batch_fields(k, phi, s / L, axial_ratio, shear_ratio, b, L, r)
     fields.setflags(write=False)  # fresh: poses, strains and stresses are views of it
     poses = fields[..., :16].reshape(*fields.shape[:-1], 4, 4)
     strains, stresses = fields[..., 16:22], fields[..., 22:]
@@ -203,6 +206,31 @@ def solve_elastica(arm, force: np.ndarray, s: np.ndarray, extensible: bool, load
                                   axis=-1)
     return build(arm, s, poses, strains, loads, "analytic.elastica", extensible,
                  stresses=stresses)
+
+
+#: Bytes of work per load case and per station of the batch route (planar_elastica's
+#: quadrature and its arrays, measured about 10 kB and 0.2 kB): a batch is evaluated in
+#: parts of at most PART_BYTES of work, so that it needs its result's memory and little more
+_CASE_BYTES, _STATION_BYTES = 12_000, 400
+
+
+def _batch_fields(k, phi, s_over_L, axial_ratio, shear_ratio, b, L, r) -> np.ndarray:
+    """:func:`_fields` of :func:`planar_elastica` for a batch (B...,) of loads, written part
+    by part (along the flattened batch) into one (B..., N, 28) array: the same numbers as
+    one call on the whole batch (every load is solved on its own), in bounded memory."""
+    shape = np.shape(k)
+    count = int(np.prod(shape))
+    check_allocation(count, s_over_L.size, "force")  # (softarm.solve checked it already)
+    flat = [np.broadcast_to(x, shape).reshape(-1) for x in
+            (k, phi, axial_ratio, shear_ratio, b[..., 1], b[..., 2])]
+    fields = np.empty((*shape, s_over_L.size, 28))  # (the caller freezes this very array)
+    rows = fields.reshape(count, s_over_L.size, 28)  # a view of it
+    part = max(1, PART_BYTES // (_CASE_BYTES + _STATION_BYTES * s_over_L.size))
+    for first in range(0, count, part):
+        k_, phi_, a_, g_, by, bz = (x[first:first + part] for x in flat)
+        sol = planar_elastica(k_, phi_, s_over_L, axial_ratio=a_, shear_ratio=g_)
+        rows[first:first + part] = _fields(sol, by, bz, L, r)
+    return fields
 
 
 #: Row and column of every entry of C (see :func:`_fields`) that depends on the plane, L or

@@ -20,6 +20,7 @@ from .._admissible import batch_part, check_stretch, load_case, tendon_limit
 from .._threads import in_threads, threads_for
 from .._validate import (
     BYTES_PER_STATION,
+    PART_BYTES,
     check_allocation,
     count,
     real,
@@ -46,19 +47,18 @@ _IDENTITY = np.eye(4)
 _IDENTITY.setflags(write=False)
 #: Fewest load cases per thread of a batch: below it a thread costs more than it saves.
 CASES_PER_THREAD = 16
-#: Most load cases solved at once: a larger batch is solved in parts of this size, each
-#: with its own load channels and work arrays (about 1 kB a case beside the result,
-#: tests/test_memory.py), so that a batch needs its result's memory and one part's work.
+#: Most load cases solved at once: a larger batch is solved in parts (each with its own
+#: load channels, work arrays and result, copied into the whole batch's), of at most this
+#: many cases and about PART_BYTES of work (_cases_per_part), so that a batch needs its
+#: result's memory and little more (tests/test_memory.py).
 CASES_PER_PART = 1 << 15
 #: Bytes of work per case of a part besides its result (channels 8 P W, verdict, outputs)
 _WORK_PER_CASE = 2048
 
 
-def _part_work(cases: int, stations: int) -> float:
-    """Bytes a batch needs beside its result: one part's result and work, twice (the part
-    being solved, and what the allocator still holds of the part before: measured, a batch's
-    peak resident memory exceeds its result by up to 1.7 parts, tests/test_memory.py)."""
-    return 2.0 * min(cases, CASES_PER_PART) * (_WORK_PER_CASE + stations * BYTES_PER_STATION)
+def _cases_per_part(stations: int) -> int:
+    return max(1, min(CASES_PER_PART, PART_BYTES // (_WORK_PER_CASE
+                                                     + stations * BYTES_PER_STATION)))
 
 
 def _kernels():
@@ -859,8 +859,7 @@ class Solver:
         shape = batch_shape(loads)
         for load in loads:
             load.check(self.arm)
-        cases = math.prod(shape)
-        check_allocation(cases, self.s.size, "loads", work=_part_work(cases, self.s.size))
+        check_allocation(math.prod(shape), self.s.size, "loads")
         check_magnitudes(self.arm, loads)
         return loads, shape
 
@@ -939,7 +938,7 @@ class Solver:
                 checked = True
             else:
                 shape = batch_shape(loads)
-            if math.prod(shape) > CASES_PER_PART:
+            if math.prod(shape) > _cases_per_part(self.s.size):
                 return self._solve_in_parts(loads, shape, chained=chained,
                                             jacobians=jacobians, outputs=outputs)
         k = _kernels()
@@ -1049,16 +1048,16 @@ class Solver:
 
     def _solve_in_parts(self, loads, shape, *, chained: bool, jacobians: bool,
                         outputs: bool) -> Equilibrium | None:
-        """:meth:`_solve` of a batch larger than :data:`CASES_PER_PART`, part after part (in
-        the order of the flattened batch: a chained batch stays one path) into one result:
+        """:meth:`_solve` of a batch larger than a part (:func:`_cases_per_part`), part after
+        part (in the order of the flattened batch: a chained batch stays one path) into one
+        result:
         each part's channels and work arrays are freed before the next, its outputs copied
         into the whole batch's arrays. The answer is the unparted one's to the bit (every case
         is solved from its own loads, or the path goes on from the part before)."""
-        count = math.prod(shape)
+        count, size = math.prod(shape), _cases_per_part(self.s.size)
         whole = None
-        for first in range(0, count, CASES_PER_PART):
-            index = np.unravel_index(np.arange(first, min(first + CASES_PER_PART, count)),
-                                     shape)
+        for first in range(0, count, size):
+            index = np.unravel_index(np.arange(first, min(first + size, count)), shape)
             with batch_part(shape, first):  # (messages name a case of the whole batch)
                 result = self._solve([_part_of(load, shape, index) for load in loads],
                                      chained=chained, jacobians=jacobians, outputs=outputs)
