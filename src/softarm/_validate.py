@@ -323,16 +323,22 @@ def check_array_size(shape, name: str) -> None:
             "take; solve fewer cases at a time")
 
 
+#: The most work (bytes) any route needs per load case of a part beside its result
+#: (measured: the elastica's batch route, its quadrature, about 10 kB; the solver 1-2 kB)
+WORK_PER_CASE = 12_288
+
+
 def check_allocation(cases, stations, name: str = "the result", *,
                      per_station: float = BYTES_PER_STATION,
-                     per_case: float = BYTES_PER_CASE, work: float = 3 * PART_BYTES) -> int:
+                     per_case: float = BYTES_PER_CASE) -> int:
     """Reject, before allocating, a result of ``cases`` × ``stations`` that cannot fit in memory.
 
     The output of one solve is a pose, strains and stresses per load case and station
     (:data:`BYTES_PER_STATION`; more with Jacobians: ``per_station``) and a few numbers per
-    case (``per_case``), plus the ``work`` (bytes) the solve needs beside it (a batch is
-    solved in parts of :data:`PART_BYTES` of work). ValueError naming the sizes and the
-    memory they would need if that exceeds :func:`memory_limit`; else the number of bytes.
+    case (``per_case``), plus the work the solve needs beside it: three parts' (a batch is
+    solved in parts of at most :data:`PART_BYTES` of work, :data:`WORK_PER_CASE` a case and
+    a part's own result). ValueError naming the sizes and the memory they would need if that
+    exceeds :func:`memory_limit`; else the number of bytes.
 
     Examples
     --------
@@ -342,7 +348,9 @@ def check_allocation(cases, stations, name: str = "the result", *,
     ...     print(str(error)[:69])
     loads: 10000000 load cases × 101 stations would need 233 GB of memory
     """
-    size = float(cases) * (float(stations) * per_station + per_case) + work
+    result = float(stations) * per_station
+    size = float(cases) * (result + per_case) + 3.0 * min(
+        PART_BYTES, float(cases) * (WORK_PER_CASE + result))
     limit = memory_limit()
     if size > limit:
         raise ValueError(
