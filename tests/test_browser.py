@@ -222,7 +222,8 @@ def test_pages_fill_the_window_and_the_controls_stay_off_the_scene(browser, live
         # the sweep: 3D figure, tip plot, slider and buttons, none over the scene
         sweep_case = softarm.load_case(EXAMPLES / "fig2_sweep.toml")
         io.save_result(solve_case(sweep_case), tmp_path / "sweep.npz", sweep_case)
-        page = view.view_result_file(tmp_path / "sweep.npz", tmp_path / "sweep.html")
+        page = view.view_result_file(io.load_saved(tmp_path / "sweep.npz"),
+                                     tmp_path / "sweep.html")
         browser.get(page.as_uri())
         wait_for(browser, "const gd = document.getElementById('softarm-view');"
                  "return !!(gd && gd._fullLayout && gd.querySelector('.updatemenu-button') "
