@@ -132,16 +132,16 @@ def test_softarm_compile_pays_the_first_solve_ahead(tmp_path):
                      else os.cpu_count() or 1) < 2,
                     reason="the verdict compiles beside the solver only with 2 usable cores")
 def test_a_cold_first_solve_compiles_its_verdict_on_another_core(tmp_path):
-    run = _python(_PASSIVE_SOLVE, "stability_cases", "solve_cases", cache=tmp_path,
+    run = _python(_PASSIVE_SOLVE, "stability_cases", "_record", "solve_cases", cache=tmp_path,
                   prefetch=True)
     assert run.returncode == 0, run.stderr
-    # this process compiled the solver; the verdict it loaded from the cache, where the
-    # other process had put it
-    assert ast.literal_eval(run.stdout.splitlines()[0]) == {"stability_cases": 0,
-                                                            "solve_cases": 1}
+    # this process compiled the solver's path; the output pass and the verdict it loaded
+    # from the cache, where the other process had put them
+    assert ast.literal_eval(run.stdout.splitlines()[0]) == {
+        "stability_cases": 0, "_record": 0, "solve_cases": 1}
     notices = [line for line in run.stderr.splitlines() if line.startswith("softarm:")]
     assert len(notices) == 1 and notices[0].startswith(
-        "softarm: compiling the solver for passive arms and its stability verdict beside it "
-        "on another core, once (about ")
+        "softarm: compiling the solver for passive arms (its output pass and stability "
+        "verdict on another core), once (about ")
     record = json.loads(next(tmp_path.rglob("softarm-compile-seconds.json")).read_text())
     assert set(record) == {"solve", "verdict"}

@@ -198,7 +198,7 @@ class _Notice(event.Listener):
         key, text = capability(ev.data["args"])
         stack.append((key, text, dispatcher, time.perf_counter()))
         extra = [callback(ev.data["args"]) for callback in _ON_COLD.get(dispatcher.py_func, ())]
-        text += "".join(f" and {more}" for more in extra if more)
+        text += "".join(f" ({more})" for more in extra if more)
         with _LOCK:
             first = key not in _ANNOUNCED
             _ANNOUNCED.add(key)

@@ -1,16 +1,18 @@
-"""A cold first solve compiles its stability verdict on another core, beside the solver.
+"""A cold first solve compiles its output pass and its verdict on another core.
 
-A first solve on a machine compiles two kernels (softarm._jit, statics/README.md): the
-solver (``solve_cases``) and then the stability verdict (``stability_cases``), one after the
+A first solve on a machine compiles the solver (``solve_cases``, with the output pass
+``_record`` inside it) and then the stability verdict (``stability_cases``), one after the
 other in one process (numba compiles under one lock, mostly in Python). When the solver's
 compile starts cold (numba's event, the moment the cache misses), :func:`start` launches a
-Python process running ``softarm.statics.solver.compile_verdict(KIND)``: it compiles the
-verdict of the same kind of arm (passive, or actuated/magnetic) into numba's cache, on the
-second core.
-Before its first verdict, :func:`wait` waits for that process, and numba loads the verdict
-from the cache instead of compiling it (a cache miss, had the process failed, compiles it as
-before: nothing depends on the process but the time). On a 2-core machine the first solve's
-wall time drops by the verdict's compile (tests/test_compile.py, docs/performance.md).
+Python process running ``softarm.statics.solver.compile_beside(KIND)``: it compiles the
+output pass and the verdict of the same kind of arm (passive, or actuated/magnetic) into
+numba's cache, on the second core, while this process compiles the solver's path. numba
+looks a callee up in its cache when the caller first needs it: the solver finds the output
+pass there, and :func:`wait`, before the first verdict, waits for the process so that the
+verdict is found there too. A cache miss (the process slower, or failed) compiles it here
+as before: nothing depends on the process but the time. On a 2-core machine a cold
+``softarm demo`` took 29 s with everything in one process, 21 s so (docs/performance.md;
+tests/test_compile.py checks that the solver's process compiled neither).
 
 Not launched with one usable core, where numba cannot write its cache, with
 ``SOFTARM_PREFETCH=0``, or inside such a process itself.
@@ -60,13 +62,13 @@ def start(kind: str, dispatcher) -> str | None:
         try:
             _RUNNING[kind] = subprocess.Popen(
                 [sys.executable, "-c", "import sys; from softarm.statics.solver import "
-                 "compile_verdict; compile_verdict(sys.argv[1])", kind],
+                 "compile_beside; compile_beside(sys.argv[1])", kind],
                 env=env, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
                 stderr=subprocess.DEVNULL)
         except OSError:  # no process can be started here: compile as before
             _RUNNING[kind] = None
             return None
-    return "its stability verdict beside it on another core"
+    return "its output pass and stability verdict on another core"
 
 
 def kind(arm) -> str:

@@ -1519,14 +1519,23 @@ def solve_numeric(arm, loads, *, s=None, tol=1e-8, base=None, jacobians=False,
         loads, jacobians=jacobians)
 
 
-def compile_verdict(kind: str) -> None:
-    """Compile (or load) the stability verdict of a small arm of this kind, "passive" or
-    "actuated": the same kernel, with the same argument types, as every solve's verdict
-    (what ``_prefetch`` runs in another process beside a cold first solve)."""
+def compile_beside(kind: str) -> None:
+    """Compile (or load) what a first solve of an arm of this kind ("passive" or "actuated")
+    needs after its solver's own path, with the same argument types as every solve: the
+    output pass (``_record``, through ``record_points``, whose stations of a given solution
+    are the output pass's) and the stability verdict. ``_prefetch`` runs this in another
+    process beside a cold first solve, which then loads both from numba's cache."""
     arm = Arm(0.2, Circle(0.01), Material(youngs_modulus=1e6, poisson_ratio=0.49,
                                           density=1000.0))
     loads = [Gravity()] + ([Tendon(0.1, Straight(0.0, 0.005))] if kind == "actuated" else [])
     solver = Solver(arm)
-    _, shape, count, _, channels = solver._prepare(loads)
+    _, shape, count, pieces, channels = solver._prepare(loads)
+    S, A = solver._s_kernel.size, len(channels.actuators)
+    out = (np.empty((count, S, 4, 4)), np.empty((count, S, 6)), np.empty((count, S, 6)),
+           np.zeros((count, 5)), np.zeros(count, dtype=np.int64), solver._unused((0, 6, 6)),
+           solver._unused((1, S, 6, 6)), np.empty((count, 6)), np.empty((count, A)))
+    _kernels().record_points(solver._base_kernel, *channels.arm_tuple(),
+                             (channels.piece, channels.tip_loads), np.zeros((count, 6)),
+                             np.full(pieces[0].size, 4, dtype=np.int64), solver._s_kernel, out)
     verdict(channels, solver._base_kernel, np.zeros((count, 6)), np.full(count, 8.0), shape,
             np.zeros((count, 4, 4)))
