@@ -143,5 +143,6 @@ def test_a_cold_first_solve_compiles_its_verdict_on_another_core(tmp_path):
     assert len(notices) == 1 and notices[0].startswith(
         "softarm: compiling the solver for passive arms (its output pass and stability "
         "verdict on another core), once (about ")
+    # the times are this process's: the other one's include what this one compiled too
     record = json.loads(next(tmp_path.rglob("softarm-compile-seconds.json")).read_text())
-    assert set(record) == {"solve", "verdict"}
+    assert set(record) == {"solve"}

@@ -35,29 +35,30 @@ __all__ = ["COMPILED", "REFERENCE_SECONDS", "compile_seconds", "jit", "notices",
 
 _WARNED = set()
 
-#: Cold compile of each capability in a fresh process with an empty cache, seconds, on the
-#: reference machine (2 cores, the machine of docs/performance.md), with what a first use
-#: compiles before it (the passive solve before the others): ``benchmarks/compile.py``.
+#: Cold compile of each capability, seconds, on the reference machine (2 cores, AMD EPYC, the
+#: machine of docs/performance.md), each after those before it in softarm.warmup.STEPS (what
+#: a user meets who adds capabilities one by one; a capability used first compiles what it
+#: shares with the others too): ``python benchmarks/compile.py``, 2026-12-01.
 REFERENCE_SECONDS = {
-    "solve": 18.0,
-    "solve+jacobians": 14.0,
-    "solve+chained": 16.0,
-    "actuated": 30.0,
-    "actuated+jacobians": 18.0,
-    "actuated+chained": 22.0,
-    "actuated+chained+jacobians": 24.0,
-    "verdict": 8.0,
-    "verdict+actuated": 9.0,
-    "shoot": 10.0,
-    "shoot+actuated": 12.0,
-    "branch": 12.0,
-    "branch+actuated": 14.0,
-    "inverse": 20.0,
-    "bounded": 3.0,
-    "closed forms": 7.0,
+    "solve": 17.0,
+    "verdict": 6.0,
+    "closed forms": 3.0,
+    "solve+jacobians": 7.0,
+    "solve+chained": 7.0,
+    "actuated": 26.0,
+    "verdict+actuated": 5.0,
+    "actuated+jacobians": 8.0,
+    "actuated+chained": 9.0,
+    "actuated+chained+jacobians": 11.0,
+    "inverse": 13.0,
+    "bounded": 2.0,
+    "shoot": 1.0,
+    "shoot+actuated": 2.0,
+    "branch": 4.0,
+    "branch+actuated": 5.0,
 }
-#: The probe's time on the reference machine, seconds (:func:`_probe`).
-_REFERENCE_PROBE = 0.020
+#: The probe's time on the reference machine, seconds (:func:`_probe`, best of 5)
+_REFERENCE_PROBE = 0.0158
 #: The file of measured compile times, in numba's cache folder of the compiled module.
 _RECORD = "softarm-compile-seconds.json"
 
@@ -71,6 +72,9 @@ _LOCK = threading.Lock()
 _PROBE: list[float] = []
 #: The capabilities compiled in this process, in order: (key, text, seconds)
 COMPILED: list[tuple[str, str, float]] = []
+#: Whether compile times are recorded (not in statics/_prefetch.py's process, whose times
+#: include what the solver's process compiles beside it)
+_RECORD_TIMES = os.environ.get("SOFTARM_COMPILE_RECORD", "1") != "0"
 #: Whether a compile prints its notice (``softarm compile`` draws a progress bar instead)
 notices = os.environ.get("SOFTARM_COMPILE_NOTICE", "1") != "0"
 
@@ -215,7 +219,8 @@ class _Notice(event.Listener):
             key, text, dispatcher, start = entry
             seconds = time.perf_counter() - start
             COMPILED.append((key, text, seconds))
-            _write_record(dispatcher, key, seconds)
+            if _RECORD_TIMES:  # (several entry points of one capability: their sum)
+                _write_record(dispatcher, key, sum(t for k, _, t in COMPILED if k == key))
 
 
 def _about(seconds: float) -> str:

@@ -58,7 +58,8 @@ def start(kind: str, dispatcher) -> str | None:
         package = Path(__file__).resolve().parents[2]  # the folder holding softarm/
         path = os.pathsep.join(filter(None, [str(package), os.environ.get("PYTHONPATH")]))
         env = dict(os.environ, PYTHONPATH=path, SOFTARM_PREFETCH="0",
-                   SOFTARM_COMPILE_NOTICE="0", SOFTARM_NUM_THREADS="1")
+                   SOFTARM_COMPILE_NOTICE="0", SOFTARM_COMPILE_RECORD="0",
+                   SOFTARM_NUM_THREADS="1")
         try:
             _RUNNING[kind] = subprocess.Popen(
                 [sys.executable, "-c", "import sys; from softarm.statics.solver import "
