@@ -13,7 +13,7 @@ prints one line the first time a capability compiles in a process, with the time
 on this machine, and afterwards records how long it took. The record lives in numba's cache
 folder beside the compiled code it describes (``softarm-compile-seconds.json``), so the next
 estimate on this machine is a measurement; before any, it is the reference machine's time
-(:data:`REFERENCE_SECONDS`, ``python benchmarks/compile.py``) scaled by a 20-ms probe of this
+(:data:`REFERENCE_SECONDS`, ``python benchmarks/cold_compile.py``) scaled by a 20-ms probe of this
 machine's single-core speed. ``SOFTARM_COMPILE_NOTICE=0`` silences the notice.
 """
 
@@ -38,7 +38,7 @@ _WARNED = set()
 #: Cold compile of each capability, seconds, on the reference machine (2 cores, AMD EPYC, the
 #: machine of docs/performance.md), each after those before it in softarm.warmup.STEPS (what
 #: a user meets who adds capabilities one by one; a capability used first compiles what it
-#: shares with the others too): ``python benchmarks/compile.py``, 2026-12-01.
+#: shares with the others too): ``python benchmarks/cold_compile.py``, 2026-12-01.
 REFERENCE_SECONDS = {
     "solve": 17.0,
     "verdict": 6.0,

@@ -13,7 +13,7 @@ Prints, each in fresh processes with an empty numba cache of their own:
    ``_REFERENCE_PROBE`` in ``softarm/_jit.py`` come from this run on the reference machine).
 
 Wall time beside CPU time (this process's children: the second core's work shows as CPU time
-above the wall time). ``python benchmarks/compile.py [--baseline REV] [--repeat N]``.
+above the wall time). ``python benchmarks/cold_compile.py [--baseline REV] [--repeat N]``.
 """
 
 from __future__ import annotations
