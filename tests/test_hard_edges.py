@@ -201,10 +201,10 @@ def test_stations_1e9_rejected_with_the_memory_it_needs(case, capsys, monkeypatc
 
 def test_sweep_sizes_rejected_before_parsing_on(tmp_path, capsys):
     # 1e11 steps × (101 stations × 224 B + 640 B) = 2.33 PB, and 1e7 × (101 × 224 B + 640 B)
-    # = 233 GB (and a little work, _validate.check_allocation): more than any machine this
-    # runs on has (half of its memory is the limit).
+    # = 233 GB, and the work of the parts (_validate.check_allocation): 234 GB; more than any
+    # machine this runs on has (half of its memory is the limit).
     for steps, need in (("1e11", "2.33 PB"), ("100000000000", "2.33 PB"),
-                        ("10000000", "233 GB")):
+                        ("10000000", "234 GB")):
         path = tmp_path / "sweep.toml"
         path.write_text(MOMENT_CASE + f"[sweep]\nstart = 0.0\nstop = 1.0\nsteps = {steps}\n",
                         encoding="utf-8")
@@ -215,20 +215,20 @@ def test_sweep_sizes_rejected_before_parsing_on(tmp_path, capsys):
 
 
 def test_library_rejects_a_batch_before_allocating(monkeypatch):
-    # 1000 cases × (101 stations × 224 B + 640 B) = 23.3 MB for the result and three parts'
-    # work, 3 × 1000 × (12288 B + 101 × 224 B) = 105 MB: 128 MB against a limit pinned to 1 MB
+    # 1000 cases × (101 stations × 224 B + 640 B) = 23.3 MB for the result and the work of
+    # one part, 3 × 1000 × 12288 B = 36.9 MB: 60.1 MB against a limit pinned to 1 MB
     monkeypatch.setattr(_validate, "memory_limit", lambda: 10**6)
     arm = softarm.Arm.from_stiffness(1.0, 1e6, 1e6, 1e6, 1.0, 1.0, 1.0)
     moments = np.zeros((1000, 3))
     moments[:, 1] = 1.0
     for method in ("auto", "numeric"):
         with pytest.raises(ValueError, match=r"1000 load cases × 101 stations would need "
-                                             r"128 MB"):
+                                             r"60\.1 MB"):
             softarm.solve(arm, softarm.TipLoad(moment=moments), method=method)
-    # 10⁵ stations × 224 B + 640 B, and three times that and 12288 B of work: 89.6 MB
-    with pytest.raises(ValueError, match=r"s: 1 load case × 100000 stations would need 89\.6 MB"):
+    # 10⁵ stations × 224 B + 640 B, and 3 × 12288 B of work: 22.4 MB
+    with pytest.raises(ValueError, match=r"s: 1 load case × 100000 stations would need 22\.4 MB"):
         softarm.analytic.tip_moment(arm, [0.0, 1.0, 0.0], s=100_000)
-    small = softarm.solve(arm, softarm.TipLoad(moment=moments[:10]), s=11)  # 474 kB: fine
+    small = softarm.solve(arm, softarm.TipLoad(moment=moments[:10]), s=11)  # 400 kB: fine
     assert small.poses.shape == (10, 11, 4, 4)
 
 

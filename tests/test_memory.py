@@ -76,7 +76,7 @@ def test_a_zero_copy_broadcast_batch_too_large_is_a_value_error():
 
 def test_a_result_that_cannot_fit_is_refused_before_it_is_allocated():
     # 10⁴ cases × (10⁵ stations × 224 B + 640 B) for the result, and three parts' work
-    # (PART_BYTES, 64 MiB each): 224 GB
+    # (at most PART_BYTES, 64 MiB, each): 224 GB
     with pytest.raises(ValueError, match=r"loads: 10000 load cases × 100000 stations would "
                                          r"need 224 GB of memory"):
         softarm.solve(ARM, _loads((10_000,)), s=100_000)
@@ -121,12 +121,14 @@ print(json.dumps({"method": eq.method, "peak": peak - before, "guard": guard,
 
 @pytest.mark.slow
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc (Linux)")
-@pytest.mark.parametrize("stations", [1, 101])
-@pytest.mark.parametrize(("kind", "method"), [
-    ("numeric", "numeric.shooting"), ("elastica", "analytic.elastica"),
-    ("tendon", "analytic.actuated"), ("moment", "analytic.tip_moment.helix")])
-def test_the_guard_assumes_at_least_what_a_batch_takes(kind, method, stations):
-    count = 30_000
+@pytest.mark.parametrize(("kind", "method", "count", "stations"), [
+    *((kind, method, 30_000, stations) for kind, method in (
+        ("numeric", "numeric.shooting"), ("elastica", "analytic.elastica"),
+        ("tendon", "analytic.actuated"), ("moment", "analytic.tip_moment.helix"))
+      for stations in (1, 101)),
+    # the solver's batch in two parts (CASES_PER_PART = 32768), their results copied in
+    ("numeric", "numeric.shooting", 40_000, 101)])
+def test_the_guard_assumes_at_least_what_a_batch_takes(kind, method, count, stations):
     run = subprocess.run([sys.executable, "-c", _MEASURE, kind, str(count), str(stations)],
                          capture_output=True, text=True, timeout=600)
     assert run.returncode == 0, run.stderr
@@ -135,4 +137,4 @@ def test_the_guard_assumes_at_least_what_a_batch_takes(kind, method, stations):
     # the process's peak resident memory over the batch (result, work of the parts)
     assert figures["peak"] <= figures["guard"], figures
     if stations > 1:  # where the result, not one part's work, is most of it: not much more
-        assert figures["guard"] <= 2.0 * figures["peak"], figures
+        assert figures["guard"] <= 2.5 * figures["peak"], figures

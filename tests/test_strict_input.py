@@ -222,6 +222,6 @@ def test_solver_direct_checks_the_allocation(monkeypatch):
     from softarm.statics import Solver
 
     monkeypatch.setattr(_validate, "memory_limit", lambda: 10**6)
-    # 10⁵ stations × 224 B + 640 B, and three times that and 12288 B of work (check_allocation)
-    with pytest.raises(ValueError, match=r"100000 stations would need 89\.6 MB"):
+    # 10⁵ stations × 224 B + 640 B, and 3 × 12288 B of work (check_allocation)
+    with pytest.raises(ValueError, match=r"100000 stations would need 22\.4 MB"):
         Solver(ARM, s=100_000)

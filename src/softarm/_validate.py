@@ -326,6 +326,9 @@ def check_array_size(shape, name: str) -> None:
 #: The most work (bytes) any route needs per load case of a part beside its result
 #: (measured: the elastica's batch route, its quadrature, about 10 kB; the solver 1-2 kB)
 WORK_PER_CASE = 12_288
+#: The solver's parts (statics.solver.CASES_PER_PART): its work is about 2 kB a case, and
+#: each part's result is copied into the whole batch's (the closed forms write in place)
+CASES_PER_PART = PART_BYTES // 2048
 
 
 def check_allocation(cases, stations, name: str = "the result", *,
@@ -335,10 +338,12 @@ def check_allocation(cases, stations, name: str = "the result", *,
 
     The output of one solve is a pose, strains and stresses per load case and station
     (:data:`BYTES_PER_STATION`; more with Jacobians: ``per_station``) and a few numbers per
-    case (``per_case``), plus the work the solve needs beside it: three parts' (a batch is
-    solved in parts of at most :data:`PART_BYTES` of work, :data:`WORK_PER_CASE` a case and
-    a part's own result). ValueError naming the sizes and the memory they would need if that
-    exceeds :func:`memory_limit`; else the number of bytes.
+    case (``per_case``), plus the work the solve needs beside it: a batch is solved in parts
+    of at most :data:`PART_BYTES` of work (:data:`WORK_PER_CASE` a case; counted three times:
+    the part being solved and what the allocator still holds of the one before), and the
+    solver copies each part's result into the whole batch's (:data:`CASES_PER_PART` cases,
+    twice). ValueError naming the sizes and the memory they would need if that exceeds
+    :func:`memory_limit`; else the number of bytes.
 
     Examples
     --------
@@ -346,11 +351,13 @@ def check_allocation(cases, stations, name: str = "the result", *,
     ...     check_allocation(10**7, 101, "loads")
     ... except ValueError as error:
     ...     print(str(error)[:69])
-    loads: 10000000 load cases × 101 stations would need 233 GB of memory
+    loads: 10000000 load cases × 101 stations would need 234 GB of memory
     """
     result = float(stations) * per_station
-    size = float(cases) * (result + per_case) + 3.0 * min(
-        PART_BYTES, float(cases) * (WORK_PER_CASE + result))
+    work = 3.0 * min(PART_BYTES, float(cases) * WORK_PER_CASE)
+    if cases > CASES_PER_PART:  # the solver's part results, copied in (up to 2 at once)
+        work += 2.0 * CASES_PER_PART * (result + per_case)
+    size = float(cases) * (result + per_case) + work
     limit = memory_limit()
     if size > limit:
         raise ValueError(

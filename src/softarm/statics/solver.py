@@ -19,7 +19,6 @@ import numpy as np
 from .._admissible import batch_part, check_stretch, load_case, tendon_limit
 from .._threads import in_threads, threads_for
 from .._validate import (
-    BYTES_PER_STATION,
     PART_BYTES,
     check_allocation,
     count,
@@ -47,18 +46,10 @@ _IDENTITY = np.eye(4)
 _IDENTITY.setflags(write=False)
 #: Fewest load cases per thread of a batch: below it a thread costs more than it saves.
 CASES_PER_THREAD = 16
-#: Most load cases solved at once: a larger batch is solved in parts (each with its own
-#: load channels, work arrays and result, copied into the whole batch's), of at most this
-#: many cases and about PART_BYTES of work (_cases_per_part), so that a batch needs its
-#: result's memory and little more (tests/test_memory.py).
-CASES_PER_PART = 1 << 15
-#: Bytes of work per case of a part besides its result (channels 8 P W, verdict, outputs)
-_WORK_PER_CASE = 2048
-
-
-def _cases_per_part(stations: int) -> int:
-    return max(1, min(CASES_PER_PART, PART_BYTES // (_WORK_PER_CASE
-                                                     + stations * BYTES_PER_STATION)))
+#: Most load cases solved at once (``_validate.CASES_PER_PART``): a larger batch is solved
+#: in parts of this size, each with its own load channels and work arrays (about 2 kB a
+#: case) and its own result, copied into the whole batch's (tests/test_memory.py).
+CASES_PER_PART = PART_BYTES // 2048
 
 
 def _kernels():
@@ -938,7 +929,7 @@ class Solver:
                 checked = True
             else:
                 shape = batch_shape(loads)
-            if math.prod(shape) > _cases_per_part(self.s.size):
+            if math.prod(shape) > CASES_PER_PART:
                 return self._solve_in_parts(loads, shape, chained=chained,
                                             jacobians=jacobians, outputs=outputs)
         k = _kernels()
@@ -1054,7 +1045,7 @@ class Solver:
         each part's channels and work arrays are freed before the next, its outputs copied
         into the whole batch's arrays. The answer is the unparted one's to the bit (every case
         is solved from its own loads, or the path goes on from the part before)."""
-        count, size = math.prod(shape), _cases_per_part(self.s.size)
+        count, size = math.prod(shape), CASES_PER_PART
         whole = None
         for first in range(0, count, size):
             index = np.unravel_index(np.arange(first, min(first + size, count)), shape)
