@@ -14,7 +14,7 @@ import math
 
 import numpy as np
 
-from .._admissible import check_finite, check_stretch
+from .._admissible import all_finite, check_finite, check_stretch
 from .._threads import THREADS_VARIABLE, in_threads, thread_setting, threads_for
 from .._validate import as_vectors, stations
 from ..equilibrium import Equilibrium
@@ -325,10 +325,15 @@ def build(arm: Arm, s: np.ndarray, poses, strains, loads, method: str, exact: bo
     if stresses is None:
         stresses = strains * stiffness_diagonal(arm)  # K ε
     stresses = _owned(stresses)
-    # the model's limits (_admissible): an answer, finite, and an arm that is not inside out
-    check_finite(method, poses, 3)
-    check_finite(method, strains, 2)
-    check_finite(method, stresses, 2)
+    # the model's limits (_admissible): an answer, finite, and an arm that is not inside out.
+    # Fields that are views of one contiguous array (a batch route's (B..., N, 28) fields):
+    # one pass over it (a pass over each strided view cost as much as the closed form)
+    base = poses.base
+    if not (isinstance(base, np.ndarray) and base.flags.c_contiguous
+            and strains.base is base and stresses.base is base and all_finite(base)):
+        check_finite(method, poses, 3)
+        check_finite(method, strains, 2)
+        check_finite(method, stresses, 2)
     check_stretch(strains, s, stresses=stresses, what=f"the equilibrium ({method})")
     shapes = (poses.shape[:-3], strains.shape[:-2], stresses.shape[:-2])
     batch = shapes[0] if shapes[0] == shapes[1] == shapes[2] else np.broadcast_shapes(*shapes)
