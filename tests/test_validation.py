@@ -237,9 +237,20 @@ def test_plot_without_matplotlib_is_one_line(tmp_path):
     child = subprocess.run([sys.executable, "-c", _WITHOUT_MATPLOTLIB, "plot", str(result)],
                            capture_output=True, text=True, timeout=600)
     assert child.returncode == 2
-    assert child.stderr == (f"softarm: error: {tmp_path / 'moment.png'}: softarm.plot needs "
-                            "matplotlib: pip install 'softarm[plot]'\n")
+    assert child.stderr == (f"softarm: error: {tmp_path / 'moment.png'}: drawing a picture "
+                            'needs matplotlib, which is not installed: pip install '
+                            '"softarm[plot]"\n')
     assert not (tmp_path / "moment.png").exists()
+    # a command that solves and draws refuses before it solves: nothing written (the demo
+    # wrote its table, then failed on the picture)
+    for command in (["demo", "--out", str(tmp_path)],
+                    ["solve", str(case), "-o", str(tmp_path / "again.csv"), "--plot",
+                     str(tmp_path / "again.png")]):
+        child = subprocess.run([sys.executable, "-c", _WITHOUT_MATPLOTLIB, *command],
+                               capture_output=True, text=True, timeout=600)
+        assert child.returncode == 2 and child.stderr.count("\n") == 1, child.stderr
+        assert "needs matplotlib" in child.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["moment.csv", "moment.toml"]
 
 
 def test_unknown_case_is_rejected():

@@ -31,6 +31,7 @@ import argparse
 import concurrent.futures
 import contextlib
 import errno
+import importlib.util
 import os
 import signal
 import sys
@@ -394,8 +395,12 @@ def interrupted(what: str = "interrupted") -> int:
 def _check_output(path: str, suffixes: tuple[str, ...], what: str, inputs=(),
                   taken=()) -> Path:
     """An output path that can be written: a known suffix, an existing folder, not a folder
-    itself, not one of ``inputs`` nor ``taken`` (the other outputs), even through a link."""
+    itself, not one of ``inputs`` nor ``taken`` (the other outputs), even through a link; a
+    picture only where matplotlib is installed (before any solve: no output is written)."""
     out = Path(path)
+    if what == "picture" and importlib.util.find_spec("matplotlib") is None:
+        raise CaseError(f"{out}: drawing a picture needs matplotlib, which is not installed: "
+                        'pip install "softarm[plot]"')
     if out.suffix.lower() not in suffixes:
         raise CaseError(f"{out}: unknown {what} format {out.suffix or '(no suffix)'!r}; use "
                         f"one of {', '.join(suffixes)}")
