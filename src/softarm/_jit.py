@@ -119,7 +119,7 @@ def on_cold_compile(dispatcher, callback: Callable) -> None:
     """Call ``callback(argument types)`` when the entry point ``dispatcher`` starts a compile
     that missed numba's cache (statics/_prefetch.py starts the verdict's compile then); what
     it returns, if not None, is added to the notice."""
-    _ON_COLD.setdefault(dispatcher.py_func, []).append(callback)
+    _ON_COLD.setdefault(getattr(dispatcher, "py_func", dispatcher), []).append(callback)
 
 
 def compile_seconds(key: str, dispatcher=None) -> tuple[float, bool]:

@@ -561,3 +561,27 @@ def test_a_fold_is_named_with_its_load_factor():
     assert np.all(np.diff(d2) < 0)
     root = lams[1] - d2[1] * (lams[2] - lams[1]) / (d2[2] - d2[1])
     assert abs(root - lam_c) < 2e-3, (root, lam_c)
+
+
+def test_a_chained_solve_through_a_vanishing_input_is_no_zero_division():
+    """A chained Solver driven from tensions (0, 1/3, 0.2) N through (5.8e-113, 0, 0) N to
+    zero (what inverse statics met with extreme scales): the path's turning test took the
+    cosine of two tip motions of order 1e-113 m per unit load, whose squared norms' product
+    underflowed to 0, and the kernel raised ZeroDivisionError. Now the last equilibrium is
+    the unloaded-by-tendons arm's, as a solve from the unloaded arm gives it."""
+    from softarm.routing import Straight
+
+    nitinol = softarm.Material(6.0e10, poisson_ratio=0.33, density=6450.0)
+    arm = softarm.Arm(0.25, softarm.Circle(0.0006), nitinol, mass_per_length=0.02)
+    offsets = [(0.0, 0.008), (0.006928, -0.004), (-0.006928, -0.004)]
+
+    def loads(tensions):
+        return [softarm.Gravity([0.0, 0.0, -9.81]),
+                *(softarm.Tendon(t, Straight(*o)) for t, o in zip(tensions, offsets, strict=True))]
+
+    solver = softarm.statics.Solver(arm, tol=1e-6)
+    for tensions in ((0.0, 1 / 3, 0.2), (5.8e-113, 0.0, 0.0), (0.0, 0.0, 0.0)):
+        last = solver.solve(loads(tensions))
+    alone = softarm.solve(arm, loads((0.0, 0.0, 0.0)), tol=1e-6, method="numeric")
+    np.testing.assert_allclose(last.tip_position, alone.tip_position, rtol=0.0,
+                               atol=1e-6 * 0.25)

@@ -1199,12 +1199,14 @@ def _tip_motion(T, t, out):
 
 @_jit
 def _cosine(a, b):
-    """The cosine of the angle between two 3-vectors (1 if either is zero)."""
+    """The cosine of the angle between two 3-vectors (1 if either is zero). The norms are
+    multiplied, not their squares: two tiny motions (an input of 1e-113 N) have squares
+    whose product underflows to 0 (a ZeroDivisionError)."""
     aa = a[0] * a[0] + a[1] * a[1] + a[2] * a[2]
     bb = b[0] * b[0] + b[1] * b[1] + b[2] * b[2]
     if not (aa > 0.0 and bb > 0.0):
         return 1.0
-    return (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) / math.sqrt(aa * bb)
+    return (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) / (math.sqrt(aa) * math.sqrt(bb))
 
 
 @_jit
