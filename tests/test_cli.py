@@ -299,3 +299,8 @@ def test_a_swallowed_ctrl_c_is_raised_again_at_the_next_progress_report():
             progress(2, 4)  # ... so raised again here
     finally:
         cli._Interrupt.seen = False
+
+
+def test_printed_vectors_have_no_negative_zero():
+    # softarm critical printed a buckling mode as "(-0, -0, -0, -0, -0, 29.762)"
+    assert cli._vector([-0.0, 0.0, -2.5e-17, 29.7617]) == "(0, 0, -2.5e-17, 29.762)"

@@ -843,7 +843,8 @@ def _run_demo(args) -> int:
 
 
 def _vector(v, digits: int = 5) -> str:
-    return "(" + ", ".join(f"{c:.{digits}g}" for c in np.asarray(v, dtype=float)) + ")"
+    """(a, b, c) with ``digits`` significant digits; a zero is 0, never -0."""
+    return "(" + ", ".join(f"{c + 0.0:.{digits}g}" for c in np.asarray(v, dtype=float)) + ")"
 
 
 def _peak(values: np.ndarray, s: np.ndarray) -> tuple[float, float]:
