@@ -266,6 +266,7 @@ def test_the_inverse_command_reaches_the_example_target(capsys, tmp_path):
     assert main(["inverse", str(example), "-o", str(tmp_path / "reached.json")]) == 0
     out = capsys.readouterr().out
     assert "reached   yes" in out
+    assert "(starts tried 1)" in out  # reached from the first guess
     tensions = [float(v) for v in re.findall(r"tension: ([-\d.e+]+) N", out)]
     case = load_case(example)
     again = softarm.solve(case.arm, [case.loads[0], *tendons(tensions)], tol=1e-10)
@@ -733,3 +734,23 @@ def test_a_tracked_paths_equilibrium_is_each_targets_own():
                                    atol=1e-6 * np.abs(ref.base_wrench).max())
         np.testing.assert_array_equal(eq.stability.index, ref.stability.index)
         assert np.all(eq.error_estimate <= 1e-7 * L)
+
+
+def test_the_inverse_table_takes_the_number_of_starts(tmp_path, capsys):
+    from pathlib import Path
+
+    from softarm.cli import main
+
+    example = (Path(__file__).resolve().parents[1] / "examples" / "tendon_robot.toml")
+    text = example.read_text()
+    case = tmp_path / "starts.toml"
+    case.write_text(text.replace("tol = 1e-5", "tol = 1e-5\nstarts = 0"))
+    assert main(["inverse", str(case)]) == 2
+    assert "starts" in capsys.readouterr().err
+    # an unreachable target (below the base) tried from exactly the starts asked for
+    case.write_text(text.replace("tol = 1e-5", "tol = 1e-5\nstarts = 2")
+                    .replace("target = [0.2246902, 0.0835529, -0.0442158]",
+                             "target = [0.0, 0.0, -0.3]"))
+    assert main(["inverse", str(case)]) == 0
+    out = capsys.readouterr().out
+    assert "reached   NO" in out and "(starts tried 2)" in out

@@ -189,7 +189,7 @@ SOLVE = (Field("method", "text", choices=("auto", "numeric")),
 INVERSE = (Key("target", "vector", "m", required=True),
            Field("tol", "number", "units of the arm length"),
            Field("lower", "numbers"), Field("upper", "numbers"),
-           Field("max_iterations", "integer", minimum=1))
+           Field("max_iterations", "integer", minimum=1), Field("starts", "integer", minimum=1))
 
 #: ``[sweep]`` (:class:`softarm.sweep.Sweep`), by name: ``load`` counts from 1 in the file,
 #: from 0 in the model; ``field`` is one of the swept load's vectors; either ``values`` or

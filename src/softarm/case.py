@@ -121,6 +121,8 @@ class InverseTask:
         Bounds per actuation input (in the order of the loads' inputs; tensions are >= 0
         anyway).
     max_iterations : int
+    starts : int
+        Starts tried before a target is called unreachable (``softarm.InverseSolver``).
     """
 
     target: tuple
@@ -128,6 +130,7 @@ class InverseTask:
     lower: tuple | None = None
     upper: tuple | None = None
     max_iterations: int = 10
+    starts: int = 6
 
     def __post_init__(self):
         target = np.asarray(self.target, dtype=float)
@@ -140,6 +143,9 @@ class InverseTask:
         if self.max_iterations < 1:
             raise ValueError(f"InverseTask.max_iterations must be >= 1, got "
                              f"{format_value(self.max_iterations)}")
+        if self.starts < 1:
+            raise ValueError(f"InverseTask.starts must be >= 1, got "
+                             f"{format_value(self.starts)}")
 
 
 @dataclass(frozen=True, eq=False)

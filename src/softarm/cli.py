@@ -566,6 +566,7 @@ def _run_inverse(args) -> int:
         solver = InverseSolver(case.arm, actuators, others, bounds=bounds,
                                tol=task.tol if task is not None else 1e-6,
                                max_iterations=task.max_iterations if task is not None else 10,
+                               starts=task.starts if task is not None else 6,
                                s=int(case.solve.stations), solver_tol=float(case.solve.tol))
     except (ValueError, TypeError) as error:
         raise CaseError(f"{args.case}: inverse: {error}") from None
@@ -589,8 +590,8 @@ def _run_inverse(args) -> int:
                  f"{name}: {value:.6g} {unit}" + (" (at its bound)" if bound else "")
                  for name, value, unit, bound in zip(names, answer.inputs, units,
                                                      answer.at_bound, strict=True)),
-             f"iterations {answer.iterations}, condition {answer.condition:.3g}, time "
-             f"{seconds:.3g} s"]
+             f"iterations {answer.iterations} (starts tried {answer.starts}), condition "
+             f"{answer.condition:.3g}, time {seconds:.3g} s"]
     print("\n".join(lines))
     solved_case = dataclasses.replace(case, loads=tuple(solved),
                                       data={**case.data, "load": loads_to_dict(solved)})
