@@ -892,3 +892,25 @@ steps = 3
     with pytest.raises(CaseError, match=r"sweep\.load: load 1 \(tendon\) has no vector.*"
                                         r"load\[1\]\.tension"):
         parse_case(tomllib.loads(old))
+
+
+def test_the_actuated_arm_rows_are_built_once_per_structure(monkeypatch):
+    # what depends on the actuators' kinds, paths and spans alone is remembered per arm: a
+    # second solve of the same structure with other tensions builds nothing (the remembered
+    # (arm, act) pair was once compared by its first element with the cut, and rebuilt)
+    from softarm.statics import solver as solver_module
+
+    built = []
+    original = solver_module._Channels._build_actuated_arm
+
+    def counting(self):
+        built.append(1)
+        return original(self)
+
+    monkeypatch.setattr(solver_module._Channels, "_build_actuated_arm", counting)
+    silicone = softarm.Material(youngs_modulus=1.5e6, poisson_ratio=0.49, density=1070.0)
+    arm = softarm.Arm(0.3, softarm.Circle(0.01), silicone)
+    for tension in (0.2, 0.4, 0.6):
+        softarm.solve(arm, [softarm.Gravity(), softarm.Tendon(tension, Straight(0.0, 0.008))],
+                      method="numeric")
+    assert len(built) == 1

@@ -317,7 +317,7 @@ class _Channels:
             return mine[1]
         key = (self.starts.tobytes(), self.signature())
         found = self.data.remembered("actuated arm", key)
-        if found is None or found[0][0] is not self.pieces[0]:
+        if found is None or found[0][0][0] is not self.pieces[0]:  # (arm, act): arm[0]
             found = self.data.remember("actuated arm", key, self._build_actuated_arm())
         self._actuated = (len(self.actuators), found)
         return found
