@@ -16,7 +16,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .._admissible import batch_part, check_stretch, load_case, tendon_limit
+from .._admissible import batch_part, check_stretch, load_case, stretched, tendon_limit
 from .._threads import in_threads, threads_for
 from .._validate import (
     PART_BYTES,
@@ -1392,6 +1392,8 @@ def _admissible(solver, strains, stresses, s, shape, residual, chained: bool) ->
     :class:`~softarm.InadmissibleStateError` where the axial stretch v₁ <= 0 at a station
     (the shooting passes through v₁ = 0 without noticing: the equations stay smooth there);
     a chained Solver then returns to the unloaded arm, as after a failure."""
+    if stretched(strains):  # (the common case: nothing to reshape)
+        return
     try:
         check_stretch(strains.reshape(*shape, *strains.shape[-2:]), s, residual,
                       stresses.reshape(*shape, *stresses.shape[-2:]))
