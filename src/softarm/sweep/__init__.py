@@ -12,18 +12,8 @@
 This package sits above :mod:`softarm.case`: the case reader knows a ``[sweep]`` table only as
 plain data (:class:`Sweep`, :class:`Design`, defined in :mod:`softarm._sweep_table`); building
 a design's cases (``_design``), solving them in chunks (``_run``) and the store (``_store``)
-are here. :func:`solve_case` is :mod:`softarm.case`'s, re-exported.
-
-Examples
---------
->>> from softarm import TipLoad
->>> sweep = Sweep(load=0, kind="tip", field="moment", component="y", values=(0.0, 1.0, 2.0))
->>> sweep.apply([TipLoad(moment=[0.0, 5.0, 0.0])])[0].moment
-array([[0., 0., 0.],
-       [0., 1., 0.],
-       [0., 2., 0.]])
->>> sweep.column
-'tip_moment_y_Nm'
+are here. :func:`solve_case` is :mod:`softarm.case`'s, re-exported. (An example of a
+:class:`Sweep`: :mod:`softarm._sweep_table`.)
 """
 
 from .._sweep_table import COMPONENTS, DESIGNS, Design, Parameter, Sweep
