@@ -114,8 +114,8 @@ def run(cases: Sequence[str] | None = None, *, data_dir=_AUTO,
     report = Report(data_dir=tables.directory)
     if progress is not None:
         where = _where(tables.directory) if tables.directory is not None else "none (skipping)"
-        progress.write(f"reproduce: {len(selected)} cases; reference tables: {where}; the first "
-                       "numerical solve compiles the solver (about 1 min on a cold cache)\n")
+        # (a kernel's first compile on this machine says so itself, with its time: _jit)
+        progress.write(f"reproduce: {len(selected)} cases; reference tables: {where}\n")
     start = time.perf_counter()
     for i, case in enumerate(selected):
         _progress(progress, i, len(selected), f"{case.name} ...")
