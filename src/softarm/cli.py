@@ -432,10 +432,8 @@ def _solve(case: Case, args) -> tuple:
     progress = _Progress()
     start = time.perf_counter()
     # A single solve has no steps to count; say that something is happening if it is slow
-    # (the first run compiles the solver's kernels).
-    notice = threading.Timer(2.0, lambda: print(
-        "solving... (the first run also compiles the solver; later runs are fast)",
-        file=sys.stderr, flush=True))
+    # (a first compile announces itself, with its time: softarm._jit)
+    notice = threading.Timer(2.0, lambda: print("solving...", file=sys.stderr, flush=True))
     notice.daemon = True
     if case.sweep is None:
         notice.start()
