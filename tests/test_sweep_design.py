@@ -239,3 +239,29 @@ def test_a_pickled_design_leaves_its_samples_behind():
     small = len(pickle.dumps(Design(design.parameters, "sobol", samples=4096)))
     assert len(pickle.dumps(design)) == small < 1000
     np.testing.assert_array_equal(pickle.loads(pickle.dumps(design)).values(), values)
+
+
+def test_a_stiffness_matrix_arm_has_no_stiffness_table_to_sweep():
+    # arm.stiffness.EIy on an arm given by a full stiffness_matrix: one CaseError when the
+    # file is read (it passed, and the sweep ended in a KeyError traceback)
+    import tomllib
+
+    from softarm.case import CaseError, parse_case
+
+    text = """
+[arm]
+length = 1.0
+stiffness_matrix = [[1e6, 0, 0, 0, 0, 0], [0, 1e6, 0, 0, 0, 0], [0, 0, 1e6, 0, 0, 0],
+                    [0, 0, 0, 1, 0, 0], [0, 0, 0, 0, 1, 0], [0, 0, 0, 0, 0, 1]]
+[[load]]
+kind = "tip"
+force = [0.0, 0.0, 1.0]
+[sweep]
+design = "grid"
+[[sweep.parameter]]
+path = "arm.stiffness.EIy"
+values = [1.0, 2.0]
+"""
+    with pytest.raises(CaseError, match=r"arm\.stiffness\.EIy: this arm is given by its "
+                                        r"stiffness_matrix, not stiffness"):
+        parse_case(tomllib.loads(text), "x.toml")

@@ -604,3 +604,22 @@ def test_an_unreachable_scheduler_is_named_with_the_time_waited(tmp_path, capsys
     assert code == 2
     assert err == f"softarm: error: cannot reach the Dask scheduler at {address} within 1 s\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["case.toml"]
+
+
+def test_resuming_a_path_store_with_workers_is_refused_first(tmp_path, capsys):
+    """A store started with --path resumes serially: --resume --workers 2 is refused in one
+    line before any worker starts (it built a process pool, then failed naming `map`)."""
+    from softarm.cli import main
+
+    case_file = tmp_path / "path.toml"
+    case_file.write_text('[arm]\nlength = 1.0\nstiffness = { EA = 1e9, GAy = 1e9, GAz = 1e9, '
+                         'GJ = 1.0, EIy = 1.0, EIz = 1.0 }\n[[load]]\nkind = "tip"\n'
+                         'force = [0.0, 0.0, 1.0]\n[sweep]\nload = 1\ncomponent = "z"\n'
+                         'values = [1.0, 2.0]\n')
+    out = tmp_path / "path.zarr"
+    assert main(["sweep", str(case_file), "-o", str(out), "--stations", "3", "--path"]) == 0
+    capsys.readouterr()
+    assert main(["sweep", str(case_file), "-o", str(out), "--resume", "--workers", "2"]) == 2
+    err = capsys.readouterr().err
+    assert err == ("softarm: error: this store was started with --path: it follows the cases "
+                   "one after the other, in this process; give no --workers or --scheduler\n")

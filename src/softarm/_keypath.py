@@ -108,11 +108,13 @@ def resolve(data: dict, path: str) -> Target:
             raise ValueError(f"{path}: there are {len(segments)} [[segment]] tables, got "
                              f"segment[{index}] (counted from 1)")
         table, where = segments[index - 1], ("segment", index - 1)
-    subtables = ("section", "material") if "section" in table else ("stiffness",)
+    # an arm given by a full stiffness_matrix has no table of numbers to sweep by name
+    subtables = ("section", "material") if "section" in table else (
+        ("stiffness",) if "stiffness" in table else ())
     if rest[0] in ("section", "material", "stiffness"):
         if rest[0] not in subtables:
-            raise ValueError(f"{path}: this arm is given by its {' and '.join(subtables)}, "
-                             f"not {rest[0]}")
+            given = " and ".join(subtables) or "stiffness_matrix"
+            raise ValueError(f"{path}: this arm is given by its {given}, not {rest[0]}")
         if len(rest) < 2:
             raise ValueError(f"{path}: name a key of the {rest[0]} table")
         if rest[0] == "section":
@@ -147,7 +149,11 @@ def _table_of(data: dict, table: tuple) -> dict:
     node = data
     for key in table:
         if not (isinstance(key, int) and isinstance(node, dict)):  # a lone [segment] table
-            node = node[key]
+            try:
+                node = node[key]
+            except (KeyError, IndexError, TypeError):
+                raise ValueError(f"the case has no table {'.'.join(map(str, table))}"
+                                 ) from None
     return node
 
 

@@ -709,9 +709,19 @@ def _run_sweep(args) -> int:
         except ImportError:
             raise CaseError("--scheduler needs Dask's distributed: pip install "
                             "'softarm[dask]'") from None
-    if args.path and (args.scheduler is not None or args.workers > 1):
-        raise CaseError("--path follows the cases one after the other, in this process; give "
-                        "no --workers or --scheduler")
+    path = args.path
+    if args.resume and path is None:  # a store started with --path resumes serially too
+        from .sweep._store import recorded_options
+
+        try:
+            recorded = recorded_options(out)
+        except ValueError as error:
+            raise CaseError(str(error)) from None
+        path = bool(recorded and recorded["path"])
+    if path and (args.scheduler is not None or args.workers > 1):
+        raise CaseError(("this store was started with --path: it " if args.path is None else
+                         "--path ") + "follows the cases one after the other, in this "
+                        "process; give no --workers or --scheduler")
     progress = _Progress(label="sweep", unit="cases", rate=True)
     start = time.perf_counter()
     try:
@@ -724,7 +734,7 @@ def _run_sweep(args) -> int:
                 client = _connect(Client, args.scheduler)
             executor = client.get_executor(pure=False)
             mapper = executor.map
-        elif args.workers > 1 and not args.path:
+        elif args.workers > 1 and not path:
             executor = sweep.process_pool(args.workers, case)  # forked where safe
             mapper = executor.map
         try:
