@@ -516,7 +516,7 @@ def solve_case(case: Case, *, method: str | None = None, stations: int | None = 
     Equilibrium
         Batch shape (steps,) for a sweep, () otherwise.
     """
-    if getattr(case, "design", None) is not None:
+    if case.design is not None:
         raise ValueError(f"{case.source or case.name}: [sweep] is a design over "
                          f"{', '.join(case.design.paths)}; run it with softarm sweep CASE.toml "
                          "-o OUT.zarr (softarm.sweep.run)")

@@ -703,12 +703,14 @@ def _run_sweep(args) -> int:
         raise CaseError(f"{args.case}: sweep: missing (softarm sweep needs a [sweep] table)")
     executor = cluster = client = None
     mapper = None
+    killed = concurrent.futures.BrokenExecutor  # what a worker that died raises
     if args.scheduler is not None:
         try:
-            from distributed import Client, LocalCluster
+            from distributed import Client, KilledWorker, LocalCluster
         except ImportError:
             raise CaseError("--scheduler needs Dask's distributed: pip install "
                             "'softarm[dask]'") from None
+        killed = (concurrent.futures.BrokenExecutor, KilledWorker)
     path = args.path
     if args.resume and path is None:  # a store started with --path resumes serially too
         from .sweep._store import recorded_options
@@ -744,7 +746,7 @@ def _run_sweep(args) -> int:
                                path=args.path, progress=progress)
         except (ValueError, TypeError) as error:
             raise CaseError(_named(error, case.source or case.name, out)) from None
-        except concurrent.futures.BrokenExecutor:  # a worker killed (the OOM killer: SIGKILL)
+        except killed:  # a worker killed (the OOM killer: SIGKILL), a process or a Dask one
             progress.close()
             print("softarm: a worker process of the sweep died (killed by the system, e.g. "
                   "out of memory); the finished chunks are kept: finish with softarm sweep "

@@ -28,7 +28,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ._validate import count, real
+from ._validate import count, format_value, real
 from .dispatch import warn_unstable, warn_verdict
 from .equilibrium import Equilibrium, Stability
 from .errors import ConvergenceError
@@ -920,7 +920,7 @@ def _scales(scales, n) -> np.ndarray:
             np.all(values >= 1e-100) and np.all(values <= 1e100)):
         raise ValueError(f"scales must be a positive number in [1e-100, 1e100] (each input's "
                          f"unit of effort, in its SI unit) or {n} of them (one per input), got "
-                         f"{scales!r}")
+                         f"{format_value(scales)}")
     return np.broadcast_to(values, (n,)).copy()
 
 

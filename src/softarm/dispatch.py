@@ -173,8 +173,7 @@ def solve_stable(solver: Solver, loads, imperfection=None, *, max_switches=4):
         if not bifurcations:
             break
         new = switch_at(path, bifurcations[0], imperfection, 1.0)
-        points, indices, critical = (np.asarray(new.equilibria.base_wrench), new.index,
-                                     new.critical)
+        indices, critical = new.index, new.critical
         points = np.column_stack([np.asarray(new.x) / path.xscale, new.lam])
     if indices[-1] != 0 or abs(points[-1, 6] - 1.0) > 1e-12:
         raise ConvergenceError(

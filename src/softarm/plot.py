@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ._files import write_atomic
 from .geometry import (
     actuator_paths,
     cube_limits,
@@ -129,7 +130,6 @@ def _side_axes(side) -> None:
 
 def _finish(fig, path):
     if path is not None:
-        from .io import write_atomic
 
         path = Path(path)
         fmt = path.suffix.lstrip(".").lower() or "png"

@@ -27,7 +27,7 @@ import numpy as np
 
 from .. import dispatch
 from .._sweep_table import Design, Parameter
-from .._validate import check_allocation, count
+from .._validate import check_allocation, count, format_value
 from ..case import parse_case
 from ..errors import ConvergenceError
 from ..lie import so3
@@ -247,7 +247,7 @@ def _record(eq, rows: np.ndarray, data: dict) -> None:
 def design_of(case) -> Design:
     """The sweep design of a case: its ``[sweep]`` design, or its one-parameter sweep as a
     list design over ``load[i].field.component``."""
-    if getattr(case, "design", None) is not None:
+    if case.design is not None:
         return case.design
     sweep = case.sweep
     if sweep is None:
@@ -407,7 +407,8 @@ def _check_given(out, given: dict, recorded: dict, final: dict) -> None:
 
 
 def _text(value) -> str:
-    return ",".join(value) if isinstance(value, tuple) else f"{value:g}" \
+    """An option's value in a message (a float with every digit that tells it apart)."""
+    return ",".join(value) if isinstance(value, tuple) else format_value(value) \
         if isinstance(value, float) else str(value)
 
 
