@@ -23,7 +23,8 @@ import numpy as np
 
 from .errors import ConvergenceError, InadmissibleStateError
 
-__all__ = ["check_finite", "check_stretch", "inside_out", "load_case", "tendon_limit"]
+__all__ = ["all_finite", "batch_part", "check_finite", "check_stretch", "distinct",
+           "inside_out", "load_case", "stretched", "tendon_limit"]
 
 
 #: While a part of a larger batch is solved (statics.solver solves a batch in parts), the
@@ -32,10 +33,11 @@ _PART: contextvars.ContextVar = contextvars.ContextVar("softarm_batch_part", def
 
 
 @contextlib.contextmanager
-def batch_part(shape: tuple, first: int):
-    """Within the block, :func:`load_case` of a part (a batch of shape (n,)) names its cases
-    in the whole batch of shape ``shape``, of which the part starts at case ``first``."""
-    token = _PART.set((tuple(shape), int(first)))
+def batch_part(shape: tuple, first: int, size: int):
+    """Within the block, :func:`load_case` of the part (a batch of shape (size,)) names its
+    cases in the whole batch of shape ``shape``, of which the part starts at case ``first``
+    (another batch solved meanwhile, e.g. a diagnosis's, keeps its own numbers)."""
+    token = _PART.set((tuple(shape), int(first), int(size)))
     try:
         yield
     finally:
@@ -48,7 +50,7 @@ def load_case(flat: int, shape: tuple) -> str:
     if not shape:
         return ""
     part = _PART.get()
-    if part is not None and len(shape) == 1:
+    if part is not None and tuple(shape) == (part[2],):
         shape, flat = part[0], part[1] + int(flat)
     return f" for load case {tuple(int(i) for i in np.unravel_index(int(flat), shape))}"
 

@@ -208,8 +208,12 @@ class _Notice(event.Listener):
             _ANNOUNCED.add(key)
         if first and notices:
             seconds, _ = compile_seconds(key, dispatcher)
-            print(f"softarm: compiling {text}, once (about {_about(seconds)} on this machine; "
-                  "later runs load it from the cache)", file=sys.stderr, flush=True)
+            cached = _record_path(dispatcher) is not None
+            print(f"softarm: compiling {text}{', once' if cached else ''} (about "
+                  f"{_about(seconds)} on this machine; " + (
+                      "later runs load it from the cache)" if cached else
+                      "not cached here: every process compiles it; set NUMBA_CACHE_DIR)"),
+                  file=sys.stderr, flush=True)
 
     def on_end(self, ev):
         stack = _STATE.__dict__.setdefault("stack", [])

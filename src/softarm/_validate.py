@@ -19,11 +19,17 @@ from numbers import Integral, Real
 import numpy as np
 
 __all__ = [
+    "BYTES_PER_CASE",
+    "BYTES_PER_STATION",
+    "CASES_PER_PART",
     "LENGTH_RANGE",
+    "PART_BYTES",
+    "WORK_PER_CASE",
     "as_array",
     "as_matrices",
     "as_vectors",
     "check_allocation",
+    "check_array_size",
     "count",
     "format_bytes",
     "format_value",
@@ -47,10 +53,10 @@ BYTES_PER_STATION = 28 * 8
 #: wrench, verdict, ...): measured 200-610 B (tests/test_memory.py)
 BYTES_PER_CASE = 640
 #: The work (bytes) one part of a batch may take beside the result: every route cuts a large
-#: batch into parts of this much work (load channels, solver or closed-form arrays, a part's
-#: own result before it is copied in), so that a batch needs its result's memory and at most
-#: three times this (measured up to 2.2: the part being solved with its result, and what the
-#: allocator still holds of the one before, tests/test_memory.py)
+#: batch into parts of about this much work (load channels, solver or closed-form arrays),
+#: counted three times by the guard (measured up to 2.2: the part being solved, and what the
+#: allocator still holds of the one before, tests/test_memory.py); the solver's parts also
+#: copy their own result into the whole batch's (CASES_PER_PART, counted twice)
 PART_BYTES = 1 << 26
 
 #: Largest deviation ‖RᵀR − I‖ (max entry) of a base rotation that is re-orthonormalised; a
@@ -67,7 +73,8 @@ def format_value(value, limit: int = 80) -> str:
     the same float: ``0.10000000001`` (never rounded to ``0.1``, which would hide why it is
     out of range) and ``-0.5`` (never ``np.float64(-0.5)``, numpy 2's repr). Lists, tuples and
     small arrays are shown element by element the same way; a large array by its shape and
-    dtype; anything else by its repr. Every number put into a message goes through here.
+    dtype; anything else by its repr. The numbers of the model's error messages go through
+    here (a few older messages still show a value's repr).
 
     Examples
     --------
@@ -314,7 +321,7 @@ def memory_limit() -> int:
 def check_array_size(shape, name: str) -> None:
     """ValueError naming ``name`` if a float64 array of this shape (an input softarm copies,
     e.g. a zero-copy ``np.broadcast_to`` view) cannot fit in :func:`memory_limit`."""
-    size = 8.0 * float(np.prod(np.asarray(shape, dtype=np.float64)))
+    size = 8.0 * math.prod(int(n) for n in shape)  # (exact: Python ints)
     if size > memory_limit():
         raise ValueError(
             f"{name}: an array of shape {tuple(int(n) for n in shape)} would need "

@@ -410,7 +410,8 @@ class InverseSolver:
         self._model_bounds = (np.where(tension, 0.0, -np.inf), np.full(n, np.inf))
         self.scales = np.ones(n) if scales is None else _scales(scales, n)
         self.q = np.clip(self.q, lower, upper)
-        self.solver = Solver(arm, s=s, tol=solver_tol)
+        # (its trial steps catch failures themselves: no diagnosis of a failed path)
+        self.solver = Solver(arm, s=s, tol=solver_tol, diagnose=False)
         # where a target after a miss starts (_solve): the last answer that reached its
         # target, at first the first target's first guess (None until then)
         self._sane = None
@@ -424,7 +425,7 @@ class InverseSolver:
         if not displaced:
             return self.actuators, displaced
         try:
-            eq = Solver(arm, s=2, tol=solver_tol).solve_from_unloaded(
+            eq = Solver(arm, s=2, tol=solver_tol, diagnose=False).solve_from_unloaded(
                 [*self.loads, *self.actuators])
             tensions = eq.tendon_tensions
         except ConvergenceError:

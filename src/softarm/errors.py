@@ -13,6 +13,8 @@ class ConvergenceError(RuntimeError):
 
     Attributes
     ----------
+    message : str
+        What failed, without the residual and what was tried (``str(error)`` has all three).
     residual : float
         Infinity norm of the boundary-condition residual at the last iterate, in the units of
         the tip wrench (N and N m).
@@ -25,6 +27,7 @@ class ConvergenceError(RuntimeError):
 
     def __init__(self, message: str, residual: float, tried: str = "", *,
                  load_factor: float | None = None):
+        self.message = message
         self.residual = float(residual)
         self.tried = tried
         self.load_factor = load_factor

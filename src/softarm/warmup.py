@@ -146,7 +146,7 @@ def compile_kernels(all: bool = False, progress: Callable | None = None) -> list
 
     steps = [step for step in STEPS if all or step.first]
     done = []
-    quiet, _jit.notices = _jit.notices, progress is None and _jit.notices
+    previous, _jit.notices = _jit.notices, progress is None and _jit.notices
     try:
         for index, step in enumerate(steps):
             estimate = sum(_jit.compile_seconds(key, _dispatcher(key))[0] for key in step.keys)
@@ -160,7 +160,7 @@ def compile_kernels(all: bool = False, progress: Callable | None = None) -> list
                 progress(step, index, len(steps), seconds, -1.0)
             done.append((step, seconds, list(_jit.COMPILED[before:])))
     finally:
-        _jit.notices = quiet
+        _jit.notices = previous
     return done
 
 

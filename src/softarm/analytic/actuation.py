@@ -122,6 +122,9 @@ def _root(K, f0, tendons, chambers):
             moved = np.where(usable, np.max(np.abs(trial - eps), axis=-1), 0.0)
             eps = np.where(usable[:, None], trial, eps)
             energy, F, H = _energy(K, f0, wrench, tendons, eps, True)
+        # (of the last iterate: after the twelfth step too)
+        converged = np.isfinite(H).all(axis=(-2, -1)) & (np.max(np.abs(F), axis=-1) <= 1e-10 * (
+            scale + np.max(np.abs((eps - f0) @ K.T), axis=-1)))
     residual = np.max(np.abs(F), axis=-1)
     return eps, converged, np.where(np.isfinite(residual), residual, first)
 
@@ -391,7 +394,12 @@ def _checked_roots(pieces, loads, shape, count) -> list[np.ndarray]:
         for case in np.flatnonzero(~admissible):
             if limits and case > min(limits):
                 break  # (a later case: the first one is reported)
-            root, limit = _Path(piece, int(case)).follow()
+            try:
+                root, limit = _Path(piece, int(case)).follow()
+            except ConvergenceError as error:  # (name the case, with its Newton residual)
+                raise ConvergenceError(
+                    f"{error.message}{load_case(int(case), shape)}",
+                    float(np.broadcast_to(residual, count)[case])) from None
             if root is not None:
                 eps[case] = root
             elif case not in limits or limit[0] < limits[case][0]:

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from .._validate import PART_BYTES, check_allocation
+from .._validate import PART_BYTES, WORK_PER_CASE, check_allocation
 from ..loads import TipLoad, check_magnitudes
 from ._common import (
     ROUNDOFF,
@@ -208,10 +208,11 @@ def solve_elastica(arm, force: np.ndarray, s: np.ndarray, extensible: bool, load
                  stresses=stresses)
 
 
-#: Bytes of work per load case and per station of the batch route (planar_elastica's
-#: quadrature and its arrays, measured about 10 kB and 0.2 kB): a batch is evaluated in
-#: parts of at most PART_BYTES of work, so that it needs its result's memory and little more
-_CASE_BYTES, _STATION_BYTES = 12_000, 400
+#: Bytes of work per station of the batch route beside its WORK_PER_CASE a load case
+#: (planar_elastica's quadrature and its arrays, measured about 10 kB a case and 0.2 kB a
+#: station): a batch is evaluated in parts of at most PART_BYTES of work, so that it needs
+#: its result's memory and little more
+_STATION_BYTES = 400
 
 
 def _batch_fields(k, phi, s_over_L, axial_ratio, shear_ratio, b, L, r) -> np.ndarray:
@@ -225,7 +226,7 @@ def _batch_fields(k, phi, s_over_L, axial_ratio, shear_ratio, b, L, r) -> np.nda
             (k, phi, axial_ratio, shear_ratio, b[..., 1], b[..., 2])]
     fields = np.empty((*shape, s_over_L.size, 28))  # (the caller freezes this very array)
     rows = fields.reshape(count, s_over_L.size, 28)  # a view of it
-    part = max(1, PART_BYTES // (_CASE_BYTES + _STATION_BYTES * s_over_L.size))
+    part = max(1, PART_BYTES // (WORK_PER_CASE + _STATION_BYTES * s_over_L.size))
     for first in range(0, count, part):
         k_, phi_, a_, g_, by, bz = (x[first:first + part] for x in flat)
         sol = planar_elastica(k_, phi_, s_over_L, axial_ratio=a_, shear_ratio=g_)

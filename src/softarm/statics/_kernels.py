@@ -135,9 +135,9 @@ FD, FF, LD, LF, JD, JF = _FD, _FF, _LD, _LF, _JD, _JF = 0, 3, 6, 9, 12, 18
 FB, FG = _FB, _FG = 24, 27
 PIECE_LOADS = 36
 ACT = _ACT = 36
-# Actuator kinds (the arm tuple's ``kinds``).
+# Actuator kinds (``act``'s ``kinds``).
 TENDON, CHAMBER = 0, 1
-# The columns of an actuator's routing row (the arm tuple's ``routes``): a bound of its
+# The columns of an actuator's routing row (``act``'s ``routes``): a bound of its
 # distance from the centreline (m, for load sizes), the helix radius (m), angular rate
 # 2π n (rad/m) and phase (rad), then D power-series coefficients of y(s), then D of z(s).
 _RHO, _HR, _HW, _HP, _POLY = 0, 1, 2, 3, 4

@@ -86,6 +86,9 @@ def wait(kind: str) -> None:
     deadline = time.monotonic() + _PATIENCE
     while process.poll() is None and time.monotonic() < deadline:
         time.sleep(0.02)
+    if process.poll() is None:  # hung: this process compiles for itself from now on
+        process.kill()
+    _RUNNING[kind] = None  # done: never waited for again (start() sees it was launched)
 
 
 @atexit.register

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._admissible import check_stretch, inside_out
+from .._admissible import check_stretch, inside_out, stretched
 from ..equilibrium import Equilibrium
 from ..errors import ConvergenceError
 from ..loads import as_loads
@@ -257,9 +257,8 @@ class Path:
         k.record_points(self.base, *self.arm, (np.ascontiguousarray(piece),
                                               np.ascontiguousarray(tip)),
                         xs, self.steps, solver._s_kernel, out)
-        outside = inside_out(strains).any(axis=-1)
-        if outside.any():
-            first = int(np.argmax(outside))
+        if not stretched(strains):  # (the common case: one reduction)
+            first = int(np.argmax(inside_out(strains).any(axis=-1)))
             check_stretch(strains[first], solver.s, info[first, 0], stresses[first],
                           f"the branch's point at load factor λ = {lam[first]:.6g}",
                           float(lam[first]))

@@ -16,10 +16,12 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .._admissible import batch_part, check_stretch, load_case, stretched, tendon_limit
+from .._admissible import batch_part, check_stretch, load_case, tendon_limit
 from .._threads import in_threads, threads_for
 from .._validate import (
-    PART_BYTES,
+    BYTES_PER_CASE,
+    BYTES_PER_STATION,
+    CASES_PER_PART,
     check_allocation,
     count,
     real,
@@ -46,10 +48,6 @@ _IDENTITY = np.eye(4)
 _IDENTITY.setflags(write=False)
 #: Fewest load cases per thread of a batch: below it a thread costs more than it saves.
 CASES_PER_THREAD = 16
-#: Most load cases solved at once (``_validate.CASES_PER_PART``): a larger batch is solved
-#: in parts of this size, each with its own load channels and work arrays (about 2 kB a
-#: case) and its own result, copied into the whole batch's (tests/test_memory.py).
-CASES_PER_PART = PART_BYTES // 2048
 
 
 def _kernels():
@@ -164,7 +162,9 @@ class _ArmData:
 
     @functools.lru_cache(maxsize=16)  # noqa: B019 (per arm data, itself cached per arm)
     def pieces(self, cuts: tuple[float, ...]) -> tuple:
-        """The kernel's arm tuple for the arm cut at the segment joints and at ``cuts``."""
+        """The arm cut at the segment joints and at ``cuts``: (starts, lengths, C, f0, zero,
+        diag, length, scale, K: the kernel's ``arm``; magnetisation, dipoles: ``act``'s
+        magnets; linear density, segment of each piece)."""
         starts = np.unique(np.concatenate([self.bounds, np.asarray(cuts, dtype=np.float64)]))
         starts = starts[(starts >= 0.0) & (starts < self.length)]
         ends = np.append(starts[1:], self.length)
@@ -308,7 +308,8 @@ class _Channels:
         return self._actuated_arm()[1:]
 
     def _actuated_arm(self) -> tuple:
-        """(arm tuple, tendon columns, unloaded tendon lengths): what depends on the cut and
+        """((arm, act) kernel pair, tendon columns, unloaded tendon lengths): what depends on
+        the cut and
         on the actuators' kinds, paths and spans alone, not on their magnitudes. A control
         loop or a sweep solves many cases of one structure, so it is remembered per arm
         (40-60 µs of every robot solve otherwise: routing rows, tendon quadratures)."""
@@ -437,7 +438,8 @@ class Shooter:
     def kernel_arrays(self, steps) -> tuple:
         """What a compiled caller of the kernel's ``shoot`` needs to integrate these loads
         at any inputs q (inverse statics' ``inverse_newton``): the step counts (``steps`` as
-        in :meth:`Solver.shoot`), the base pose, the arm tuple, and the channels at q = 0
+        in :meth:`Solver.shoot`), the base pose, the kernel's (arm, act) pair (passed on as
+        ``*arm``), and the channels at q = 0
         and per unit input (piece0 (P, W), unit piece (n, P, W), tip0 (12,), unit tip
         (n, 12); piece(q) = piece0 + Σᵢ qᵢ unitᵢ)."""
         return (self._steps(steps), self._solver._base_kernel, self._arm,
@@ -784,6 +786,12 @@ class Solver:
         16 cases; the answer is the same to the bit. Default: ``$SOFTARM_NUM_THREADS`` or
         every core this process may run on (``softarm._threads``). A chained :meth:`solve`
         runs its batch in order, in one thread.
+    diagnose : bool
+        When a case's loading path fails and tendons act, find out whether a tendon's path
+        left the model there (its length vanishing: an :class:`~softarm.InadmissibleStateError`
+        naming the tendon and the tension it can carry), by solving the case again near the
+        failure. Default True; False for a caller that handles failures itself and reads no
+        message (inverse statics' trial steps).
 
     Examples
     --------
@@ -797,7 +805,7 @@ class Solver:
 
     def __init__(self, arm, *, s=None, tol=1e-8, base=None, max_iterations=12,
                  max_load_step=1.0, steps=None, max_steps=_N_MAX, max_shootings=10000,
-                 stability=True, threads=None):
+                 stability=True, threads=None, diagnose=True):
         self.arm = _check_arm(arm)
         self._data = _arm_data(arm)
         self.length = self._data.length
@@ -827,6 +835,9 @@ class Solver:
             raise TypeError(f"stability must be True or False, got {stability!r}")
         self.stability = bool(stability)
         self.threads = None if threads is None else count(threads, "threads", 1)
+        if not isinstance(diagnose, (bool, np.bool_)):
+            raise TypeError(f"diagnose must be True or False, got {diagnose!r}")
+        self.diagnose = bool(diagnose)
         self._coarse_ratio = 4  # the path runs on N / 4 steps (benchmarks/run.py measures it)
         self.reset()
 
@@ -843,19 +854,35 @@ class Solver:
 
     # ---------------------------------------------------------------- preparation
 
-    def check_loads(self, loads) -> tuple[tuple, tuple[int, ...]]:
+    def check_loads(self, loads, *, jacobians: bool = False) -> tuple[tuple, tuple[int, ...]]:
         """(loads as a tuple, their batch shape), after checking that every load fits the arm
-        and that the batch's outputs fit in memory (ValueError before any allocation)."""
+        and that the batch's outputs (with ``jacobians``, the compliances and actuation
+        Jacobians too) fit in memory (ValueError before any allocation)."""
         loads = as_loads(loads)
         shape = batch_shape(loads)
         for load in loads:
             load.check(self.arm)
-        check_allocation(math.prod(shape), self.s.size, "loads")
+        self._check_memory(loads, shape, jacobians)
         check_magnitudes(self.arm, loads)
         return loads, shape
 
+    def _check_memory(self, loads, shape, jacobians: bool) -> None:
+        """:func:`check_allocation` of the batch's result; with Jacobians, per station the
+        motion per column (6 + n inputs) and the compliances made of it (twice 48 B a
+        column), per case the Jacobian's rows (6 + A actuators) likewise."""
+        per_station, per_case = BYTES_PER_STATION, BYTES_PER_CASE
+        if jacobians:
+            n = sum(int(np.size(getattr(load, name))) // max(1, math.prod(load.batch_shape))
+                    for load in loads for name in load.inputs)
+            actuators = sum(1 for load in loads if load.acts_through_base)
+            per_station += 2 * 48 * (6 + n)
+            per_case += 2 * 8 * (6 + actuators) * (6 + n)
+        check_allocation(math.prod(shape), self.s.size, "loads", per_station=per_station,
+                         per_case=per_case)
+
     def _prepare(self, loads, extra_cuts=(), *, checked=False):
-        """(loads, batch shape, count, the kernel's arm tuple, load channels); ``checked``:
+        """(loads, batch shape, count, the pieces (:meth:`_ArmData.pieces`), load channels);
+        ``checked``:
         ``loads`` is what :meth:`check_loads` returned (not checked again)."""
         loads, shape = (loads, batch_shape(loads)) if checked else self.check_loads(loads)
         count = math.prod(shape)
@@ -888,10 +915,12 @@ class Solver:
         ------
         ConvergenceError
             If the loading path meets a fold (the arm would snap; ``load_factor`` says where),
-            Newton fails, or the error estimate cannot reach tol.
+            Newton fails, or the error estimate cannot reach tol; its subclass
+            :class:`~softarm.InadmissibleStateError` if the loads lead the arm out of the
+            model (inside out, a tendon's path without length).
         ValueError
             For loads that do not fit the arm (point load off the arm, gravity without mass,
-            a load too large to represent).
+            a load too large to represent, a batch too large for memory).
         """
         return self._solve(loads, chained=True, jacobians=jacobians)
 
@@ -925,10 +954,15 @@ class Solver:
             return solve_displaced(self, loads, jacobians=jacobians)
         if not near:
             if not checked:
-                loads, shape = self.check_loads(loads)
+                loads, shape = self.check_loads(loads, jacobians=jacobians)
                 checked = True
             else:
                 shape = batch_shape(loads)
+                if jacobians:  # (checked without them: by softarm.solve, for every route)
+                    self._check_memory(loads, shape, jacobians)
+            # (CASES_PER_PART, _validate's: a larger batch is solved in parts of that many
+            # cases, each with its own channels, work arrays and result, copied into the
+            # whole batch's; tests/test_memory.py)
             if math.prod(shape) > CASES_PER_PART:
                 return self._solve_in_parts(loads, shape, chained=chained,
                                             jacobians=jacobians, outputs=outputs)
@@ -1039,7 +1073,7 @@ class Solver:
 
     def _solve_in_parts(self, loads, shape, *, chained: bool, jacobians: bool,
                         outputs: bool) -> Equilibrium | None:
-        """:meth:`_solve` of a batch larger than a part (:func:`_cases_per_part`), part after
+        """:meth:`_solve` of a batch larger than a part (:data:`CASES_PER_PART`), part after
         part (in the order of the flattened batch: a chained batch stays one path) into one
         result:
         each part's channels and work arrays are freed before the next, its outputs copied
@@ -1049,17 +1083,19 @@ class Solver:
         whole = None
         for first in range(0, count, size):
             index = np.unravel_index(np.arange(first, min(first + size, count)), shape)
-            with batch_part(shape, first):  # (messages name a case of the whole batch)
+            with batch_part(shape, first, index[0].size):  # (messages: the whole batch's)
                 result = self._solve([_part_of(load, shape, index) for load in loads],
-                                     chained=chained, jacobians=jacobians, outputs=outputs)
+                                     chained=chained, jacobians=jacobians, outputs=outputs,
+                                     checked=True)  # (the whole batch was)
             if outputs:
-                whole = whole or _Parts(result, count)
+                if whole is None:
+                    whole = _Parts(result, count)
                 whole.put(result, first)
         return whole.equilibrium(shape, loads) if outputs else None
 
     def _unused(self, shape: tuple) -> np.ndarray:
         """A placeholder whose contents the kernel never uses (the argument of a feature not
-        asked for: the Jacobians' outputs, the input channels), made once per shape."""
+        asked for: the Jacobians' outputs), made once per shape."""
         placeholders = self.__dict__.setdefault("_placeholders", {})
         found = placeholders.get(shape)
         if found is None:
@@ -1392,8 +1428,6 @@ def _admissible(solver, strains, stresses, s, shape, residual, chained: bool) ->
     :class:`~softarm.InadmissibleStateError` where the axial stretch v₁ <= 0 at a station
     (the shooting passes through v₁ = 0 without noticing: the equations stay smooth there);
     a chained Solver then returns to the unloaded arm, as after a failure."""
-    if stretched(strains):  # (the common case: nothing to reshape)
-        return
     try:
         check_stretch(strains.reshape(*shape, *strains.shape[-2:]), s, residual,
                       stresses.reshape(*shape, *stresses.shape[-2:]))
@@ -1425,20 +1459,21 @@ def _tendon_limit(solver, loads, shape, b: int, reached, residual: float
     otherwise (a fold of the arm, or a failure of a path that did not start from the
     unloaded arm)."""
     tendons = [load for load in loads if load.kind == "tendon"]
-    if not tendons or getattr(solver, "_probe", False):
+    if not tendons or not solver.diagnose:
         return None
     case = _case_loads(loads, shape, b)
-    if reached is None:  # from the unloaded arm, diagnosed by its own failure
+    options = dict(tol=solver.tol, base=solver.base, stability=False,
+                   max_iterations=solver.max_iterations, max_load_step=solver.max_load_step,
+                   steps=solver.steps, max_steps=solver.max_steps,
+                   max_shootings=solver.max_shootings)
+    if reached is None:  # not from the unloaded arm: the path from it says where it fails
         try:
-            Solver(solver.arm, s=2, tol=solver.tol, base=solver.base,
-                   stability=False).solve_from_unloaded(case)
-        except InadmissibleStateError as error:
-            return error
-        except ConvergenceError:
-            pass
+            Solver(solver.arm, s=2, diagnose=False, **options).solve_from_unloaded(case)
+        except ConvergenceError as error:
+            if error.load_factor is not None:  # (diagnosed here, named as case b)
+                return _tendon_limit(solver, loads, shape, b, error.load_factor, residual)
         return None
-    probe = Solver(solver.arm, s=201, tol=solver.tol, base=solver.base, stability=False)
-    probe._probe = True
+    probe = Solver(solver.arm, s=201, diagnose=False, **options)
     factors = reached * _PROBES
     try:
         eq = probe.solve_from_unloaded([load.scaled(factors) for load in case])
