@@ -76,3 +76,26 @@ def test_regularised_step_matches_scipy_on_the_stacked_system(seed):
         assert np.all((lower <= q + step + 1e-15) & (q + step <= upper + 1e-15))
         np.testing.assert_allclose(step, reference, rtol=0.0,
                                    atol=1e-8 * (1.0 + np.max(np.abs(reference))))
+
+
+def test_the_step_of_a_task_that_is_not_redundant_has_no_effort_term(rng):
+    # regularised_step(redundant=False): min |J s δu - b|² + μ σ² |δu|² in the box, without
+    # the ε σ² |u + δu|² rows (scipy's bvls on that stacked system: the reference)
+    for _ in range(30):
+        n = int(rng.integers(1, 5))
+        m = n + int(rng.integers(0, 3))  # (a full-rank, not redundant task)
+        J, b = rng.normal(size=(m, n)), rng.normal(size=m)
+        scales = np.exp(2.0 * rng.normal(size=n))
+        q = rng.uniform(0.0, 2.0, n)
+        lower, upper = np.zeros(n), np.full(n, 2.5)
+        mu = 0.0 if rng.random() < 0.5 else 10.0 ** rng.uniform(-4, 0)
+        Js = J * scales
+        sigma = np.sqrt(np.sum(Js**2))
+        rows = np.vstack([Js, np.sqrt(mu) * sigma * np.eye(n)])
+        rhs = np.concatenate([b, np.zeros(n)])
+        reference = lsq_linear(rows, rhs, bounds=(lower / scales - q / scales,
+                                                  upper / scales - q / scales),
+                               method="bvls", tol=1e-14).x * scales
+        step = regularised_step(J, b, q, scales, mu, lower, upper, redundant=False)
+        np.testing.assert_allclose(step, reference, rtol=0.0,
+                                   atol=1e-8 * (1.0 + np.max(np.abs(reference))))

@@ -543,18 +543,8 @@ class InverseSolver:
         the task. The nitinol robot has c ≈ 8e3 with unit scales; scales 100 apart make
         c ≈ 1e6, ε c² ≈ 1, and every target was missed by 3e-5 L, ``tests/test_control.py``.
         A redundant task keeps the term, and that limit: c² well below 1/ε.)"""
-        if redundant:
-            return regularised_step(J, b, q, self.scales, mu, self.lower, self.upper)
-        scales = self.scales
-        Js = J * scales
-        n = scales.size
-        sigma = max(math.sqrt(float(np.sum(Js * Js))), 1e-300)
-        u = q / scales
-        step, _ = _kernels().box_least_squares(
-            np.vstack([Js, math.sqrt(mu) * sigma * np.eye(n)]),
-            np.concatenate([b, np.zeros(n)]), self.lower / scales - u,
-            self.upper / scales - u, 100)
-        return step * scales
+        return regularised_step(J, b, q, self.scales, mu, self.lower, self.upper,
+                                redundant=redundant)
 
     def _shooting_newton(self, q, target, orientation, snapshot=False):
         """The fast route: Newton on the base reaction x and the inputs q together, one

@@ -33,12 +33,15 @@ def box_least_squares(A, b, lower, upper, iterations: int = 100):
     return x
 
 
-def regularised_step(J, b, q, scales, mu, lower, upper, iterations: int = 100):
+def regularised_step(J, b, q, scales, mu, lower, upper, iterations: int = 100, *,
+                     redundant: bool = True):
     """The bounded Gauss–Newton step δq of inverse statics: in scaled inputs u = q/s,
     argmin |J s δu - b|² + μ σ² |δu|² + ε σ² |u + δu|² subject to lower <= q + δq <= upper,
-    σ = |J s|_F, ε = 1e-12 (the least effort along the task's null space, moving the task
-    solution by ~1e-12 relative), δq = s δu; :func:`box_least_squares` of the stacked
-    system, built in compiled code."""
-    return _compiled().regularised_step(_floats(J), _floats(b), _floats(q), _floats(scales),
-                                       float(mu), _floats(lower), _floats(upper),
-                                       int(iterations))
+    σ = |J s|_F, δq = s δu; :func:`box_least_squares` of the stacked system, built in
+    compiled code. ε = 1e-12 for a ``redundant`` task (the least effort along its null
+    space, moving the task solution by ~1e-12 relative), else 0 (it would only bias the
+    answer: along J s's weakest direction, of singular value σ / c, it weighs ε c²)."""
+    k = _compiled()
+    return k.regularised_step(_floats(J), _floats(b), _floats(q), _floats(scales), float(mu),
+                              k.EFFORT if redundant else 0.0, _floats(lower), _floats(upper),
+                              int(iterations))

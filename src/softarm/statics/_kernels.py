@@ -2525,18 +2525,19 @@ def box_least_squares(A, b, lower, upper, iterations):
 
 
 @_entry(_fixed("bounded", "the bounded least squares"))
-def regularised_step(J, b, q, scales, mu, lower, upper, iterations):
+def regularised_step(J, b, q, scales, mu, effort, lower, upper, iterations):
     """The bounded Gauss–Newton step of inverse statics, in scaled inputs u = q / s:
     argmin |J' δu - b|² + μ σ² |δu|² + ε σ² |u + δu|² within the bounds, J' = J s (columns
-    scaled), σ = |J'|_F, ε = 1e-12 (root 1e-6); returns δq = s δu. The stacked system built
-    here, one call instead of a dozen numpy ones per step."""
+    scaled), σ = |J'|_F, ε = ``effort`` (1e-12 for a redundant task: the least effort along
+    its null space; 0 otherwise, where it would only bias the answer); returns δq = s δu.
+    The stacked system built here, one call instead of a dozen numpy ones per step."""
     m, n = J.shape
     sigma = 0.0
     for i in range(m):
         for j in range(n):
             sigma += (J[i, j] * scales[j]) ** 2
     sigma = max(math.sqrt(sigma), 1e-300)
-    root_eps = 1e-6
+    root_eps = math.sqrt(effort)
     A = np.zeros((m + 2 * n, n))
     rhs = np.zeros(m + 2 * n)
     lo = np.empty(n)
@@ -2568,6 +2569,9 @@ def regularised_step(J, b, q, scales, mu, lower, upper, iterations):
 # inverse_newton's outcomes (info[0]): the stop rule met; the iteration cap; the merit grew
 # (diverging); J_x singular or a value not finite.
 NEWTON_DONE, NEWTON_CAP, NEWTON_DIVERGED, NEWTON_SINGULAR = 0, 1, 2, 3
+#: The weight of the least effort along a redundant task's null space (regularised_step's
+#: ε: it moves the task solution by about 1e-12 relative)
+EFFORT = 1e-12
 
 
 @_jit
@@ -2772,7 +2776,8 @@ def inverse_newton(x, q, every, first, steps, base, arm, act, units, goal, bound
             _scaled_singular_values(J, scales, singular)
             redundant = 1 if redundant_task(singular, n) else 0
             info[2] = redundant
-        step = regularised_step(J, rhs, q, scales, 0.0, lower, upper, np.int64(100))
+        step = regularised_step(J, rhs, q, scales, 0.0, EFFORT if redundant else 0.0, lower,
+                                upper, np.int64(100))
         for c in range(n):
             trial[c] = min(max(q[c] + step[c], lower[c]), upper[c])
         if warm_step:
