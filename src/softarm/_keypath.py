@@ -17,13 +17,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import _schema
-from ._sweep_table import KEY_PATH
+from ._sweep_table import KEY_PATH, set_vector
 from .loads import LOAD_KINDS
 
-__all__ = ["VECTOR_COMPONENTS", "Target", "resolve", "set_value", "set_vector"]
+__all__ = ["VECTOR_COMPONENTS", "Target", "resolve", "set_value"]
 
 #: Components of a vector named in a key path.
-VECTOR_COMPONENTS = ("x", "y", "z", "magnitude")
+VECTOR_COMPONENTS = ("x", "y", "z", "magnitude")  # (COMPONENTS, in the order of a message)
 
 
 @dataclass(frozen=True)
@@ -126,23 +126,6 @@ def resolve(data: dict, path: str) -> Target:
     if rest[0] not in [k.name for k in _schema.ARM.keys]:
         _choose(path, "key", rest[0], choices)
     return _number_or_vector(path, _schema.ARM.keys, rest, where)
-
-
-def set_vector(vector: np.ndarray, component: str, values: np.ndarray, path: str
-                ) -> np.ndarray:
-    """``vector`` (..., 3) with ``component`` set to ``values`` (...,): a coordinate, or the
-    length along the vector's direction (ValueError naming ``path`` if it is zero)."""
-    out = np.array(np.broadcast_to(vector, (*np.shape(values), 3)), dtype=np.float64)
-    if component == "magnitude":
-        scale = np.max(np.abs(out), axis=-1, keepdims=True)  # scaled first: |v|² may overflow
-        if np.any(scale == 0):
-            raise ValueError(f"{path}: a magnitude needs a nonzero vector to give the "
-                             "direction, got (0, 0, 0)")
-        direction = out / scale
-        direction /= np.linalg.norm(direction, axis=-1, keepdims=True)
-        return np.asarray(values)[..., None] * direction
-    out[..., "xyz".index(component)] = values
-    return out
 
 
 def _table_of(data: dict, table: tuple) -> dict:

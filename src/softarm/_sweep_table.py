@@ -34,7 +34,7 @@ import numpy as np
 
 from .loads import LOAD_KINDS, as_loads
 
-__all__ = ["COMPONENTS", "DESIGNS", "KEY_PATH", "Design", "Parameter", "Sweep"]
+__all__ = ["COMPONENTS", "DESIGNS", "KEY_PATH", "Design", "Parameter", "Sweep", "set_vector"]
 
 #: The values of ``design`` in a ``[sweep]`` table.
 DESIGNS = ("grid", "list", "latin-hypercube", "sobol")
@@ -100,16 +100,29 @@ class Sweep:
         """``loads`` with the swept field replaced by a stack of shape (steps, 3)."""
         loads = as_loads(loads)
         target = loads[self.load]
-        base = np.asarray(getattr(target, self.field), dtype=np.float64)
-        values = np.asarray(self.values, dtype=np.float64)
-        if self.component == "magnitude":
-            direction = base / np.max(np.abs(base))  # scaled first: |v|² may overflow
-            stack = values[:, None] * (direction / np.linalg.norm(direction))
-        else:
-            stack = np.repeat(base[None, :], values.size, axis=0)
-            stack[:, "xyz".index(self.component)] = values
+        stack = set_vector(getattr(target, self.field), self.component,
+                           np.asarray(self.values, dtype=np.float64),
+                           f"sweep: load {self.load + 1}'s {self.field}")
         swept = replace(target, **{self.field: stack})
         return (*loads[: self.load], swept, *loads[self.load + 1:])
+
+
+def set_vector(vector: np.ndarray, component: str, values: np.ndarray, path: str
+               ) -> np.ndarray:
+    """``vector`` (..., 3) with ``component`` (one of :data:`COMPONENTS`) set to ``values``
+    (...,): a coordinate, or the length along the vector's direction (ValueError naming
+    ``path`` if it is zero). A case file's key path and a ``[sweep]`` both use it."""
+    out = np.array(np.broadcast_to(vector, (*np.shape(values), 3)), dtype=np.float64)
+    if component == "magnitude":
+        scale = np.max(np.abs(out), axis=-1, keepdims=True)  # scaled first: |v|² may overflow
+        if np.any(scale == 0):
+            raise ValueError(f"{path}: a magnitude needs a nonzero vector to give the "
+                             "direction, got (0, 0, 0)")
+        direction = out / scale
+        direction /= np.linalg.norm(direction, axis=-1, keepdims=True)
+        return np.asarray(values)[..., None] * direction
+    out[..., "xyz".index(component)] = values
+    return out
 
 
 def _finite(value, name: str) -> float:

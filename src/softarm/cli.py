@@ -1,28 +1,12 @@
-"""The ``softarm`` command: solve a case file, export the result, plot it.
+"""The ``softarm`` command: solve a case file, export the result, plot it, and the rest.
 
-::
-
-    softarm solve CASE.toml [-o out.csv|out.json|out.npz] [--plot out.png]
-                            [--method auto|numeric] [--stations N] [--tol TOL]
-    softarm plot RESULT.(csv|json|npz) [-o out.png]
-    softarm view RESULT.(csv|json|npz) [-o out.html]
-    softarm app CASE.toml [--port PORT] [--no-browser]
-    softarm sweep CASE.toml -o OUT.zarr [--workers N] [--scheduler local|tcp://host:8786]
-                            [--resume] [--fields F,...] [--stations N] [--dtype float32]
-                            [--chunk N] [--path] [--method auto|numeric] [--tol TOL]
-    softarm demo [--out DIR]
-    softarm compile [--all]
-    softarm reproduce [--out DIR]
-
-Exit codes (docs/cli.md): 0 success; 1 a failure: the solver did not converge (one line with
-the residual), a failed check of ``softarm reproduce``, a full disk or a file-size limit, out of
-memory; 2 bad input: a missing or misspelled key, a wrong type or value, a missing or unreadable
-file, an unknown output format, an output path that is a folder or the input file, a size whose
-result cannot fit in memory (one line naming the file, the key and what is wrong); 130
-interrupted (Ctrl-C), at any moment. Every error is one line on stderr, never a traceback.
-Outputs are written to a temporary file beside the target and renamed, so a failure never leaves
-a half-written result and an existing output stays intact; a symbolic link as output path is
-written through (its target is replaced, the link kept).
+The commands, their options, exit codes and output rules are documented in docs/cli.md (a
+test compares it with this parser): 0 success; 1 a failure (the solver did not converge, a
+state outside the model, a failed check of ``softarm reproduce``, a full disk, out of memory,
+a sweep worker killed); 2 bad input (one line naming the file, the key and what is wrong);
+130 interrupted (Ctrl-C). Every error is one line on stderr, never a traceback. Outputs are
+written to a temporary file beside the target and renamed, so a failure never leaves a
+half-written result and an existing output stays intact.
 """
 
 from __future__ import annotations
@@ -392,15 +376,20 @@ def interrupted(what: str = "interrupted") -> int:
 # --------------------------------------------------------------------------------------------
 
 
+def _check_picture(path: str, inputs=(), taken=()) -> Path:
+    """:func:`_check_output` of a picture, where matplotlib is installed (checked before any
+    solve: no output is written)."""
+    if importlib.util.find_spec("matplotlib") is None:
+        raise CaseError(f"{path}: drawing a picture needs matplotlib, which is not installed: "
+                        'pip install "softarm[plot]"')
+    return _check_output(path, _PICTURE_SUFFIXES, "picture", inputs, taken)
+
+
 def _check_output(path: str, suffixes: tuple[str, ...], what: str, inputs=(),
                   taken=()) -> Path:
     """An output path that can be written: a known suffix, an existing folder, not a folder
-    itself, not one of ``inputs`` nor ``taken`` (the other outputs), even through a link; a
-    picture only where matplotlib is installed (before any solve: no output is written)."""
+    itself, not one of ``inputs`` nor ``taken`` (the other outputs), even through a link."""
     out = Path(path)
-    if what == "picture" and importlib.util.find_spec("matplotlib") is None:
-        raise CaseError(f"{out}: drawing a picture needs matplotlib, which is not installed: "
-                        'pip install "softarm[plot]"')
     if out.suffix.lower() not in suffixes:
         raise CaseError(f"{out}: unknown {what} format {out.suffix or '(no suffix)'!r}; use "
                         f"one of {', '.join(suffixes)}")
@@ -522,8 +511,7 @@ def _outputs(args) -> tuple[list[Path], Path | None]:
     outputs: list[Path] = []
     for name in args.output:
         outputs.append(_check_output(name, FORMATS, "output", [args.case], outputs))
-    picture = (_check_output(args.plot, _PICTURE_SUFFIXES, "picture", [args.case], outputs)
-               if args.plot else None)
+    picture = _check_picture(args.plot, [args.case], outputs) if args.plot else None
     return outputs, picture
 
 
@@ -560,11 +548,11 @@ def _run_inverse(args) -> int:
     if task is not None and (task.lower is not None or task.upper is not None):
         bounds = (-np.inf if task.lower is None else np.array(task.lower),
                   np.inf if task.upper is None else np.array(task.upper))
+    # the [inverse] table's settings (InverseTask's defaults are InverseSolver's)
+    settings = {} if task is None else dict(tol=task.tol, max_iterations=task.max_iterations,
+                                            starts=task.starts)
     try:
-        solver = InverseSolver(case.arm, actuators, others, bounds=bounds,
-                               tol=task.tol if task is not None else 1e-6,
-                               max_iterations=task.max_iterations if task is not None else 10,
-                               starts=task.starts if task is not None else 6,
+        solver = InverseSolver(case.arm, actuators, others, bounds=bounds, **settings,
                                s=int(case.solve.stations), solver_tol=float(case.solve.tol))
     except (ValueError, TypeError) as error:
         raise CaseError(f"{args.case}: inverse: {error}") from None
@@ -626,15 +614,11 @@ def _plot(case: Case, result, picture: Path) -> None:
 
 def _run_plot(args) -> int:
     source = Path(args.result)
-    picture = _check_output(args.output or str(source.with_suffix(".png")), _PICTURE_SUFFIXES,
-                            "picture", [source])
+    picture = _check_picture(args.output or str(source.with_suffix(".png")), [source])
     saved = load_saved(source)
     from . import plot
 
-    try:
-        plot.plot_result_file(saved, path=picture)
-    except ImportError as error:  # matplotlib missing
-        raise CaseError(f"{picture}: {error}") from None
+    plot.plot_result_file(saved, path=picture)
     print(f"wrote {picture}")
     return 0
 
@@ -840,7 +824,7 @@ def _run_demo(args) -> int:
     with resources.as_file(resources.files("softarm") / "data" / "demo.toml") as path:
         case = load_case(path)
     table = _check_output(str(folder / "demo.csv"), FORMATS, "output")
-    picture = _check_output(str(folder / "demo.png"), _PICTURE_SUFFIXES, "picture")
+    picture = _check_picture(str(folder / "demo.png"))
     args.method = args.stations = args.tol = None
     result, seconds = _solve(case, args)
     print(_summary(case, result, seconds))

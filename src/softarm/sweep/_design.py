@@ -18,8 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._keypath import Target, resolve, set_value, set_vector
-from .._sweep_table import Design
+from .._keypath import Target, resolve, set_value
+from .._sweep_table import Design, set_vector
 from ..case import Case, parse_case
 from ..errors import CaseError
 
