@@ -192,12 +192,16 @@ def _chunk_files(store: Path) -> int:
     return sum(1 for p in folder.iterdir() if p.name.isdigit()) if folder.is_dir() else 0
 
 
+#: A design of 160 cases in chunks of 4: long enough to kill a sweep while it writes
+_KILLED_DESIGN = {"design": "grid", "parameter": [
+    {"path": "load[2].force.y", "start": 0.0, "stop": 0.1, "steps": 20},
+    {"path": "load[2].force.z", "start": -0.1, "stop": 0.0, "steps": 8}]}
+
+
 def test_resume_after_sigkill_equals_an_uninterrupted_run(tmp_path, capsys):
     """softarm sweep is killed (SIGKILL) while writing; --resume finishes the chunks whose
     done flag is missing, and the store then equals an uninterrupted run."""
-    sweep = {"design": "grid", "parameter": [
-        {"path": "load[2].force.y", "start": 0.0, "stop": 0.1, "steps": 20},
-        {"path": "load[2].force.z", "start": -0.1, "stop": 0.0, "steps": 8}]}
+    sweep = _KILLED_DESIGN
     case_file = tmp_path / "resume.toml"
     case_file.write_text(_toml(soft_arm_case(sweep)))
     out = tmp_path / "killed.zarr"
@@ -416,9 +420,7 @@ def test_a_killed_worker_is_one_line_naming_the_resume_command(tmp_path):
     """One worker of --workers 2 gets SIGKILL (what the kernel's out-of-memory killer sends):
     one line on stderr that names the command to resume, exit 1 (a failure, not bad input);
     that command, run as printed, finishes a store equal to the bit to an uninterrupted run."""
-    sweep = {"design": "grid", "parameter": [
-        {"path": "load[2].force.y", "start": 0.0, "stop": 0.1, "steps": 20},
-        {"path": "load[2].force.z", "start": -0.1, "stop": 0.0, "steps": 8}]}
+    sweep = _KILLED_DESIGN
     case_file = tmp_path / "killed.toml"
     case_file.write_text(_toml(soft_arm_case(sweep)))
     out = tmp_path / "killed.zarr"
