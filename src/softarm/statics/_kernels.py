@@ -2842,3 +2842,790 @@ def inverse_newton(x, q, every, first, steps, base, arm, act, units, goal, bound
             _scaled_singular_values(J, scales, singular)  # (its condition, reported)
             info[0] = NEWTON_DONE
             return
+
+
+# ------------------------------------------------------------------ multiple shooting
+# Stiff problems (tension: k = √(T/EI), kL large). Single shooting's map x -> r(x) grows like
+# e^{kL}; here [0, L] is cut into M intervals of kL/M <= _GROWTH each, the state at every
+# interval start is an unknown, and continuity at the joins closes the system: a block-banded
+# Newton system solved by banded Gaussian elimination with partial pivoting (never condensed
+# back into a 6 × 6 transfer product, which would restore e^{kL}). README.md, "Multiple
+# shooting"; docs/solver.md for users.
+#
+# Unknowns (scaled, n = 12 M - 6): the base reaction x (6, in units of the bending scale),
+# then per interior node i = 1..M-1 the corrections (δn, δm, δp, δθ) of its state (forces in
+# the bending scale, δp in L, δθ material, rad): the order of the tangent columns below.
+# Equations: per join (12 rows, p, θ, n, m: the end of interval i minus node i + 1), then the
+# tip residual (6). An interval from a node integrates 13 tangent columns: 0-5 δ(n; m) at the
+# node, 6 the load factor, 7-9 δp, 10-12 δθ; columns 7-12 use the rate rows 1-6 of the
+# case, which are zero (the homogeneous variational equations: the same _steps, no new
+# compiled right-hand side).
+
+_GROWTH = 5.0  # kL per shooting interval at most (the tangents grow by about e^5 across it)
+_STIFF_STEPS = 0.6  # coarse RK4 steps per unit of kL at least: hk <= 1.7 (RK4 is stable for the
+#                    decaying mode e^{-ks} up to hk = 2.78; the error estimate then decides)
+# The smallest load-factor step of the stiff path: the path from the unloaded arm bends
+# sharply near λ = 0 (k grows like √λ: the predicted lateral motion at λ = 0 is that of an
+# arm without tension), so steps far below _DLAM_MIN are needed there, doubling from then on.
+_DLAM_MIN_STIFF = 1e-12
+_BAND = 17  # the Jacobian's lower and upper bandwidth (rows of a join, columns of two nodes)
+_COLS = 13  # tangent columns of an interval from an interior node
+# Chunk rows (_chunk_table): piece, start s, length, 1.0 if it starts its piece (the point
+# wrench there is its own), the interval it belongs to.
+_CJ, _CS, _CL, _CFIRST, _CI = 0, 1, 2, 3, 4
+
+
+@_jit
+def _stiffness_size(arm, w):
+    """kL estimated from the case's load size ``w`` (in EI/L² of the *stiffest* bending,
+    :func:`_load_size`) with the softest bending stiffness of the arm: the growth exponent of
+    single shooting under a tension of that size."""
+    soft = 0.0
+    for j in range(arm[1].size):
+        soft = max(soft, arm[2][j, 4, 4], arm[2][j, 5, 5])
+    stiff = arm[7][3] * arm[6]  # the bending scale's EI
+    return math.sqrt(max(w, 0.0) * stiff * soft)
+
+
+@_jit
+def _chunk_table(arm, M, out):
+    """Cut [0, L] at the interval starts i L / M and at the piece starts: out[c] = (piece,
+    start, length, starts its piece, interval); returns (chunks, first chunk of each
+    interval (M + 1,))."""
+    piece_start, piece_len, length = arm[0], arm[1], arm[6]
+    first = np.empty(M + 1, dtype=np.int64)
+    c = 0
+    for i in range(M):
+        first[i] = c
+        a = length * i / M
+        b = length if i == M - 1 else length * (i + 1) / M
+        for j in range(piece_len.size):
+            s0 = piece_start[j]
+            s1 = s0 + piece_len[j] if j < piece_len.size - 1 else length
+            lo, hi = max(a, s0), min(b, s1)
+            if hi > lo or (j == 0 and i == 0 and hi >= lo):
+                out[c, _CJ] = j
+                out[c, _CS] = lo
+                out[c, _CL] = hi - lo
+                out[c, _CFIRST] = 1.0 if lo == s0 else 0.0
+                out[c, _CI] = i
+                c += 1
+    first[M] = c
+    return c, first
+
+
+@_jit
+def _chunk_steps(chunks, nc, length, N, factor, out):
+    """Steps per chunk for a nominal N over the arm (at least one), times ``factor``."""
+    for c in range(nc):
+        out[c] = factor * max(1, math.floor(N * chunks[c, _CL] / length + 0.5))
+
+
+@_jit
+def _run_chunks(y, T, nt, c0, c1, chunks, csteps, arm, act, rate, scratch):
+    """Integrate the chunks c0..c1-1 in place (state and the first nt tangent columns),
+    with the point wrench at the start of every chunk that starts its piece."""
+    work, twork, now, law = scratch[2], scratch[3], scratch[4], scratch[8]
+    for c in range(c0, c1):
+        j = int(chunks[c, _CJ])
+        if chunks[c, _CFIRST] > 0.0:
+            _jump(y, T, nt, now, rate, j, arm, act, law)
+        n = csteps[c]
+        _steps(y, T, nt, chunks[c, _CL] / n, chunks[c, _CS], n, arm, act, j, now, rate, work,
+               twork, law)
+
+
+@_jit
+def _node_start(y, T, nt, Z, i):
+    """The state at node i (Z[i]: p, R, n, m) and the tangents' initial values (columns 0-5
+    δ(n; m), 6 the load factor (0), 7-9 δp, 10-12 δθ)."""
+    for a in range(18):
+        y[a] = Z[i, a]
+    for a in range(18, y.size):
+        y[a] = 0.0
+    for d in range(nt):
+        for a in range(T.shape[1]):
+            T[d, a] = 0.0
+    for d in range(min(nt, 6)):
+        T[d, _TN + d] = 1.0
+    for d in range(3):
+        if nt > 7 + d:
+            T[7 + d, _TP + d] = 1.0
+            T[10 + d, _TT + d] = 1.0
+
+
+@_jit
+def _rotation_mismatch(Ra, y, A, out):
+    """A = Raᵀ R (R: y's rotation), out = vee(skew A) (zero where R = Ra; near it the
+    material rotation from Ra to R)."""
+    for a in range(3):
+        for b in range(3):
+            acc = 0.0
+            for k in range(3):
+                acc += Ra[_R + 3 * k + a] * y[_R + 3 * k + b]
+            A[a, b] = acc
+    out[0] = 0.5 * (A[2, 1] - A[1, 2])
+    out[1] = 0.5 * (A[0, 2] - A[2, 0])
+    out[2] = 0.5 * (A[1, 0] - A[0, 1])
+
+
+@_jit
+def _unknown(i, d):
+    """The unknown index of tangent column d (not 6) of the interval from node i."""
+    if i == 0:
+        return d
+    return 6 + 12 * (i - 1) + (d if d < 6 else d - 1)
+
+
+@_jit
+def _band_set(B, row, col, value):
+    B[row, col - row + _BAND] = value
+
+
+@_jit
+def _ms_evaluate(x, Z, M, lam, nt, chunks, first, csteps, base, arm, act, case, scratch,
+                 colscale, rowscale, F, B, G, ends, lengths):
+    """Integrate every interval at load factor λ: the scaled residual F (n), and with
+    tangents (nt > 0) the scaled Jacobian in band storage B (n, 3 _BAND + 1) and its load
+    factor column G (n). ``ends``: each interval's end state (M, width), for the tip and the
+    output. Returns the scaled residual's largest component. ``lengths``: the tendons'
+    lengths summed over the intervals."""
+    y, T = scratch[0], scratch[1]
+    rate, tip_rate = case[1], case[3]
+    now, tip_now, law = scratch[4], scratch[5], scratch[8]
+    _set_loads(lam, case, now, tip_now)
+    n = 12 * M - 6
+    if nt > 0:
+        for r_ in range(n):
+            G[r_] = 0.0
+            for c in range(B.shape[1]):
+                B[r_, c] = 0.0
+    A = np.empty((3, 3))
+    mis = np.empty(3)
+    J = np.empty((6, _COLS))
+    r6 = np.empty(6)
+    for a in range(lengths.size):
+        lengths[a] = 0.0
+    worst = 0.0
+    for i in range(M):
+        ni = 0 if nt == 0 else (7 if i == 0 else _COLS)
+        if i == 0:
+            _start(y, T, ni, base, x)
+        else:
+            _node_start(y, T, ni, Z, i)
+        _run_chunks(y, T, ni, first[i], first[i + 1], chunks, csteps, arm, act, rate, scratch)
+        for a in range(y.size):
+            ends[i, a] = y[a]
+        for a in range(lengths.size):
+            lengths[a] += y[18 + a]
+        if i < M - 1:
+            row = 12 * i
+            _rotation_mismatch(Z[i + 1], y, A, mis)
+            for k in range(3):
+                F[row + k] = (y[_P + k] - Z[i + 1, _P + k]) / rowscale[row + k]
+                F[row + 3 + k] = mis[k]
+                F[row + 6 + k] = (y[_N + k] - Z[i + 1, _N + k]) / rowscale[row + 6 + k]
+                F[row + 9 + k] = (y[_M + k] - Z[i + 1, _M + k]) / rowscale[row + 9 + k]
+            for k in range(12):
+                worst = max(worst, abs(F[row + k])) if math.isfinite(F[row + k]) else np.inf
+            if nt == 0:
+                continue
+            trace = A[0, 0] + A[1, 1] + A[2, 2]
+            for d in range(ni):
+                t = T[d]
+                if d == LAM:
+                    for k in range(12):
+                        G[row + k] = 0.0
+                    for k in range(3):
+                        G[row + k] = t[_TP + k] / rowscale[row + k]
+                        G[row + 3 + k] = 0.5 * (trace * t[_TT + k] - A[k, 0] * t[_TT]
+                                                - A[k, 1] * t[_TT + 1] - A[k, 2] * t[_TT + 2])
+                        G[row + 6 + k] = t[_TN + k] / rowscale[row + 6 + k]
+                        G[row + 9 + k] = t[_TM + k] / rowscale[row + 9 + k]
+                    continue
+                col = _unknown(i, d)
+                cs = colscale[col]
+                for k in range(3):
+                    _band_set(B, row + k, col, t[_TP + k] / rowscale[row + k] * cs)
+                    _band_set(B, row + 3 + k, col, 0.5 * cs * (
+                        trace * t[_TT + k] - A[k, 0] * t[_TT] - A[k, 1] * t[_TT + 1]
+                        - A[k, 2] * t[_TT + 2]))
+                    _band_set(B, row + 6 + k, col, t[_TN + k] / rowscale[row + 6 + k] * cs)
+                    _band_set(B, row + 9 + k, col, t[_TM + k] / rowscale[row + 9 + k] * cs)
+            # the next node's own columns: -1 on p, n, m; -(tr A I - Aᵀ)/2 on θ
+            nxt = 6 + 12 * i
+            for k in range(3):
+                _band_set(B, row + k, nxt + 6 + k, -colscale[nxt + 6 + k] / rowscale[row + k])
+                _band_set(B, row + 6 + k, nxt + k, -colscale[nxt + k] / rowscale[row + 6 + k])
+                _band_set(B, row + 9 + k, nxt + 3 + k,
+                          -colscale[nxt + 3 + k] / rowscale[row + 9 + k])
+                for m in range(3):
+                    v = -0.5 * ((trace if k == m else 0.0) - A[m, k])
+                    _band_set(B, row + 3 + k, nxt + 9 + m, v * colscale[nxt + 9 + m])
+        else:
+            _tip_residual(y, T, ni, tip_now, tip_rate, r6, J, arm, act, now, rate, law)
+            row = 12 * (M - 1)
+            for k in range(6):
+                F[row + k] = r6[k] / rowscale[row + k]
+                worst = max(worst, abs(F[row + k])) if math.isfinite(F[row + k]) else np.inf
+            if nt == 0:
+                continue
+            for d in range(ni):
+                for k in range(6):
+                    if d == LAM:
+                        G[row + k] = J[k, d] / rowscale[row + k]
+                    else:
+                        col = _unknown(i, d)
+                        _band_set(B, row + k, col, J[k, d] / rowscale[row + k] * colscale[col])
+    return worst
+
+
+@_jit
+def _band_factor(B, n, piv, Lm):
+    """Gaussian elimination with partial pivoting of the band matrix B (n rows; row r holds
+    columns r - _BAND .. r + 2 _BAND, the last _BAND for the fill of the row exchanges) in
+    place: U in B, the multipliers in Lm, the exchanges in piv (LAPACK's gbtrf, written out).
+    Returns the sign of the determinant, 0.0 if singular."""
+    kl = _BAND
+    sign = 1.0
+    for c in range(n):
+        last = min(n - 1, c + kl)
+        p = c
+        best = abs(B[c, kl])
+        for r in range(c + 1, last + 1):
+            v = abs(B[r, c - r + kl])
+            if v > best:
+                best = v
+                p = r
+        if not (best > 0.0 and math.isfinite(best)):
+            return 0.0
+        right = min(n - 1, c + 2 * kl)
+        piv[c] = p
+        if p != c:
+            sign = -sign
+            for col in range(c, right + 1):
+                a = B[c, col - c + kl]
+                B[c, col - c + kl] = B[p, col - p + kl]
+                B[p, col - p + kl] = a
+        pivot = B[c, kl]
+        if pivot < 0.0:
+            sign = -sign
+        for r in range(c + 1, last + 1):
+            g = B[r, c - r + kl] / pivot
+            Lm[c, r - c - 1] = g
+            B[r, c - r + kl] = 0.0
+            if g != 0.0:
+                for col in range(c + 1, right + 1):
+                    B[r, col - r + kl] -= g * B[c, col - c + kl]
+    return sign
+
+
+@_jit
+def _band_solve(B, n, piv, Lm, b):
+    """b ← A⁻¹ b from :func:`_band_factor`'s factors. False if the result is not finite."""
+    kl = _BAND
+    for c in range(n):
+        p = piv[c]
+        if p != c:
+            a = b[c]
+            b[c] = b[p]
+            b[p] = a
+        for r in range(c + 1, min(n - 1, c + kl) + 1):
+            b[r] -= Lm[c, r - c - 1] * b[c]
+    for c in range(n - 1, -1, -1):
+        acc = b[c]
+        for col in range(c + 1, min(n - 1, c + 2 * kl) + 1):
+            acc -= B[c, col - c + kl] * b[col]
+        b[c] = acc / B[c, kl]
+        if not math.isfinite(b[c]):
+            return False
+    return True
+
+
+@_jit
+def _ms_apply(x, Z, M, du, colscale, sign):
+    """x, Z += sign × du (scaled unknowns): forces and positions added, node rotations
+    R ← R exp(δθ~) (material)."""
+    for k in range(6):
+        x[k] += sign * du[k] * colscale[k]
+    e = np.empty((3, 3))
+    R = np.empty((3, 3))
+    for i in range(1, M):
+        o = 6 + 12 * (i - 1)
+        for k in range(3):
+            Z[i, _N + k] += sign * du[o + k] * colscale[o + k]
+            Z[i, _M + k] += sign * du[o + 3 + k] * colscale[o + 3 + k]
+            Z[i, _P + k] += sign * du[o + 6 + k] * colscale[o + 6 + k]
+        a0 = sign * du[o + 9] * colscale[o + 9]
+        a1 = sign * du[o + 10] * colscale[o + 10]
+        a2 = sign * du[o + 11] * colscale[o + 11]
+        angle = math.sqrt(a0 * a0 + a1 * a1 + a2 * a2)
+        if angle < 1e-4:  # the series, to round-off
+            sa = 1.0 - angle * angle / 6.0
+            ca = 0.5 - angle * angle / 24.0
+        else:
+            sa, ca = math.sin(angle) / angle, (1.0 - math.cos(angle)) / (angle * angle)
+        e[0, 0] = 1.0 - ca * (a1 * a1 + a2 * a2)
+        e[1, 1] = 1.0 - ca * (a0 * a0 + a2 * a2)
+        e[2, 2] = 1.0 - ca * (a0 * a0 + a1 * a1)
+        e[0, 1] = -sa * a2 + ca * a0 * a1
+        e[1, 0] = sa * a2 + ca * a0 * a1
+        e[0, 2] = sa * a1 + ca * a0 * a2
+        e[2, 0] = -sa * a1 + ca * a0 * a2
+        e[1, 2] = -sa * a0 + ca * a1 * a2
+        e[2, 1] = sa * a0 + ca * a1 * a2
+        for a in range(3):
+            for b in range(3):
+                R[a, b] = (Z[i, _R + 3 * a] * e[0, b] + Z[i, _R + 3 * a + 1] * e[1, b]
+                           + Z[i, _R + 3 * a + 2] * e[2, b])
+        for a in range(3):
+            for b in range(3):
+                Z[i, _R + 3 * a + b] = R[a, b]
+
+
+@_jit
+def _ms_motion(T, M, du, colscale, lam_rate, out):
+    """The tip's displacement (out[0:3]) and rotation (out[3:6], material) for the scaled
+    change du of the unknowns, from the last interval's tangents T (and ``lam_rate`` times
+    its load-factor column)."""
+    nt = 7 if M == 1 else _COLS
+    for k in range(3):
+        acc_p = lam_rate * T[LAM, _TP + k]
+        acc_t = lam_rate * T[LAM, _TT + k]
+        for d in range(nt):
+            if d == LAM:
+                continue
+            col = _unknown(M - 1, d)
+            acc_p += T[d, _TP + k] * du[col] * colscale[col]
+            acc_t += T[d, _TT + k] * du[col] * colscale[col]
+        out[k] = acc_p
+        out[3 + k] = acc_t
+
+
+@_jit
+def _ms_distance(du, n, T, M, colscale, w, length, motion):
+    """The size of a scaled change du of the unknowns: the largest of its components
+    (forces relative to the case's load size 1 + w, positions in L, angles in rad) and of the
+    tip motion it causes (L, rad)."""
+    out = 0.0
+    for k in range(n):
+        force = k < 6 or (k - 6) % 12 < 6
+        out = max(out, abs(du[k]) / (1.0 + w) if force else abs(du[k]))
+    _ms_motion(T, M, du, colscale, 0.0, motion)
+    for k in range(6):
+        out = max(out, abs(motion[k]) / (length if k < 3 else 1.0))
+    if not math.isfinite(out):
+        return np.inf
+    return out
+
+
+@_jit
+def _ms_corrector(x, Z, M, lam, nt, chunks, first, csteps, base, arm, act, case, scratch, colscale,
+                  rowscale, work, w, length, threshold, max_iterations, first_limit, loose, tip,
+                  counter):
+    """Newton at fixed λ on the block system from the prediction (x, Z), with
+    :func:`_corrector`'s tests (the first step within ``first_limit``, every further one at
+    most half the one before, converged at the threshold or at a step no larger than
+    ``loose``, taken without integrating again). On success the band matrix holds the
+    factors of the Jacobian at the last point integrated (for the tangent and det's sign),
+    returned as (True, sign, the distance travelled); ``tip`` the tip position."""
+    F, B, G, ends, lengths, piv, Lm, du, motion = work
+    n = 12 * M - 6
+    previous = np.inf
+    travelled = 0.0
+    for k in range(max_iterations + 1):
+        res = _ms_evaluate(x, Z, M, lam, nt, chunks, first, csteps, base, arm, act, case, scratch,
+                           colscale, rowscale, F, B, G, ends, lengths)
+        counter[0] += 1
+        for i in range(3):
+            tip[i] = ends[M - 1, _P + i]
+        if not math.isfinite(res):
+            return False, 0.0, travelled
+        sign = _band_factor(B, n, piv, Lm)
+        if res <= threshold:
+            return sign != 0.0, sign, travelled
+        if k == max_iterations or sign == 0.0:
+            return False, 0.0, travelled
+        for i in range(n):
+            du[i] = -F[i]
+        if not _band_solve(B, n, piv, Lm, du):
+            return False, 0.0, travelled
+        size = _ms_distance(du, n, scratch[1], M, colscale, w, length, motion)
+        if k == 0:
+            if size > first_limit:
+                return False, 0.0, travelled
+        elif size > _CONTRACTION_MAX * previous:
+            return res <= _STALL * threshold, sign, travelled
+        previous = size
+        travelled += size
+        if travelled > first_limit:
+            return False, 0.0, travelled
+        _ms_apply(x, Z, M, du, colscale, 1.0)
+        if size <= loose:
+            for i in range(3):
+                tip[i] += motion[i]
+            return True, sign, travelled
+    return False, 0.0, travelled
+
+
+@_jit
+def _ms_follow(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, colscale, rowscale,
+               work, w, length, threshold, max_iterations, max_load_step, max_shootings, final,
+               tip, counter, reached):
+    """:func:`_follow` on the block system: the path from λ = 0 (x, Z: the solution there)
+    to λ = 1, predicted along the tangent -J⁻¹ ∂F/∂λ, corrected by :func:`_ms_corrector`,
+    with the same step control and branch guards (the sign of the whole banded Jacobian's
+    determinant, the tip's direction of motion). True on success (x, Z at λ = 1, the band
+    factors there); else reached[0] is the last load factor reached."""
+    B, G, piv, Lm, du, motion = work[1], work[2], work[5], work[6], work[7], work[8]
+    n = 12 * M - 6
+    nt = M - M + _COLS  # (a variable: one compiled version of the callees)
+    reached[0] = 0.0
+    ok, sign, dist = _ms_corrector(x, Z, M, 0.0, nt, chunks, first, csteps, base, arm, act, case,
+                             scratch, colscale, rowscale, work, w, length, threshold,
+                             max_iterations, _REFINE_MAX, _LOOSE, tip, counter)
+    if not ok:
+        return False
+    t = np.empty(n)
+    for i in range(n):
+        t[i] = -G[i]
+    if not _band_solve(B, n, piv, Lm, t):
+        return False
+    reached[1] = sign
+    x_keep = np.empty(6)
+    Z_keep = np.empty_like(Z)
+    motion_prev = np.empty(6)
+    motion_new = np.empty(6)
+    _ms_motion(scratch[1], M, t, colscale, 1.0, motion_prev)
+    moved = np.empty(n)
+    lam = 0.0
+    size = _ms_distance(t, n, scratch[1], M, colscale, w, length, motion)
+    dl = max_load_step if size <= 0.0 else min(max_load_step, _FIRST_MOTION / size)
+    while lam < 1.0:
+        if counter[0] > max_shootings:
+            return False
+        if lam + 1.5 * dl >= 1.0:
+            dl = 1.0 - lam
+        target = lam + dl
+        if target >= 1.0 - 1e-12:
+            target = 1.0
+        _copy(x, x_keep)
+        _copy(Z, Z_keep)
+        for i in range(n):
+            moved[i] = (target - lam) * t[i]
+        _ms_apply(x, Z, M, moved, colscale, 1.0)
+        ok, new_sign, dist = _ms_corrector(x, Z, M, target, nt, chunks, first, csteps, base,
+                                           arm, act, case, scratch, colscale, rowscale, work, w,
+                                           length, threshold, max_iterations, _DIST_MAX,
+                                           final if target == 1.0 else _LOOSE, tip, counter)
+        if ok:
+            for i in range(n):
+                du[i] = -G[i]
+            ok = _band_solve(B, n, piv, Lm, du)
+        if ok:
+            _ms_motion(scratch[1], M, du, colscale, 1.0, motion_new)
+            ok = dl <= _DLAM_CROSS or (new_sign == sign
+                                       and _cosine(motion_prev, motion_new) >= 0.5)
+        if ok:
+            sign = new_sign
+            reached[1] = sign
+            for i in range(3):
+                motion_prev[i] = motion_new[i]
+            # (dist: the corrector's distance from the prediction, the step control's measure)
+            for i in range(n):
+                t[i] = du[i]
+            lam = target
+            reached[0] = lam
+            grow = 2.0 if dist <= 0.0 else min(2.0, max(0.5, (_DIST_AIM / dist) ** (1 / 3)))
+            dl = min(max_load_step, dl * grow)
+        else:
+            _copy(x_keep, x)
+            _copy(Z_keep, Z)
+            dl *= 0.4
+            if dl < _DLAM_MIN_STIFF:
+                return False
+    return True
+
+
+@_jit
+def _ms_chord(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, colscale, rowscale,
+              work, threshold, max_iterations, tip, counter):
+    """The solution at λ = 1 on another grid by chord iterations from (x, Z) with the band
+    factors left in ``work`` (a nearby grid's): :func:`_chord`'s tests (the first step a
+    discretisation-sized change, the residual at least halved every iteration, a stall
+    accepted at ``_STALL`` times the threshold). True if converged."""
+    F, B, G, ends, lengths, piv, Lm, du = work[:8]
+    n = 12 * M - 6
+    none = M - M  # no tangents (a variable: one compiled version)
+    previous = np.inf
+    for _ in range(max_iterations):
+        res = _ms_evaluate(x, Z, M, 1.0, none, chunks, first, csteps, base, arm, act, case,
+                           scratch, colscale, rowscale, F, B, G, ends, lengths)
+        counter[0] += 1
+        for i in range(3):
+            tip[i] = ends[M - 1, _P + i]
+        if res <= threshold:
+            return True
+        if not res < 0.5 * previous:
+            return res <= _STALL * threshold
+        for i in range(n):
+            du[i] = -F[i]
+        if not _band_solve(B, n, piv, Lm, du):
+            return False
+        if not math.isfinite(previous):
+            size = 0.0
+            for i in range(n):
+                size = max(size, abs(du[i]))
+            if not size <= _REFINE_MAX:
+                return False
+        previous = res
+        _ms_apply(x, Z, M, du, colscale, 1.0)
+    return False
+
+
+@_jit
+def _ms_record(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, s_out, out, b):
+    """The output pass of the solution (x, Z) at λ = 1: each interval integrated from its
+    start once more, state only, and every station written (a station inside a step: the RK4
+    step from that step's start to the station; the tip station from the tip state)."""
+    y, T, work, twork, now, tip_now, ys, Ts, law = scratch
+    poses, strains, stresses, E = out[0][b], out[1][b], out[2][b], out[6][0]
+    rate = case[1]
+    one = np.int64(1)
+    none = one - one
+    _set_loads(1.0, case, now, tip_now)
+    ns = s_out.size
+    k = 0
+    lengths = out[8]
+    for a in range(lengths.shape[1]):
+        lengths[b, a] = 0.0
+    for i in range(M):
+        if i == 0:
+            _start(y, T, none, base, x)
+        else:
+            _node_start(y, T, none, Z, i)
+        for c in range(first[i], first[i + 1]):
+            j = int(chunks[c, _CJ])
+            if chunks[c, _CFIRST] > 0.0:
+                _jump(y, T, none, now, rate, j, arm, act, law)
+            n = csteps[c]
+            h = chunks[c, _CL] / n
+            s0 = chunks[c, _CS]
+            step = 0
+            while step < n:
+                run = n - step
+                if k < ns:
+                    run = min(run, max(int((s_out[k] - s0) / h) - 1 - step, 0))
+                if run > 0:
+                    _steps(y, T, none, h, s0 + step * h, run, arm, act, j, now, rate, work,
+                           twork, law)
+                    step += run
+                    continue
+                t0 = s0 + step * h
+                t1 = s0 + (step + 1) * h
+                last = i == M - 1 and c == first[M] - 1 and step == n - 1
+                while k < ns and s_out[k] < t1 and not (last and s_out[k] >= arm[6]):
+                    _copy(y, ys)
+                    _steps(ys, Ts, none, s_out[k] - t0, t0, one, arm, act, j, now, rate, work,
+                           twork, law)
+                    _write(ys, Ts, none, j, s_out[k], arm, act, now, law, poses[k], strains[k],
+                           stresses[k], E[0])
+                    k += 1
+                _steps(y, T, none, h, t0, one, arm, act, j, now, rate, work, twork, law)
+                step += 1
+        for a in range(lengths.shape[1]):
+            lengths[b, a] += y[18 + a]
+    for i in range(k, ns):
+        _write(y, T, none, arm[1].size - 1, arm[6], arm, act, now, law, poses[i], strains[i],
+               stresses[i], E[0])
+    for i in range(6):
+        out[7][b, i] = x[i]
+
+
+@_jit
+def _ms_work(M, width):
+    """Work arrays of the block system with M intervals: F, the band B, G, the interval end
+    states, the tendons' lengths, pivots, multipliers, a step, a motion."""
+    n = 12 * M - 6
+    return (np.empty(n), np.empty((n, 3 * _BAND + 1)), np.empty(n), np.empty((M, width)),
+            np.empty(width - 18), np.empty(n, dtype=np.int64), np.empty((n, _BAND)),
+            np.empty(n), np.empty(6))
+
+
+@_entry(_per_arm("stiff", "the multiple-shooting solver (stiff problems)", 2), nogil=True)
+def solve_stiff_cases(base, arm, act, loads, options, s_out, out):
+    """Solve every load case of a flattened batch by multiple shooting, each from the
+    unloaded arm (λ = 0) along its own loading path (the stiff route of
+    :func:`solve_cases`: same arguments where they exist, same outputs but the Jacobians).
+
+    The stages follow solve_cases': the path at N steps, the solution at 2N (chord
+    iterations with the factors at N, else Newton), the Richardson estimate
+    |p_2N - p_N| / 15 against tol, N grown by the order-4 model until it is met, the output
+    pass. The intervals (kL/M <= _GROWTH, k from the case's load size) and their cut by the
+    pieces are fixed per case; N spreads over them as over the arm.
+    """
+    piece_loads, tip_loads = loads
+    nb = piece_loads.shape[0]
+    npieces = arm[1].size
+    length = arm[6]
+    scale = arm[7]
+    tol = options[_O_TOL]
+    max_iterations = int(options[_O_ITER])
+    max_load_step = options[_O_LOADSTEP]
+    n_fixed = int(options[_O_NFIXED])
+    n_max = int(options[_O_NMAX])
+    budget = int(options[_O_BUDGET])
+    info, status = out[3], out[4]
+    width = piece_loads.shape[2]
+    scratch = _scratch(npieces, width - PIECE_LOADS, _COLS)
+    start = np.zeros((npieces, width))
+    rate = np.zeros((7, npieces, width))  # rows 1-6: zero (the node columns 7-12)
+    tip_start = np.zeros(TIP_LOADS)
+    tip_rate = np.zeros((7, TIP_LOADS))
+    case = (start, rate, tip_start, tip_rate)
+    final_step = min(1e-3, math.sqrt(0.01 * tol / length)) if math.isfinite(tol) else 1e-9
+    reached = np.zeros(2)
+    counter = np.zeros(1, dtype=np.int64)
+    x = np.zeros(6)
+    x_f = np.zeros(6)
+    tip_c = np.empty(3)
+    tip_f = np.empty(3)
+    y, T = scratch[0], scratch[1]
+    for b in range(nb):
+        counter[0] = 0
+        for j in range(npieces):
+            for i in range(width):
+                rate[0, j, i] = piece_loads[b, j, i]
+        for i in range(TIP_LOADS):
+            tip_rate[0, i] = tip_loads[b, i]
+        w, turning = _load_size(arm, act, scale, start, piece_loads[b], tip_start, tip_loads[b])
+        threshold = 1e-12 * w + 1e-300
+        kl = _stiffness_size(arm, w)
+        M = max(1, min(math.ceil(kl / _GROWTH), n_max // 4))
+        chunks = np.empty((M + npieces, 5))
+        nc, first = _chunk_table(arm, M, chunks)
+        csteps = np.empty(nc, dtype=np.int64)
+        n = 12 * M - 6
+        work = _ms_work(M, y.size)
+        colscale = np.empty(n)
+        rowscale = np.empty(n)
+        for k in range(6):
+            colscale[k] = scale[k]
+        for i in range(1, M):
+            o = 6 + 12 * (i - 1)
+            for k in range(6):
+                colscale[o + k] = scale[k]
+                colscale[o + 6 + k] = length if k < 3 else 1.0
+        for i in range(M - 1):  # rows p, θ, n, m of join i
+            o = 12 * i
+            for k in range(3):
+                rowscale[o + k] = length
+                rowscale[o + 3 + k] = 1.0
+                rowscale[o + 6 + k] = scale[k]
+                rowscale[o + 9 + k] = scale[3 + k]
+        for k in range(6):
+            rowscale[n - 6 + k] = scale[k]
+        Z = np.zeros((M, y.size))
+        Z_f = np.zeros((M, y.size))
+        if n_fixed > 0:
+            N = n_fixed // 2
+        else:
+            N = max(_first_steps(arm, tol, turning), math.ceil(_STIFF_STEPS * kl))
+        N = min(N, n_max // 2)
+        status[b] = OK
+        estimate = np.inf
+        failures = 0
+        failed_at = -1.0
+        path = True
+        done = False
+        while not done:
+            if path:
+                # the unloaded arm at the node positions (λ = 0: no load, no growth)
+                _chunk_steps(chunks, nc, length, N, np.int64(1), csteps)
+                _set_loads(0.0, case, scratch[4], scratch[5])
+                for k in range(6):
+                    x[k] = 0.0
+                _start(y, T, M - M, base, x)
+                for i in range(M):
+                    if i > 0:
+                        for a in range(y.size):
+                            Z[i, a] = y[a]
+                    _run_chunks(y, T, M - M, first[i], first[i + 1], chunks, csteps, arm, act,
+                                rate, scratch)
+                if not _ms_follow(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch,
+                                  colscale, rowscale, work, w, length, threshold,
+                                  max_iterations, max_load_step, budget, final_step, tip_c,
+                                  counter, reached):
+                    if counter[0] > budget:
+                        status[b] = BUDGET
+                        break
+                    if (n_fixed == 0 and 2 * N <= n_max // 2 and failures < 4
+                            and abs(reached[0] - failed_at) > 0.02):
+                        failures += 1
+                        failed_at = reached[0]
+                        N = 2 * N
+                        continue
+                    status[b] = PATH_FAILED
+                    break
+                path = False
+            if counter[0] > budget:
+                status[b] = BUDGET
+                break
+            # the fine solution at 2N: chord iterations with the factors at N, else Newton
+            _copy(x, x_f)
+            _copy(Z, Z_f)
+            _chunk_steps(chunks, nc, length, N, np.int64(2), csteps)
+            if not _ms_chord(x_f, Z_f, M, chunks, first, csteps, base, arm, act, case, scratch,
+                             colscale, rowscale, work, threshold, max_iterations, tip_f,
+                             counter):
+                _copy(x, x_f)
+                _copy(Z, Z_f)
+                ok, _, _ = _ms_corrector(
+                    x_f, Z_f, M, 1.0, M - M + _COLS, chunks, first, csteps, base, arm, act,
+                    case, scratch, colscale, rowscale, work, w, length, threshold,
+                    max_iterations, _REFINE_MAX, 1e-9, tip_f, counter)
+                if not ok:
+                    if 4 * N > n_max or n_fixed > 0:
+                        status[b] = NEWTON_FAILED
+                        break
+                    N = 2 * N
+                    path = True
+                    continue
+            d2 = 0.0
+            for i in range(3):
+                d2 += (tip_f[i] - tip_c[i]) ** 2
+            estimate = math.sqrt(d2) / 15.0
+            if estimate <= tol or n_fixed > 0:
+                done = True
+                break
+            if 2 * N >= n_max:
+                status[b] = TOO_MANY_STEPS
+                break
+            grow = (estimate / (0.3 * tol)) ** 0.25
+            N = min(n_max // 2, max(N + 1, math.ceil(N * grow)))
+            _chunk_steps(chunks, nc, length, N, np.int64(1), csteps)
+            _copy(x_f, x)
+            _copy(Z_f, Z)
+            ok, _, _ = _ms_corrector(
+                x, Z, M, 1.0, M - M + _COLS, chunks, first, csteps, base, arm, act, case,
+                scratch, colscale, rowscale, work, w, length, threshold, max_iterations,
+                _REFINE_MAX, final_step, tip_c, counter)
+            path = not ok
+        info[b, 1] = estimate
+        info[b, 2] = 1.0 if status[b] == OK else reached[0]
+        info[b, 3] = counter[0]
+        info[b, 4] = N
+        F = work[0]
+        residual = 0.0
+        for i in range(6):  # the tip residual (N, N m), as solve_cases reports it
+            v = abs(F[n - 6 + i]) * rowscale[n - 6 + i]
+            if not v <= residual:
+                residual = v
+        info[b, 0] = residual
+        if status[b] != OK:
+            continue
+        _chunk_steps(chunks, nc, length, N, np.int64(2), csteps)
+        _ms_record(x_f, Z_f, M, chunks, first, csteps, base, arm, act, case, scratch, s_out,
+                   out, b)
+        if not math.isfinite(residual):
+            status[b] = NOT_FINITE

@@ -745,6 +745,60 @@ def _shoot(k, x, lam, counts, base, arm, case, actuators) -> ShootResult:
                        motion[:, 6:].copy())
 
 
+#: Cases whose estimated kL = L √(F/EI) (F the largest load's force, EI the softest bending
+#: stiffness) reaches this go to multiple shooting (_kernels.solve_stiff_cases): single
+#: shooting's map grows like e^{kL} and loses its digits beyond (docs/solver.md).
+_STIFF_KL = 15.0
+
+
+def _stiffness(channels, arm) -> np.ndarray:
+    """kL per case, estimated from the loads (B,): L √(F / EI_min), F the largest of the tip
+    force, the sum of the distributed and point forces, and the largest actuator force
+    (a tendon's tension), each as the sum of its components' magnitudes."""
+    k = channels.k
+    pieces, tip = channels.piece, channels.tip_loads
+    lengths = arm[0][1]
+    f_tip = np.abs(tip[:, k.TD:k.TD + 3]).sum(-1) + np.abs(tip[:, k.TF:k.TF + 3]).sum(-1)
+    f_along = (np.abs(pieces[:, :, k.FD:k.FD + 3]).sum(-1)
+               + np.abs(pieces[:, :, k.FF:k.FF + 3]).sum(-1)) @ lengths
+    f_points = (np.abs(pieces[:, :, k.JD:k.JD + 3]).sum(-1)
+                + np.abs(pieces[:, :, k.JF:k.JF + 3]).sum(-1)).sum(-1)
+    f_act = np.abs(pieces[:, :, k.PIECE_LOADS:]).max(axis=(1, 2), initial=0.0)
+    force = np.maximum(np.maximum(f_tip, f_along + f_points), f_act)
+    C = arm[0][2]
+    soft = float(np.max(C[:, [4, 5], [4, 5]]))
+    return arm[0][6] * np.sqrt(force * soft)
+
+
+def _by_route(k, solver, arm, channels, options, s_kernel, first, memory, inputs, outs,
+              stiff, count) -> None:
+    """Solve the easy cases by single shooting (solve_cases) and the stiff ones by multiple
+    shooting (solve_stiff_cases), each route on its cases gathered, in threads, the outputs
+    scattered back (a case's answer does not depend on the others: batch = loop)."""
+    for route, index in ((False, np.flatnonzero(~stiff)), (True, np.flatnonzero(stiff))):
+        if index.size == 0:
+            continue
+        whole = index.size == count
+        pieces = channels.piece if whole else channels.piece[index]
+        tips = channels.tip_loads if whole else channels.tip_loads[index]
+        part = outs if whole else tuple(x[index] if x.shape[0] == count else x for x in outs)
+
+        def run(a, b, pieces=pieces, tips=tips, part=part, route=route, size=index.size):
+            cut = tuple(x[a:b] if x.shape[0] == size else x for x in part)
+            if route:
+                k.solve_stiff_cases(solver._base_kernel, *arm, (pieces[a:b], tips[a:b]),
+                                    options, s_kernel, cut)
+            else:
+                k.solve_cases(solver._base_kernel, *arm, (pieces[a:b], tips[a:b]), first,
+                              options, s_kernel, memory, inputs, cut)
+
+        in_threads(run, index.size, solver._threads(index.size) if first is None else 1)
+        if not whole:
+            for x, y in zip(outs, part, strict=True):
+                if x.shape[0] == count:
+                    x[index] = y
+
+
 class Solver:
     """A prepared problem: an arm, output stations, a tolerance and a base pose.
 
@@ -792,6 +846,11 @@ class Solver:
         naming the tendon and the tension it can carry), by solving the case again near the
         failure. Default True; False for a caller that handles failures itself and reads no
         message (inverse statics' trial steps).
+    shooting : str
+        "auto" (default): each case by single shooting on the six base unknowns, or, where
+        the loads put the arm in strong tension (kL = L √(F/EI) >= 15, docs/solver.md), by
+        multiple shooting on the states at the starts of intervals of kL <= 3 each.
+        "single" or "multiple" forces one route (for comparisons and studies).
 
     Examples
     --------
@@ -805,7 +864,7 @@ class Solver:
 
     def __init__(self, arm, *, s=None, tol=1e-8, base=None, max_iterations=12,
                  max_load_step=1.0, steps=None, max_steps=_N_MAX, max_shootings=10000,
-                 stability=True, threads=None, diagnose=True):
+                 stability=True, threads=None, diagnose=True, shooting="auto"):
         self.arm = _check_arm(arm)
         self._data = _arm_data(arm)
         self.length = self._data.length
@@ -838,8 +897,19 @@ class Solver:
         if not isinstance(diagnose, (bool, np.bool_)):
             raise TypeError(f"diagnose must be True or False, got {diagnose!r}")
         self.diagnose = bool(diagnose)
+        if shooting not in ("auto", "single", "multiple"):
+            raise ValueError(f"shooting must be 'auto', 'single' or 'multiple', got "
+                             f"{shooting!r}")
+        self.shooting = shooting
         self._coarse_ratio = 4  # the path runs on N / 4 steps (benchmarks/run.py measures it)
         self.reset()
+
+    def _stiff(self, channels, arm) -> np.ndarray:
+        """Which cases go to multiple shooting (B,) bool: ``shooting`` "multiple" all,
+        "single" none, "auto" those whose estimated kL reaches _STIFF_KL."""
+        if self.shooting != "auto":
+            return np.full(channels.count, self.shooting == "multiple")
+        return _stiffness(channels, arm) >= _STIFF_KL
 
     def _threads(self, cases: int) -> int:
         """Threads for a batch of ``cases`` independent cases."""
@@ -1012,14 +1082,32 @@ class Solver:
         arm, options = channels.arm_tuple(), self._options(near)
         outs = (poses, strains, stresses, info, status, jac, motion, base_wrench, lengths)
 
+        stiff = self._stiff(channels, arm)
+        if stiff.any() and jacobians:
+            raise NotImplementedError(
+                f"jacobians=True on a stiff case (kL = {_stiffness(channels, arm).max():.3g} "
+                f">= {_STIFF_KL:g}, solved by multiple shooting): its compliance and actuation "
+                "Jacobians are not implemented yet; solve with jacobians=False")
+        if stiff.any() and (chained or near):
+            # multiple shooting starts every case from the unloaded arm: a chained Solver
+            # restarts from there after it (docs/solver.md, "Multiple shooting")
+            stiff[:] = True
+            first = memory = None
+            chained = near = False
+            self.reset()
+
         def run(a, b):  # cases [a, b): per-case arrays cut, the rest (placeholders) whole
             k.solve_cases(self._base_kernel, *arm, (channels.piece[a:b],
                                                     channels.tip_loads[a:b]),
                           first, options, s_kernel, memory, inputs,
                           tuple(x[a:b] if x.shape[0] == count else x for x in outs))
 
-        # (a chained batch is one path, case after case; unchained cases are independent)
-        in_threads(run, count, 1 if chained or near else self._threads(count))
+        if not stiff.any():
+            # (a chained batch is one path, case after case; unchained cases are independent)
+            in_threads(run, count, 1 if chained or near else self._threads(count))
+        else:
+            _by_route(k, self, arm, channels, options, s_kernel, first, memory, inputs, outs,
+                      stiff, count)
         actuation = _actuation(channels, base_wrench, lengths, shape) if outputs else None
         failed = np.flatnonzero(status != k.OK) if status.any() else ()  # (OK is 0)
         if len(failed):
