@@ -101,6 +101,11 @@ def _critical():
                   max_factor=4.0)
 
 
+def _stiff():
+    arm = Arm.from_stiffness(1.0, EA=1e9, GAy=1e9, GAz=1e9, GJ=1.0, EIy=1.0, EIz=1.0)
+    solve(arm, [TipLoad(force=[1e3, 0.0, 1.0]), DistributedForce([0.0, 0.0, 0.0])])
+
+
 @dataclass(frozen=True)
 class Step:
     """One capability to compile: ``name`` (its keys in the compile record, see
@@ -133,6 +138,8 @@ STEPS: tuple[Step, ...] = (
     Step("inverse", "inverse statics", ("inverse",), _inverse),
     Step("displacement", "displacement-controlled tendons", ("bounded",), _displacement),
     Step("critical", "critical loads and continuation", ("shoot", "branch"), _critical),
+    Step("stiff", "multiple shooting (arms in strong tension: kL >= 15)", ("stiff+verdict",),
+         _stiff),
 )
 
 

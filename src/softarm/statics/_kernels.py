@@ -2184,7 +2184,8 @@ def _orthonormalise(T, nt, weights, A):
 
 
 @_inline
-def _sweep(x, lam, steps, base, arm, act, case, scratch, nt, r, J, states, fields, theta0, tip):
+def _sweep(x, lam, steps, base, arm, act, case, scratch, nt, r, J, states, fields, theta0, tip,
+           given):
     """The backward sweep of one equilibrium (base reaction x at load factor λ, ``steps``
     RK4 steps per piece, the solution's own grid): the state integrated forward to the tip
     (state only), then the state and nt seeded tangent columns back to the base with the
@@ -2196,7 +2197,14 @@ def _sweep(x, lam, steps, base, arm, act, case, scratch, nt, r, J, states, field
     ``states`` of length steps + 1, the state and the tangents at every grid point from the
     tip (index steps) to the base (0) are stored, and in ``fields[k, nt:2nt, :nt]`` the
     change of basis A_k of step k (the columns stored at k are those propagated from k + 1
-    times A_k: a solution with coefficients c at k has A_k c at k + 1)."""
+    times A_k: a solution with coefficients c at k has A_k c at k + 1).
+
+    ``given`` (None, or the solution's state at every grid point, base (0) to tip): the
+    state is then not integrated backwards but taken from it at the top of every step (a
+    piece's top excepted, reached from the state after the point wrench by undoing it).
+    Backwards, the state has the growing modes e^{ks} of a rod in tension too; the multiple
+    shooting solver gives its states (:func:`solve_stiff_cases`), so that the sweep of a
+    stiff case integrates only the Jacobi fields, which it orthonormalises at every step."""
     y, T, work, twork, now = scratch[0], scratch[1], scratch[2], scratch[3], scratch[4]
     tip_now, law = scratch[5], scratch[8]
     rate, tip_rate = case[1], case[3]
@@ -2206,7 +2214,10 @@ def _sweep(x, lam, steps, base, arm, act, case, scratch, nt, r, J, states, field
     # the callees are the same compiled versions as the solver's (one compile, not two)
     none = nt - nt
     one = np.int64(1)
-    if tip.shape[0] == 4:
+    if given is not None:
+        _set_loads(lam, case, now, tip_now)
+        _copy(given[given.shape[0] - 1], y)
+    elif tip.shape[0] == 4:
         _set_loads(lam, case, now, tip_now)
         for i in range(y.size):
             y[i] = 0.0
@@ -2265,6 +2276,8 @@ def _sweep(x, lam, steps, base, arm, act, case, scratch, nt, r, J, states, field
         h = piece_len[j] / steps[j]
         for i in range(steps[j] - 1, -1, -1):
             top = piece_start[j] + (i + 1) * h
+            if given is not None and (i < steps[j] - 1 or j == piece_len.size - 1):
+                _copy(given[k], y)
             _steps(y, T, nt, -h, top, one, arm, act, j, now, rate, work, twork, law)
             _block(T, nt, length, new)
             c = _crossings(old, new, nt, lu, M, _AT_CLAMP if j == 0 and i == 0 else 0.0)
@@ -2346,7 +2359,7 @@ def stability_cases(base, arm, act, loads, xs, Ns, tips, factor, index, theta0, 
         _fill_steps(arm[6], arm[1], int(Ns[b]), factor, steps)
         t0 = np.zeros((nt, nt))
         index[b] = _sweep(xs[b], 1.0, steps, base, arm, act, case, scratch, nt, r, J, none3,
-                          none4, t0, tips[b] if tips.shape[0] > b else none3)
+                          none4, t0, tips[b] if tips.shape[0] > b else none3, None)
         for i in range(nt):
             for d in range(nt):
                 theta0[b, i, d] = t0[i, d]
@@ -2363,7 +2376,7 @@ def sweep_point(x, lam, steps, base, arm, act, case, theta0, states, fields):
     r = np.empty(6)
     J = np.empty((6, 7))
     return _sweep(x, lam, steps, base, arm, act, case, scratch, theta0.shape[0], r, J, states,
-                  fields, theta0, np.empty((0, 1)))
+                  fields, theta0, np.empty((0, 1)), None)
 
 
 @_entry(_per_arm("branch", "the stations of a branch (continuation)", 2))
@@ -3384,10 +3397,13 @@ def _ms_chord(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, col
 
 
 @_jit
-def _ms_record(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, s_out, out, b):
+def _ms_record(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, s_out, out, b,
+               states):
     """The output pass of the solution (x, Z) at λ = 1: each interval integrated from its
     start once more, state only, and every station written (a station inside a step: the RK4
-    step from that step's start to the station; the tip station from the tip state)."""
+    step from that step's start to the station; the tip station from the tip state). With
+    ``states`` (not None), the state itself at each station s_out instead (the stability
+    sweep's grid)."""
     y, T, work, twork, now, tip_now, ys, Ts, law = scratch
     poses, strains, stresses, E = out[0][b], out[1][b], out[2][b], out[6][0]
     rate = case[1]
@@ -3398,7 +3414,8 @@ def _ms_record(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, s_
     k = 0
     lengths = out[8]
     for a in range(lengths.shape[1]):
-        lengths[b, a] = 0.0
+        if states is None:
+            lengths[b, a] = 0.0
     for i in range(M):
         if i == 0:
             _start(y, T, none, base, x)
@@ -3428,18 +3445,26 @@ def _ms_record(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, s_
                     _copy(y, ys)
                     _steps(ys, Ts, none, s_out[k] - t0, t0, one, arm, act, j, now, rate, work,
                            twork, law)
-                    _write(ys, Ts, none, j, s_out[k], arm, act, now, law, poses[k], strains[k],
-                           stresses[k], E[0])
+                    if states is not None:
+                        _copy(ys, states[k])
+                    else:
+                        _write(ys, Ts, none, j, s_out[k], arm, act, now, law, poses[k],
+                               strains[k], stresses[k], E[0])
                     k += 1
                 _steps(y, T, none, h, t0, one, arm, act, j, now, rate, work, twork, law)
                 step += 1
         for a in range(lengths.shape[1]):
-            lengths[b, a] += y[18 + a]
+            if states is None:
+                lengths[b, a] += y[18 + a]
     for i in range(k, ns):
-        _write(y, T, none, arm[1].size - 1, arm[6], arm, act, now, law, poses[i], strains[i],
-               stresses[i], E[0])
-    for i in range(6):
-        out[7][b, i] = x[i]
+        if states is not None:
+            _copy(y, states[i])
+        else:
+            _write(y, T, none, arm[1].size - 1, arm[6], arm, act, now, law, poses[i],
+                   strains[i], stresses[i], E[0])
+    if states is None:
+        for i in range(6):
+            out[7][b, i] = x[i]
 
 
 @_jit
@@ -3452,8 +3477,15 @@ def _ms_work(M, width):
             np.empty(n), np.empty(6))
 
 
-@_entry(_per_arm("stiff", "the multiple-shooting solver (stiff problems)", 2), nogil=True)
-def solve_stiff_cases(base, arm, act, loads, options, s_out, out):
+def _stiff_capability(args):
+    key, text = _per_arm("stiff", "the multiple-shooting solver (stiff problems)", 2)(args)
+    if _given(args[7]):
+        return key + "+verdict", text + " with its stability verdict"
+    return key, text
+
+
+@_entry(_stiff_capability, nogil=True)
+def solve_stiff_cases(base, arm, act, loads, options, s_out, out, verdicts):
     """Solve every load case of a flattened batch by multiple shooting, each from the
     unloaded arm (λ = 0) along its own loading path (the stiff route of
     :func:`solve_cases`: same arguments where they exist, same outputs but the Jacobians).
@@ -3463,6 +3495,11 @@ def solve_stiff_cases(base, arm, act, loads, options, s_out, out):
     |p_2N - p_N| / 15 against tol, N grown by the order-4 model until it is met, the output
     pass. The intervals (kL/M <= _GROWTH, k from the case's load size) and their cut by the
     pieces are fixed per case; N spreads over them as over the arm.
+
+    ``verdicts``: None, or (index (B,), conservative (B,)): each solved case's stability
+    verdict (:func:`stability_cases`' Morse index on the grid of N steps per piece, its
+    sweep taking the state at every grid point from this solution instead of integrating it
+    backwards, where it would grow like e^{kL}).
     """
     piece_loads, tip_loads = loads
     nb = piece_loads.shape[0]
@@ -3626,6 +3663,41 @@ def solve_stiff_cases(base, arm, act, loads, options, s_out, out):
             continue
         _chunk_steps(chunks, nc, length, N, np.int64(2), csteps)
         _ms_record(x_f, Z_f, M, chunks, first, csteps, base, arm, act, case, scratch, s_out,
-                   out, b)
+                   out, b, None)
         if not math.isfinite(residual):
             status[b] = NOT_FINITE
+        if verdicts is not None and status[b] == OK:
+            _ms_verdict(x_f, Z_f, M, chunks, first, csteps, base, arm, act, case, scratch, N,
+                        piece_loads[b], tip_loads[b], out, b, verdicts)
+
+
+@_jit
+def _ms_verdict(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, N, piece, tip,
+                out, b, verdicts):
+    """Case b's stability verdict (see :func:`solve_stiff_cases`): the solution's state at
+    every point of the sweep's grid (N steps spread over the pieces), then the sweep."""
+    npieces = arm[1].size
+    steps = np.empty(npieces, dtype=np.int64)
+    _fill_steps(arm[6], arm[1], N, np.int64(1), steps)
+    total = 0
+    for j in range(npieces):
+        total += steps[j]
+    grid = np.empty(total + 1)
+    k = 0
+    for j in range(npieces):
+        h = arm[1][j] / steps[j]
+        for i in range(steps[j]):
+            grid[k] = arm[0][j] + i * h
+            k += 1
+    grid[total] = arm[6]
+    states = np.empty((total + 1, scratch[0].size))
+    _ms_record(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, grid, out, b,
+               states)
+    nt = _tangent_columns(arm, piece)
+    verdicts[1][b] = _conservative(piece, tip)
+    one_case = (case[0], case[1][:1], case[2], case[3][:1])
+    r = np.empty(6)
+    J = np.empty((6, 7))
+    t0 = np.zeros((nt, nt))
+    verdicts[0][b] = _sweep(x, 1.0, steps, base, arm, act, one_case, scratch, nt, r, J,
+                            np.empty((0, 1)), np.empty((0, 1, 1)), t0, np.empty((0, 1)), states)

@@ -771,9 +771,10 @@ def _stiffness(channels, arm) -> np.ndarray:
 
 
 def _by_route(k, solver, arm, channels, options, s_kernel, first, memory, inputs, outs,
-              stiff, count) -> None:
+              stiff, count, verdicts) -> None:
     """Solve the easy cases by single shooting (solve_cases) and the stiff ones by multiple
-    shooting (solve_stiff_cases), each route on its cases gathered, in threads, the outputs
+    shooting (solve_stiff_cases, with their stability verdicts into ``verdicts`` (index,
+    conservative) when given), each route on its cases gathered, in threads, the outputs
     scattered back (a case's answer does not depend on the others: batch = loop)."""
     for route, index in ((False, np.flatnonzero(~stiff)), (True, np.flatnonzero(stiff))):
         if index.size == 0:
@@ -782,17 +783,24 @@ def _by_route(k, solver, arm, channels, options, s_kernel, first, memory, inputs
         pieces = channels.piece if whole else channels.piece[index]
         tips = channels.tip_loads if whole else channels.tip_loads[index]
         part = outs if whole else tuple(x[index] if x.shape[0] == count else x for x in outs)
+        judged = None if verdicts is None else tuple(v[index] for v in verdicts)
 
-        def run(a, b, pieces=pieces, tips=tips, part=part, route=route, size=index.size):
+        def run(a, b, pieces=pieces, tips=tips, part=part, route=route, size=index.size,
+                judged=judged):
             cut = tuple(x[a:b] if x.shape[0] == size else x for x in part)
             if route:
                 k.solve_stiff_cases(solver._base_kernel, *arm, (pieces[a:b], tips[a:b]),
-                                    options, s_kernel, cut)
+                                    options, s_kernel, cut,
+                                    None if judged is None else (judged[0][a:b],
+                                                                 judged[1][a:b]))
             else:
                 k.solve_cases(solver._base_kernel, *arm, (pieces[a:b], tips[a:b]), first,
                               options, s_kernel, memory, inputs, cut)
 
         in_threads(run, index.size, solver._threads(index.size) if first is None else 1)
+        if route and judged is not None:
+            for v, w in zip(verdicts, judged, strict=True):
+                v[index] = w
         if not whole:
             for x, y in zip(outs, part, strict=True):
                 if x.shape[0] == count:
@@ -1102,12 +1110,15 @@ class Solver:
                           first, options, s_kernel, memory, inputs,
                           tuple(x[a:b] if x.shape[0] == count else x for x in outs))
 
+        verdicts = None
         if not stiff.any():
             # (a chained batch is one path, case after case; unchained cases are independent)
             in_threads(run, count, 1 if chained or near else self._threads(count))
         else:
+            if self.stability and outputs:
+                verdicts = (np.zeros(count, dtype=np.int64), np.zeros(count, dtype=np.bool_))
             _by_route(k, self, arm, channels, options, s_kernel, first, memory, inputs, outs,
-                      stiff, count)
+                      stiff, count, verdicts)
         actuation = _actuation(channels, base_wrench, lengths, shape) if outputs else None
         failed = np.flatnonzero(status != k.OK) if status.any() else ()  # (OK is 0)
         if len(failed):
@@ -1137,7 +1148,9 @@ class Solver:
             tips = poses[:, -1] if self.s[-1] == self.length else None
             actuation["stability"] = verdict(channels, self._base_kernel, base_wrench,
                                              info[:, 4], shape, tips,
-                                             threads=self._threads(count))
+                                             threads=self._threads(count),
+                                             given=None if verdicts is None else
+                                             (stiff, *verdicts))
         # fresh arrays, frozen before reshaping: Equilibrium takes them without a copy
         for array in (poses, strains, stresses, info):
             array.setflags(write=False)

@@ -51,11 +51,25 @@ def conservative(piece: np.ndarray, tip: np.ndarray) -> np.ndarray:
     return (follower == 0.0) & (couple == 0.0)
 
 
-def verdict(channels, base, xs, Ns, shape, tips=None, factor=1, threads=1) -> Stability:
+def verdict(channels, base, xs, Ns, shape, tips=None, factor=1, threads=1,
+            given=None) -> Stability:
     """The stability of every case solved by ``solve_cases`` (loads from zero to the
     channels' values, solution xs), swept on factor × Ns steps; ``tips`` (B, 4, 4): the
     solution's tip poses (the forward pass to the tip is then skipped); in up to ``threads``
-    threads (:func:`softarm._threads.in_threads`)."""
+    threads (:func:`softarm._threads.in_threads`). ``given``: None, or (which (B,) bool,
+    index (B,), conservative (B,)): the verdicts of the cases ``which`` already known (the
+    stiff cases', from ``solve_stiff_cases``); only the others are swept here."""
+    if given is not None:
+        which, index, flags = given
+        rest = np.flatnonzero(~which)
+        if rest.size:
+            part = verdict(channels.cases(channels.piece[rest], channels.tip_loads[rest],
+                                          (rest.size,)),
+                           base, xs[rest], np.asarray(Ns)[rest], (rest.size,),
+                           None if tips is None else np.asarray(tips)[rest], factor, threads)
+            index[rest] = part.index.reshape(-1)
+            flags[rest] = part.conservative.reshape(-1)
+        return make(index, flags, shape)
     k = _k()
     count = xs.shape[0]
     index = np.zeros(count, dtype=np.int64)
