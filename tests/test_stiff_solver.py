@@ -86,6 +86,81 @@ def test_the_shooting_route_is_checked():
         Solver(ROD, shooting="double")
 
 
-def test_jacobians_of_a_stiff_case_say_they_are_not_there_yet():
-    with pytest.raises(NotImplementedError, match=r"jacobians=True on a stiff case \(kL = 1e\+03"):
-        softarm.solve(ROD, pull(1e6), jacobians=True)
+
+
+def test_the_compliance_under_strong_tension_is_the_finite_difference():
+    # kL = 100 (F L²/EI = 1e4): the block system's implicit function against central
+    # differences of tight solves
+    force = np.array([1e4, 0.0, 100.0])
+    eq = softarm.solve(ROD, [TipLoad(force=force), NUDGE], jacobians=True, s=3)
+    h = 10.0  # (1e-3 of F: the truncation ~1e-6 relative, the solves' 1e-12 L ~1e-7)
+    tight = Solver(ROD, s=3, tol=1e-12, stability=False)
+    for k in range(3):
+        step = np.zeros(3)
+        step[k] = h
+        plus = tight.solve([TipLoad(force=force + step), NUDGE]).tip_position
+        minus = tight.solve([TipLoad(force=force - step), NUDGE]).tip_position
+        column = (plus - minus) / (2 * h)
+        assert np.abs(eq.tip_compliance[:3, k] - column).max() < 1e-5 * np.abs(column).max()
+        assert np.array_equal(eq.compliance[-1], eq.tip_compliance)
+
+
+def test_a_tendon_robot_under_large_tensions_solves_alike_on_both_routes():
+    # tendons at τ L²/EI = 2500 (kL = 50 by the tension): the backbone is compressed, so
+    # single shooting still works; both routes agree, and their actuation Jacobians are
+    # the central differences
+    arm = Arm.from_stiffness(1.0, EA=1e8, GAy=1e8, GAz=1e8, GJ=1.0, EIy=1.0, EIz=1.0)
+    routes = (softarm.routing.Straight(0.0, 1e-3), softarm.routing.Straight(1e-3, 0.0))
+
+    def loads(t1, t2):
+        return [softarm.Tendon(t1, routes[0]), softarm.Tendon(t2, routes[1]),
+                TipLoad(force=[0.0, 0.5, 0.0])]
+
+    tau = np.array([2500.0, 750.0])
+    results = [Solver(arm, s=3, shooting=shooting).solve(loads(*tau), jacobians=True)
+               for shooting in ("single", "multiple")]
+    assert np.abs(results[0].positions - results[1].positions).max() < 1e-9
+    tight = Solver(arm, s=3, tol=1e-12, stability=False, shooting="multiple")
+    h = 1e-3
+    for k in range(2):
+        step = np.zeros(2)
+        step[k] = h
+        column = (tight.solve(loads(*(tau + step))).tip_position
+                  - tight.solve(loads(*(tau - step))).tip_position) / (2 * h)
+        for eq in results:
+            assert np.abs(eq.actuation_jacobian[:3, k] - column).max() < 1e-8 * np.abs(column).max()
+
+
+def _tensioned_rod_tip(T, q, P, EI, EA, GA, L):
+    """The lateral tip deflection of a clamped, extensible and shearable rod under an axial
+    tension T, a lateral load q per length and a lateral tip force P (planar, linear in the
+    rotation θ of the sections). The lateral internal force is n_z = q (L - s) + P; the
+    strains v1 = 1 + T/EA, v3 = (n_z - T θ)/GA give w' = v1 θ + v3, and the moment balance
+    m' = -p' × n with m = -EI θ' gives θ'' = K² (θ - n_z/T), K² = c T/EI, c = v1 - T/GA,
+    θ(0) = 0, θ'(L) = 0. So θ = n_z/T + c1 cosh Ks + c2 sinh Ks, c1 = -(qL + P)/T,
+    c2 = q/(T K cosh KL) - c1 tanh KL, and w(L) = c ∫θ + ∫n_z/GA, written without
+    cosh KL (which overflows)."""
+    c = 1.0 + T / EA - T / GA
+    K = np.sqrt(c * T / EI)
+    c1 = -(q * L + P) / T
+    moment = q * L * L / 2 + P * L  # ∫ n_z ds
+    integral = moment / T + c1 * np.tanh(K * L) / K + q * (1.0 - 1.0 / np.cosh(K * L)) / (T * K * K)
+    return c * integral + moment / GA
+
+
+@pytest.mark.parametrize(("radius", "length", "T"), [(2e-4, 1.0, 5.0), (2.5e-4, 1.5, 5.0),
+                                                     (5e-4, 2.0, 40.0)])
+def test_a_nitinol_guide_wire_in_tension_under_its_weight(radius, length, T):
+    # a horizontal nitinol wire (E 60 GPa, ρ 6450 kg/m³) under gravity, a tip tension T and
+    # a lateral tip force of 10 mN: kL = 233-258; against the linear theory of a rod in
+    # tension (slopes qL/T + P/T below 3e-3: the nonlinear terms below 1e-8 L)
+    wire = Arm(length, Circle(radius), Material(60e9, poisson_ratio=0.33, density=6450.0))
+    rigidities = wire.rigidities
+    EI = rigidities.EIy
+    q = -6450.0 * np.pi * radius ** 2 * 9.81
+    P = 0.01
+    assert length * np.sqrt(T / EI) > 200
+    eq = softarm.solve(wire, [Gravity([0.0, 0.0, -9.81]), TipLoad(force=[T, 0.0, P])], s=3)
+    w = _tensioned_rod_tip(T, q, P, EI, rigidities.EA, rigidities.GAz, length)
+    assert abs(eq.tip_position[2] - w) < 1e-7 * length
+    assert eq.stability.stable

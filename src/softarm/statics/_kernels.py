@@ -2997,12 +2997,15 @@ def _band_set(B, row, col, value):
 
 @_jit
 def _ms_evaluate(x, Z, M, lam, nt, chunks, first, csteps, base, arm, act, case, scratch,
-                 colscale, rowscale, F, B, G, ends, lengths):
+                 colscale, rowscale, F, B, G, ends, lengths, Gq):
     """Integrate every interval at load factor λ: the scaled residual F (n), and with
     tangents (nt > 0) the scaled Jacobian in band storage B (n, 3 _BAND + 1) and its load
     factor column G (n). ``ends``: each interval's end state (M, width), for the tip and the
     output. Returns the scaled residual's largest component. ``lengths``: the tendons'
-    lengths summed over the intervals."""
+    lengths summed over the intervals. ``Gq``: None, or (n, inputs) the scaled residual's
+    derivatives by the inputs (tangent columns _COLS.. along the case's rate rows 7..: every
+    interval then integrates nt = _COLS + inputs columns, the first one's node columns
+    unused)."""
     y, T = scratch[0], scratch[1]
     rate, tip_rate = case[1], case[3]
     now, tip_now, law = scratch[4], scratch[5], scratch[8]
@@ -3015,13 +3018,19 @@ def _ms_evaluate(x, Z, M, lam, nt, chunks, first, csteps, base, arm, act, case, 
                 B[r_, c] = 0.0
     A = np.empty((3, 3))
     mis = np.empty(3)
-    J = np.empty((6, _COLS))
+    J = np.empty((6, max(nt, _COLS)))
     r6 = np.empty(6)
+    if Gq is not None:
+        for r_ in range(n):
+            for c in range(Gq.shape[1]):
+                Gq[r_, c] = 0.0
     for a in range(lengths.size):
         lengths[a] = 0.0
     worst = 0.0
     for i in range(M):
         ni = 0 if nt == 0 else (7 if i == 0 else _COLS)
+        if Gq is not None:
+            ni = nt
         if i == 0:
             _start(y, T, ni, base, x)
         else:
@@ -3056,6 +3065,17 @@ def _ms_evaluate(x, Z, M, lam, nt, chunks, first, csteps, base, arm, act, case, 
                         G[row + 6 + k] = t[_TN + k] / rowscale[row + 6 + k]
                         G[row + 9 + k] = t[_TM + k] / rowscale[row + 9 + k]
                     continue
+                if Gq is not None and d >= _COLS:  # an input's column
+                    for k in range(3):
+                        Gq[row + k, d - _COLS] = t[_TP + k] / rowscale[row + k]
+                        Gq[row + 3 + k, d - _COLS] = 0.5 * (
+                            trace * t[_TT + k] - A[k, 0] * t[_TT] - A[k, 1] * t[_TT + 1]
+                            - A[k, 2] * t[_TT + 2])
+                        Gq[row + 6 + k, d - _COLS] = t[_TN + k] / rowscale[row + 6 + k]
+                        Gq[row + 9 + k, d - _COLS] = t[_TM + k] / rowscale[row + 9 + k]
+                    continue
+                if i == 0 and d > LAM:  # (the base's interval has no node columns)
+                    continue
                 col = _unknown(i, d)
                 cs = colscale[col]
                 for k in range(3):
@@ -3087,6 +3107,10 @@ def _ms_evaluate(x, Z, M, lam, nt, chunks, first, csteps, base, arm, act, case, 
                 for k in range(6):
                     if d == LAM:
                         G[row + k] = J[k, d] / rowscale[row + k]
+                    elif Gq is not None and d >= _COLS:
+                        Gq[row + k, d - _COLS] = J[k, d] / rowscale[row + k]
+                    elif i == 0 and d > LAM:
+                        continue
                     else:
                         col = _unknown(i, d)
                         _band_set(B, row + k, col, J[k, d] / rowscale[row + k] * colscale[col])
@@ -3248,7 +3272,7 @@ def _ms_corrector(x, Z, M, lam, nt, chunks, first, csteps, base, arm, act, case,
     travelled = 0.0
     for k in range(max_iterations + 1):
         res = _ms_evaluate(x, Z, M, lam, nt, chunks, first, csteps, base, arm, act, case, scratch,
-                           colscale, rowscale, F, B, G, ends, lengths)
+                           colscale, rowscale, F, B, G, ends, lengths, None)
         counter[0] += 1
         for i in range(3):
             tip[i] = ends[M - 1, _P + i]
@@ -3373,7 +3397,7 @@ def _ms_chord(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, col
     previous = np.inf
     for _ in range(max_iterations):
         res = _ms_evaluate(x, Z, M, 1.0, none, chunks, first, csteps, base, arm, act, case,
-                           scratch, colscale, rowscale, F, B, G, ends, lengths)
+                           scratch, colscale, rowscale, F, B, G, ends, lengths, None)
         counter[0] += 1
         for i in range(3):
             tip[i] = ends[M - 1, _P + i]
@@ -3398,17 +3422,20 @@ def _ms_chord(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, col
 
 @_jit
 def _ms_record(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, s_out, out, b,
-               states):
+               states, sens):
     """The output pass of the solution (x, Z) at λ = 1: each interval integrated from its
-    start once more, state only, and every station written (a station inside a step: the RK4
-    step from that step's start to the station; the tip station from the tip state). With
-    ``states`` (not None), the state itself at each station s_out instead (the stability
-    sweep's grid)."""
+    start once more, and every station written (a station inside a step: the RK4 step from
+    that step's start to the station; the tip station from the tip state). With ``states``
+    (not None), the state itself at each station s_out instead (the stability sweep's grid).
+    With ``sens`` (not None: (U, colscale, nt), :func:`_ms_sensitivities`), the tangents
+    too (nt columns), and each station's compliance and actuation Jacobian into out[6][b],
+    the tendons' lengths' into out[5][b] rows 6.. (:func:`_ms_motion_rows`)."""
     y, T, work, twork, now, tip_now, ys, Ts, law = scratch
     poses, strains, stresses, E = out[0][b], out[1][b], out[2][b], out[6][0]
     rate = case[1]
     one = np.int64(1)
     none = one - one
+    nt = none if sens is None else sens[2]
     _set_loads(1.0, case, now, tip_now)
     ns = s_out.size
     k = 0
@@ -3416,15 +3443,19 @@ def _ms_record(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, s_
     for a in range(lengths.shape[1]):
         if states is None:
             lengths[b, a] = 0.0
+    if sens is not None:
+        for r_ in range(6, out[5].shape[1]):
+            for c in range(out[5].shape[2]):
+                out[5][b, r_, c] = 0.0
     for i in range(M):
         if i == 0:
-            _start(y, T, none, base, x)
+            _start(y, T, nt, base, x)
         else:
-            _node_start(y, T, none, Z, i)
+            _node_start(y, T, nt, Z, i)
         for c in range(first[i], first[i + 1]):
             j = int(chunks[c, _CJ])
             if chunks[c, _CFIRST] > 0.0:
-                _jump(y, T, none, now, rate, j, arm, act, law)
+                _jump(y, T, nt, now, rate, j, arm, act, law)
             n = csteps[c]
             h = chunks[c, _CL] / n
             s0 = chunks[c, _CS]
@@ -3434,7 +3465,7 @@ def _ms_record(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, s_
                 if k < ns:
                     run = min(run, max(int((s_out[k] - s0) / h) - 1 - step, 0))
                 if run > 0:
-                    _steps(y, T, none, h, s0 + step * h, run, arm, act, j, now, rate, work,
+                    _steps(y, T, nt, h, s0 + step * h, run, arm, act, j, now, rate, work,
                            twork, law)
                     step += run
                     continue
@@ -3443,28 +3474,75 @@ def _ms_record(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, s_
                 last = i == M - 1 and c == first[M] - 1 and step == n - 1
                 while k < ns and s_out[k] < t1 and not (last and s_out[k] >= arm[6]):
                     _copy(y, ys)
-                    _steps(ys, Ts, none, s_out[k] - t0, t0, one, arm, act, j, now, rate, work,
+                    _copy(T, Ts)
+                    _steps(ys, Ts, nt, s_out[k] - t0, t0, one, arm, act, j, now, rate, work,
                            twork, law)
                     if states is not None:
                         _copy(ys, states[k])
                     else:
                         _write(ys, Ts, none, j, s_out[k], arm, act, now, law, poses[k],
                                strains[k], stresses[k], E[0])
+                        if sens is not None:
+                            _ms_motion_rows(ys, Ts, i, sens, out[6][b][k], np.int64(6))
                     k += 1
-                _steps(y, T, none, h, t0, one, arm, act, j, now, rate, work, twork, law)
+                _steps(y, T, nt, h, t0, one, arm, act, j, now, rate, work, twork, law)
                 step += 1
         for a in range(lengths.shape[1]):
             if states is None:
                 lengths[b, a] += y[18 + a]
+        if sens is not None and out[5].shape[1] > 6:
+            _ms_motion_rows(y, T, i, sens, out[5][b], -np.int64(6))
     for i in range(k, ns):
         if states is not None:
             _copy(y, states[i])
         else:
             _write(y, T, none, arm[1].size - 1, arm[6], arm, act, now, law, poses[i],
                    strains[i], stresses[i], E[0])
+            if sens is not None:
+                _ms_motion_rows(y, T, M - 1, sens, out[6][b][i], np.int64(6))
     if states is None:
         for i in range(6):
             out[7][b, i] = x[i]
+
+
+@_jit
+def _ms_motion_rows(y, T, i, sens, rows, which):
+    """With the tangents T of interval i at a point: ``which`` = 6, the point's motion
+    (δp; δθ spatial) per tip wrench and per input into rows (6, 6 + n), written; ``which``
+    = -6, the tendons' lengths' (T's columns NT.., the interval's share) added into rows
+    6.. of rows (6 + A, 6 + n). Through the unknowns' sensitivities U (scaled, per tip
+    wrench component, then per input): Σ_d T[d] colscale U[unknown(i, d)], plus an input's
+    own column."""
+    U, colscale, nt = sens
+    m = U.shape[1]
+    count = 6 if which > 0 else T.shape[1] - NT
+    for r_ in range(count):
+        for c in range(m):
+            acc = 0.0
+            for d in range(min(nt, _COLS)):
+                if d == LAM or (i == 0 and d > LAM):
+                    continue
+                col = _unknown(i, d)
+                acc += _motion_entry(y, T, d, r_, which) * colscale[col] * U[col, c]
+            if c >= 6:
+                acc += _motion_entry(y, T, _COLS + c - 6, r_, which)
+            if which > 0:
+                rows[r_, c] = acc
+            else:
+                rows[6 + r_, c] += acc
+
+
+@_jit
+def _motion_entry(y, T, d, r_, which):
+    """Row r_ of tangent column d: δp (r_ < 3) or δθ in spatial components (which = 6), or
+    tendon r_'s length (which = -6)."""
+    if which < 0:
+        return T[d, NT + r_]
+    if r_ < 3:
+        return T[d, _TP + r_]
+    i = r_ - 3
+    return (y[_R + 3 * i] * T[d, _TT] + y[_R + 3 * i + 1] * T[d, _TT + 1]
+            + y[_R + 3 * i + 2] * T[d, _TT + 2])
 
 
 @_jit
@@ -3479,13 +3557,15 @@ def _ms_work(M, width):
 
 def _stiff_capability(args):
     key, text = _per_arm("stiff", "the multiple-shooting solver (stiff problems)", 2)(args)
+    if _given(args[8]):
+        key, text = key + "+jacobians", text + " with Jacobians"
     if _given(args[7]):
-        return key + "+verdict", text + " with its stability verdict"
+        key, text = key + "+verdict", text + " and its stability verdict"
     return key, text
 
 
 @_entry(_stiff_capability, nogil=True)
-def solve_stiff_cases(base, arm, act, loads, options, s_out, out, verdicts):
+def solve_stiff_cases(base, arm, act, loads, options, s_out, out, verdicts, inputs):
     """Solve every load case of a flattened batch by multiple shooting, each from the
     unloaded arm (λ = 0) along its own loading path (the stiff route of
     :func:`solve_cases`: same arguments where they exist, same outputs but the Jacobians).
@@ -3499,7 +3579,10 @@ def solve_stiff_cases(base, arm, act, loads, options, s_out, out, verdicts):
     ``verdicts``: None, or (index (B,), conservative (B,)): each solved case's stability
     verdict (:func:`stability_cases`' Morse index on the grid of N steps per piece, its
     sweep taking the state at every grid point from this solution instead of integrating it
-    backwards, where it would grow like e^{kL}).
+    backwards, where it would grow like e^{kL}). ``inputs``: None, or as solve_cases'
+    (Jacobians): the compliances and actuation Jacobians by the implicit function theorem on
+    the block system (:func:`_ms_sensitivities`), in solve_cases' outputs after its
+    :func:`_implicit_function`.
     """
     piece_loads, tip_loads = loads
     nb = piece_loads.shape[0]
@@ -3662,13 +3745,72 @@ def solve_stiff_cases(base, arm, act, loads, options, s_out, out, verdicts):
         if status[b] != OK:
             continue
         _chunk_steps(chunks, nc, length, N, np.int64(2), csteps)
-        _ms_record(x_f, Z_f, M, chunks, first, csteps, base, arm, act, case, scratch, s_out,
-                   out, b, None)
+        if inputs is None:
+            _ms_record(x_f, Z_f, M, chunks, first, csteps, base, arm, act, case, scratch,
+                       s_out, out, b, None, None)
+        elif not _ms_sensitivities(x_f, Z_f, M, chunks, first, csteps, base, arm, act,
+                                   piece_loads[b], tip_loads[b], inputs, colscale, rowscale,
+                                   work, s_out, out, b):
+            status[b] = SINGULAR
+            continue
         if not math.isfinite(residual):
             status[b] = NOT_FINITE
         if verdicts is not None and status[b] == OK:
             _ms_verdict(x_f, Z_f, M, chunks, first, csteps, base, arm, act, case, scratch, N,
                         piece_loads[b], tip_loads[b], out, b, verdicts)
+
+
+@_jit
+def _ms_sensitivities(x, Z, M, chunks, first, csteps, base, arm, act, piece, tip, inputs,
+                      colscale, rowscale, work, s_out, out, b):
+    """The implicit function theorem on the block system at the solution (x, Z): the
+    scaled unknowns' changes U per dead tip wrench component (J U = e_k / rowscale_k: the
+    tip rows are n(L) - W) and per input (J U = -∂F/∂q), then the output pass with the
+    tangents, which writes each station's compliance and actuation Jacobian and the
+    tendons' lengths' (:func:`_ms_record`), and out[5][b] rows 0:6 = [∂x/∂W | -∂x/∂q], as
+    solve_cases' :func:`_implicit_function` leaves them. False if J is singular."""
+    F, B, G, ends, lengths, piv, Lm = work[:7]
+    n = 12 * M - 6
+    n_in = inputs[0].shape[0]
+    npieces = arm[1].size
+    width = piece.shape[1]
+    nt = _COLS + n_in
+    scratch = _scratch(npieces, width - PIECE_LOADS, nt)
+    rate = np.zeros((7 + n_in, npieces, width))  # row 0 (λ) and the node rows 1-6: zero
+    tip_rate = np.zeros((7 + n_in, TIP_LOADS))
+    for q in range(n_in):
+        for j in range(npieces):
+            for i in range(width):
+                rate[7 + q, j, i] = inputs[0][q, j, i]
+        for i in range(TIP_LOADS):
+            tip_rate[7 + q, i] = inputs[1][q, i]
+    case = (piece, rate, tip, tip_rate)  # at λ = 1 the loads are piece, tip (rate 0 is zero)
+    Gq = np.empty((n, max(n_in, 1)))
+    _ms_evaluate(x, Z, M, 1.0, nt, chunks, first, csteps, base, arm, act, case, scratch,
+                 colscale, rowscale, F, B, G, ends, lengths, Gq)
+    if _band_factor(B, n, piv, Lm) == 0.0:
+        return False
+    U = np.zeros((n, 6 + n_in))
+    column = np.empty(n)
+    for c in range(6 + n_in):
+        for i in range(n):
+            column[i] = 0.0
+        if c < 6:
+            column[n - 6 + c] = 1.0 / rowscale[n - 6 + c]
+        else:
+            for i in range(n):
+                column[i] = -Gq[i, c - 6]
+        if not _band_solve(B, n, piv, Lm, column):
+            return False
+        for i in range(n):
+            U[i, c] = column[i]
+    _ms_record(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, s_out, out, b,
+               None, (U, colscale, nt))
+    jac = out[5][b]
+    for i in range(6):
+        for c in range(6 + n_in):
+            jac[i, c] = U[i, c] * colscale[i] * (1.0 if c < 6 else -1.0)
+    return True
 
 
 @_jit
@@ -3692,7 +3834,7 @@ def _ms_verdict(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, N
     grid[total] = arm[6]
     states = np.empty((total + 1, scratch[0].size))
     _ms_record(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, grid, out, b,
-               states)
+               states, None)
     nt = _tangent_columns(arm, piece)
     verdicts[1][b] = _conservative(piece, tip)
     one_case = (case[0], case[1][:1], case[2], case[3][:1])
