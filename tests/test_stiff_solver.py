@@ -164,3 +164,15 @@ def test_a_nitinol_guide_wire_in_tension_under_its_weight(radius, length, T):
     w = _tensioned_rod_tip(T, q, P, EI, rigidities.EA, rigidities.GAz, length)
     assert abs(eq.tip_position[2] - w) < 1e-7 * length
     assert eq.stability.stable
+
+
+@pytest.mark.parametrize("F", [1e3, 1e4])
+def test_the_closed_form_of_a_rod_in_tension_is_stable(F):
+    # the elastica's closed form (a tip force alone) under kL = 32 and 100: its verdict's
+    # sweep takes the closed form's states (integrated backwards they grow like e^{kL}, and
+    # it reported Morse index 15 at kL = 100, with a StabilityWarning, an error here)
+    eq = softarm.solve(ROD, [TipLoad(force=[F, 0.0, 1e-3 * F])])
+    assert eq.method.startswith("analytic")
+    w = _tensioned_rod_tip(F, 0.0, 1e-3 * F, 1.0, 1e6, 1e6, 1.0)
+    assert abs(eq.tip_position[2] - w) < 1e-8
+    assert eq.stability.stable

@@ -228,7 +228,9 @@ def solve_prepared(solver: Solver, loads, method="auto") -> Equilibrium:
         result = _closed_form(solver.arm, loads, shape, solver.s, solver.base)
         if result is not None:
             if solver.stability:
-                result = result._with_stability(closed_form_verdict(solver, loads, result))
+                result = result._with_stability(closed_form_verdict(
+                    solver, loads, result,
+                    lambda s: _closed_form(solver.arm, loads, shape, s, solver.base)))
             return warn_unstable(result, 4)
         if method == "analytic":
             raise ValueError(

@@ -2332,15 +2332,26 @@ def _conservative(piece, tip):
     return True
 
 
-@_entry(_per_arm("verdict", "the stability verdict", 2), nogil=True)
-def stability_cases(base, arm, act, loads, xs, Ns, tips, factor, index, theta0, conservative):
+def _verdict_capability(args):
+    key, text = _per_arm("verdict", "the stability verdict", 2)(args)
+    if _given(args[11]):
+        return key + "+given", text + " from given states (stiff closed forms)"
+    return key, text
+
+
+@_entry(_verdict_capability, nogil=True)
+def stability_cases(base, arm, act, loads, xs, Ns, tips, factor, index, theta0, conservative,
+                    given):
     """The Morse index of every solved case of a batch (loads at λ = 1 from zero, the
     solution x, as :func:`solve_cases` returns them), swept on ``factor`` × Ns[b] steps
     (the solution's coarse grid N: the count needs the Jacobi fields resolved, not the
     solution's 1e-8 L): ``index[b]`` (-1 if a conjugate point falls exactly on a grid
     point) and Θ(0) of the sweep (``theta0[b]``, nt × nt in its top-left corner). With
     ``tips`` (B, 4, 4), the solution's tip poses, the forward pass is skipped.
-    ``conservative[b]``: whether case b's loads are conservative."""
+    ``conservative[b]``: whether case b's loads are conservative. ``given``: None, or the
+    solutions' states on the sweep's grid (B, K + 1, 18 + A), base to tip (every case on
+    the same grid), which the sweep then takes instead of integrating the state backwards
+    (:func:`_sweep`)."""
     piece_loads, tip_loads = loads
     npieces = arm[1].size
     width = piece_loads.shape[2]
@@ -2358,8 +2369,12 @@ def stability_cases(base, arm, act, loads, xs, Ns, tips, factor, index, theta0, 
         conservative[b] = _conservative(piece_loads[b], tip_loads[b])
         _fill_steps(arm[6], arm[1], int(Ns[b]), factor, steps)
         t0 = np.zeros((nt, nt))
-        index[b] = _sweep(xs[b], 1.0, steps, base, arm, act, case, scratch, nt, r, J, none3,
-                          none4, t0, tips[b] if tips.shape[0] > b else none3, None)
+        if given is None:
+            index[b] = _sweep(xs[b], 1.0, steps, base, arm, act, case, scratch, nt, r, J, none3,
+                              none4, t0, tips[b] if tips.shape[0] > b else none3, None)
+        else:
+            index[b] = _sweep(xs[b], 1.0, steps, base, arm, act, case, scratch, nt, r, J, none3,
+                              none4, t0, none3, given[b])
         for i in range(nt):
             for d in range(nt):
                 theta0[b, i, d] = t0[i, d]

@@ -34,6 +34,7 @@ from ..loads import Gravity, Tendon, as_loads, batch_shape, check_magnitudes, pa
 from ..model import Arm, Circle, Material, SegmentedArm
 from ..routing import Straight
 from . import _prefetch
+from ._stiff import STIFF_KL, tension_kl
 from .displacement import solve_displaced
 from .stability import verdict
 
@@ -599,9 +600,20 @@ class PreparedSolve:
                 np.negative(memory[k.MSTEP:k.MSTEP + 6], out=memory[k.MSTEP:k.MSTEP + 6])
                 memory[k.MPREDICTED] = 1.0
         status = self._outs[4]
-        k.solve_cases(solver._base_kernel, *self._arm, (piece, tip), self._start,
-                      self._options[near is not None], solver._s_kernel, memory, self._unit,
-                      self._outs)
+        stiff = solver.shooting == "multiple" or (
+            solver.shooting == "auto"
+            and tension_kl(k, piece, tip, self._arm)[0] >= STIFF_KL)
+        if stiff:
+            # multiple shooting, from the unloaded arm (it keeps no chained memory: the next
+            # call starts from there too), with its verdict
+            k.solve_stiff_cases(solver._base_kernel, *self._arm, (piece, tip),
+                                self._options[False], solver._s_kernel, self._outs,
+                                (self._index, self._flags) if solver.stability else None,
+                                self._unit)
+        else:
+            k.solve_cases(solver._base_kernel, *self._arm, (piece, tip), self._start,
+                          self._options[near is not None], solver._s_kernel, memory,
+                          self._unit, self._outs)
         if status[0] != k.OK:
             solver.reset()
             self._last = None
@@ -616,6 +628,12 @@ class PreparedSolve:
         except InadmissibleStateError:
             self._last = None
             raise
+        if stiff:
+            solver.reset()
+            self._last = None
+            if solver.stability:
+                self.index, self.conservative = int(self._index[0]), bool(self._flags[0])
+            return
         np.copyto(start_piece, piece[0])
         np.copyto(start_tip, tip[0])
         np.copyto(self._q_last, self.inputs)
@@ -626,7 +644,8 @@ class PreparedSolve:
             self._Ns[0] = self.info[4]
             _prefetch.wait(_prefetch.kind(self._arm))
             k.stability_cases(solver._base_kernel, *self._arm, (piece, tip), self._outs[7],
-                              self._Ns, self._tips, 1, self._index, self._theta0, self._flags)
+                              self._Ns, self._tips, 1, self._index, self._theta0, self._flags,
+                              None)
             self.index, self.conservative = int(self._index[0]), bool(self._flags[0])
 
     def reset(self) -> None:
@@ -743,32 +762,6 @@ def _shoot(k, x, lam, counts, base, arm, case, actuators) -> ShootResult:
     motion[3:] = R @ T[:, 3:6].T
     return ShootResult(r, J[:, :6].copy(), None, pose, motion[:, :6].copy(), J[:, 6:].copy(),
                        motion[:, 6:].copy())
-
-
-#: Cases whose estimated kL = L √(F/EI) (F the largest load's force, EI the softest bending
-#: stiffness) reaches this go to multiple shooting (_kernels.solve_stiff_cases): single
-#: shooting's map grows like e^{kL} and loses its digits beyond (docs/solver.md).
-_STIFF_KL = 15.0
-
-
-def _stiffness(channels, arm) -> np.ndarray:
-    """kL per case, estimated from the loads (B,): L √(F / EI_min), F the larger of the tip
-    force and the sum of the distributed and point forces, each as the sum of its
-    components' magnitudes. Not the actuators': a tendon's tension or a chamber's pressure
-    is internal, it compresses the backbone (oscillating Jacobi fields, not growing ones),
-    and single shooting was measured to solve a tendon robot at τL²/EI = 1e4."""
-    k = channels.k
-    pieces, tip = channels.piece, channels.tip_loads
-    lengths = arm[0][1]
-    f_tip = np.abs(tip[:, k.TD:k.TD + 3]).sum(-1) + np.abs(tip[:, k.TF:k.TF + 3]).sum(-1)
-    f_along = (np.abs(pieces[:, :, k.FD:k.FD + 3]).sum(-1)
-               + np.abs(pieces[:, :, k.FF:k.FF + 3]).sum(-1)) @ lengths
-    f_points = (np.abs(pieces[:, :, k.JD:k.JD + 3]).sum(-1)
-                + np.abs(pieces[:, :, k.JF:k.JF + 3]).sum(-1)).sum(-1)
-    force = np.maximum(f_tip, f_along + f_points)
-    C = arm[0][2]
-    soft = float(np.max(C[:, [4, 5], [4, 5]]))
-    return arm[0][6] * np.sqrt(force * soft)
 
 
 def _by_route(k, solver, arm, channels, options, s_kernel, first, memory, inputs, outs,
@@ -915,10 +908,10 @@ class Solver:
 
     def _stiff(self, channels, arm) -> np.ndarray:
         """Which cases go to multiple shooting (B,) bool: ``shooting`` "multiple" all,
-        "single" none, "auto" those whose estimated kL reaches _STIFF_KL."""
+        "single" none, "auto" those whose estimated kL reaches STIFF_KL (_stiff.py)."""
         if self.shooting != "auto":
             return np.full(channels.count, self.shooting == "multiple")
-        return _stiffness(channels, arm) >= _STIFF_KL
+        return tension_kl(channels.k, channels.piece, channels.tip_loads, arm) >= STIFF_KL
 
     def _threads(self, cases: int) -> int:
         """Threads for a batch of ``cases`` independent cases."""

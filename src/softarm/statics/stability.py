@@ -11,9 +11,11 @@ import math
 import numpy as np
 
 from .._threads import in_threads
+from .._validate import PART_BYTES
 from ..equilibrium import Stability
 from ..loads import TipLoad, as_loads
 from . import _prefetch
+from ._stiff import STIFF_KL, tension_kl
 
 __all__ = ["conservative", "verdict"]
 
@@ -52,13 +54,15 @@ def conservative(piece: np.ndarray, tip: np.ndarray) -> np.ndarray:
 
 
 def verdict(channels, base, xs, Ns, shape, tips=None, factor=1, threads=1,
-            given=None) -> Stability:
+            given=None, states=None) -> Stability:
     """The stability of every case solved by ``solve_cases`` (loads from zero to the
     channels' values, solution xs), swept on factor × Ns steps; ``tips`` (B, 4, 4): the
     solution's tip poses (the forward pass to the tip is then skipped); in up to ``threads``
     threads (:func:`softarm._threads.in_threads`). ``given``: None, or (which (B,) bool,
     index (B,), conservative (B,)): the verdicts of the cases ``which`` already known (the
-    stiff cases', from ``solve_stiff_cases``); only the others are swept here."""
+    stiff cases', from ``solve_stiff_cases``); only the others are swept here. ``states``:
+    None, or (B, K + 1, 18) the solutions' states on the sweep's grid (every Ns the same),
+    taken by the sweep instead of integrating the state backwards (stiff closed forms)."""
     if given is not None:
         which, index, flags = given
         rest = np.flatnonzero(~which)
@@ -85,7 +89,7 @@ def verdict(channels, base, xs, Ns, shape, tips=None, factor=1, threads=1,
     def run(a, b):  # cases [a, b)
         k.stability_cases(base, *arm, (channels.piece[a:b], channels.tip_loads[a:b]), xs[a:b],
                           Ns[a:b], tips[a:b] if tips.shape[0] else tips, factor, index[a:b],
-                          theta0[a:b], flags[a:b])
+                          theta0[a:b], flags[a:b], None if states is None else states[a:b])
 
     in_threads(run, count, threads)
     return make(index, flags, shape)
@@ -147,7 +151,7 @@ def _axial_index(eq, data, loads):
     return index
 
 
-def closed_form_verdict(solver, loads, eq) -> Stability | None:
+def closed_form_verdict(solver, loads, eq, states_at=None) -> Stability | None:
     """The stability of a closed-form equilibrium ``eq`` of ``loads`` (as
     ``solver.check_loads`` returns them) on ``solver``'s arm.
 
@@ -156,7 +160,12 @@ def closed_form_verdict(solver, loads, eq) -> Stability | None:
     s = 0, spatial) and its tip pose (when the last station is s = L), on a grid that
     resolves the Jacobi fields (:func:`_closed_form_steps`). None where the base reaction is
     not available (no station at s = 0, or actuators, whose share of the base wrench the
-    closed form does not return)."""
+    closed form does not return).
+
+    Under strong tension (kL >= STIFF_KL, _stiff.py) the state integrated backwards would
+    grow like e^{kL}: there the sweep takes the states from the closed form itself,
+    ``states_at(s)`` (the equilibrium at stations s), on a grid of hk <= 1/2, and None
+    (no verdict) where those states would not fit in PART_BYTES."""
     if eq.s[0] != 0.0:
         return None
     data = solver._data
@@ -180,5 +189,42 @@ def closed_form_verdict(solver, loads, eq) -> Stability | None:
     if eq.s[-1] == solver.length:
         tips = eq.poses[None, -1] if eq.poses.ndim == 3 else np.broadcast_to(
             eq.poses[..., -1, :, :], (*shape, 4, 4)).reshape(count, 4, 4)
-    return verdict(channels, solver._base_kernel, xs, _closed_form_steps(channels, data),
-                   shape, tips, threads=solver._threads(count))
+    steps = _closed_form_steps(channels, data)
+    states = None
+    kl = tension_kl(_k(), channels.piece, channels.tip_loads, channels.arm_tuple())
+    if np.any(kl >= STIFF_KL):
+        if states_at is None:
+            return None
+        N = max(float(steps.max()), math.ceil(2.0 * float(kl.max())))
+        grid = _sweep_grid(channels, int(N))
+        if count * grid.size * 18 * 8 > PART_BYTES:
+            return None
+        states = _states(states_at(grid), count)
+        steps = np.full(count, N)
+    return verdict(channels, solver._base_kernel, xs, steps, shape, tips,
+                   threads=solver._threads(count), states=states)
+
+
+def _sweep_grid(channels, N: int) -> np.ndarray:
+    """The sweep's grid on N steps spread over the pieces (_kernels._fill_steps), base to
+    tip: each piece's step starts, then L."""
+    starts, lengths = channels.starts, channels.lengths
+    counts = np.maximum(1, np.floor(N * lengths / channels.length + 0.5)).astype(int)
+    parts = [start + np.arange(n) * (length / n)
+             for start, length, n in zip(starts, lengths, counts, strict=True)]
+    return np.concatenate([*parts, [channels.length]])
+
+
+def _states(eq, count: int) -> np.ndarray:
+    """The kernel's states (count, S, 18) of a passive equilibrium: p, R row-major, and the
+    internal wrench in spatial components, R (its material stresses)."""
+    poses = np.broadcast_to(eq.poses, (*eq.poses.shape[:-3], eq.s.size, 4, 4))
+    R = poses[..., :3, :3]
+    out = np.empty((*poses.shape[:-2], 18))
+    out[..., 0:3] = poses[..., :3, 3]
+    out[..., 3:12] = R.reshape(*R.shape[:-2], 9)
+    stresses = np.broadcast_to(eq.stresses, (*poses.shape[:-2], 6))
+    out[..., 12:15] = (R @ stresses[..., :3, None])[..., 0]
+    out[..., 15:18] = (R @ stresses[..., 3:, None])[..., 0]
+    return np.ascontiguousarray(np.broadcast_to(out.reshape(-1, eq.s.size, 18),
+                                                (count, eq.s.size, 18)))
