@@ -176,3 +176,30 @@ def test_the_closed_form_of_a_rod_in_tension_is_stable(F):
     w = _tensioned_rod_tip(F, 0.0, 1e-3 * F, 1.0, 1e6, 1e6, 1.0)
     assert abs(eq.tip_position[2] - w) < 1e-8
     assert eq.stability.stable
+
+
+def test_the_control_loop_solves_a_tendon_arm_under_a_strong_pull():
+    # a tendon arm pulled at its tip by 3 kN (kL = 55): ForwardSolver's call takes the
+    # multiple-shooting route from the unloaded arm; the same equilibrium as softarm.solve,
+    # and its actuation Jacobian the central differences of tight solves
+    arm = Arm.from_stiffness(1.0, EA=1e8, GAy=1e8, GAz=1e8, GJ=1.0, EIy=1.0, EIz=1.0)
+    routes = (softarm.routing.Straight(0.0, 1e-2), softarm.routing.Straight(1e-2, 0.0))
+    pull_ = TipLoad(force=[3000.0, 0.0, 1.0])
+
+    def loads(t1, t2):
+        return [softarm.Tendon(t1, routes[0]), softarm.Tendon(t2, routes[1]), pull_]
+
+    model = softarm.ForwardSolver(arm, [softarm.Tendon(0.0, r) for r in routes], [pull_])
+    for q in ([10.0, 5.0], [12.0, 6.0]):
+        result = model.solve(q)
+        alone = softarm.solve(arm, loads(*q))
+        assert np.abs(result.tip_position - alone.tip_position).max() < 1e-12
+        assert result.stability.stable
+    tight = Solver(arm, s=2, tol=1e-12, stability=False)
+    h = 1e-2
+    for k in range(2):
+        step = np.zeros(2)
+        step[k] = h
+        column = (tight.solve(loads(*(np.array(q) + step))).tip_position
+                  - tight.solve(loads(*(np.array(q) - step))).tip_position) / (2 * h)
+        assert np.abs(result.actuation_jacobian[:3, k] - column).max() < 1e-6 * np.abs(column).max()

@@ -4,6 +4,8 @@ takes them (docs/solver.md, "Multiple shooting")."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 __all__ = ["STIFF_KL", "tension_kl"]
@@ -15,21 +17,28 @@ __all__ = ["STIFF_KL", "tension_kl"]
 STIFF_KL = 15.0
 
 
-def tension_kl(k, pieces, tip, arm) -> np.ndarray:
-    """kL per case, estimated from the kernel's load channels (``pieces`` (B, P, C), ``tip``
-    (B, 12); ``k`` the kernel module) (B,): L √(F / EI_min), F the larger of the tip
-    force and the sum of the distributed and point forces, each as the sum of its
-    components' magnitudes (an upper bound of the tension anywhere). Not the actuators': a
-    tendon's tension or a chamber's pressure is internal, it compresses the backbone
-    (oscillating Jacobi fields, not growing ones), and single shooting was measured to solve
-    a tendon robot at τL²/EI = 1e4. ``arm``: the kernel's (arm, act) pair."""
-    lengths = arm[0][1]
-    f_tip = np.abs(tip[:, k.TD:k.TD + 3]).sum(-1) + np.abs(tip[:, k.TF:k.TF + 3]).sum(-1)
-    f_along = (np.abs(pieces[:, :, k.FD:k.FD + 3]).sum(-1)
-               + np.abs(pieces[:, :, k.FF:k.FF + 3]).sum(-1)) @ lengths
-    f_points = (np.abs(pieces[:, :, k.JD:k.JD + 3]).sum(-1)
-                + np.abs(pieces[:, :, k.JF:k.JF + 3]).sum(-1)).sum(-1)
-    force = np.maximum(f_tip, f_along + f_points)
-    C = arm[0][2]
-    soft = float(np.max(C[:, [4, 5], [4, 5]]))
-    return arm[0][6] * np.sqrt(force * soft)
+def tension_kl(pieces, tip, lengths, length: float, soft: float) -> np.ndarray:
+    """kL per case (B,), estimated from the kernel's load channels (``pieces`` (B, P, C),
+    ``tip`` (B, 12); ``lengths`` (P,) the pieces', ``length`` L, ``soft`` the largest
+    bending compliance 1/EI of the arm): L √(F / EI), F the larger of the tip force and the
+    sum of the distributed and point forces, each as the sum of its components' magnitudes
+    (an upper bound of the tension anywhere). Not the actuators': a tendon's tension or a
+    chamber's pressure is internal, it compresses the backbone (oscillating Jacobi fields,
+    not growing ones), and single shooting was measured to solve a tendon robot at
+    τL²/EI = 1e4. (The channels' layout is _kernels': FD, FF at 0-5, JD at 12, JF at 18; TD
+    at 0, TF at 6. A control loop calls this once a solve: a few µs, not more.)"""
+    if pieces.shape[0] == 1:  # one case (the control loop): Python floats, 4× faster
+        along = points = 0.0
+        for row, piece_length in zip(pieces[0, :, :21].tolist(), lengths.tolist(),
+                                     strict=True):
+            along += sum(abs(v) for v in row[0:6]) * piece_length
+            points += sum(abs(v) for v in row[12:15]) + sum(abs(v) for v in row[18:21])
+        t = tip[0].tolist()
+        at_tip = sum(abs(v) for v in t[0:3]) + sum(abs(v) for v in t[6:9])
+        return np.array([length * math.sqrt(max(at_tip, along + points) * soft)])
+    forces = np.abs(pieces[..., :21])
+    along = forces[..., 0:6].sum(-1) @ lengths
+    points = forces[..., 12:15].sum((-1, -2)) + forces[..., 18:21].sum((-1, -2))
+    tip = np.abs(tip)
+    at_tip = tip[:, 0:3].sum(-1) + tip[:, 6:9].sum(-1)
+    return length * np.sqrt(np.maximum(at_tip, along + points) * soft)

@@ -122,6 +122,8 @@ class _ArmData:
         if not np.all(np.isnan(self.mu) | (np.isfinite(self.mu) & (self.mu >= 0.0))):
             raise ValueError(f"the arm's linear density (mass per length, density × area) must "
                              f"be finite and >= 0 kg/m, got {self.mu.tolist()!r}")
+        #: the largest bending compliance 1/EI (the tension's kL, _stiff.py)
+        self.soft = float(np.max(self.C[:, [4, 5], [4, 5]]))
         bending = float(np.max(self.K[:, [3, 4, 5], [3, 4, 5]]))
         self.force_scale = bending / self.length**2
         _normal_positive([self.force_scale, bending / self.length],
@@ -556,6 +558,21 @@ class PreparedSolve:
         self.index, self.conservative = 0, True
         self._last = None  # what this object last wrote as the Solver's _last
         self._q_last, self._dq = np.empty(n), np.empty(n)  # its inputs; their change
+        # The route (_stiff.py): fixed when no input moves a force channel (actuation inputs
+        # act through their own channels), else decided at every call
+        self._route = None
+        if solver.shooting != "auto":
+            self._route = solver.shooting == "multiple"
+        elif not (np.any(unit_piece[..., :21]) or np.any(unit_tip[..., :9])):
+            self._route = bool(tension_kl(channels.piece, channels.tip_loads, pieces[1],
+                                          solver.length, solver._data.soft)[0] >= STIFF_KL)
+
+    def _stiff(self, piece, tip) -> bool:
+        """Whether these loads take multiple shooting (Solver's route, _stiff.py)."""
+        if self._route is not None:
+            return self._route
+        return bool(tension_kl(piece, tip, self._pieces[1], self._solver.length,
+                               self._solver._data.soft)[0] >= STIFF_KL)
 
     def solve(self, q, *, near=None) -> None:
         """Solve at the inputs q (every input, in :attr:`inputs`' order; not validated: the
@@ -600,9 +617,7 @@ class PreparedSolve:
                 np.negative(memory[k.MSTEP:k.MSTEP + 6], out=memory[k.MSTEP:k.MSTEP + 6])
                 memory[k.MPREDICTED] = 1.0
         status = self._outs[4]
-        stiff = solver.shooting == "multiple" or (
-            solver.shooting == "auto"
-            and tension_kl(k, piece, tip, self._arm)[0] >= STIFF_KL)
+        stiff = self._stiff(piece, tip)
         if stiff:
             # multiple shooting, from the unloaded arm (it keeps no chained memory: the next
             # call starts from there too), with its verdict
@@ -906,12 +921,13 @@ class Solver:
         self._coarse_ratio = 4  # the path runs on N / 4 steps (benchmarks/run.py measures it)
         self.reset()
 
-    def _stiff(self, channels, arm) -> np.ndarray:
+    def _stiff(self, channels) -> np.ndarray:
         """Which cases go to multiple shooting (B,) bool: ``shooting`` "multiple" all,
         "single" none, "auto" those whose estimated kL reaches STIFF_KL (_stiff.py)."""
         if self.shooting != "auto":
             return np.full(channels.count, self.shooting == "multiple")
-        return tension_kl(channels.k, channels.piece, channels.tip_loads, arm) >= STIFF_KL
+        return tension_kl(channels.piece, channels.tip_loads, channels.lengths, self.length,
+                          self._data.soft) >= STIFF_KL
 
     def _threads(self, cases: int) -> int:
         """Threads for a batch of ``cases`` independent cases."""
@@ -1084,7 +1100,7 @@ class Solver:
         arm, options = channels.arm_tuple(), self._options(near)
         outs = (poses, strains, stresses, info, status, jac, motion, base_wrench, lengths)
 
-        stiff = self._stiff(channels, arm)
+        stiff = self._stiff(channels)
         if stiff.any() and (chained or near):
             # multiple shooting starts every case from the unloaded arm: a chained Solver
             # restarts from there after it (docs/solver.md, "Multiple shooting")
