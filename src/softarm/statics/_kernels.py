@@ -2943,10 +2943,12 @@ def _chunk_table(arm, M, out):
 
 
 @_jit
-def _chunk_steps(chunks, nc, length, N, factor, out):
-    """Steps per chunk for a nominal N over the arm (at least one), times ``factor``."""
+def _chunk_steps(chunks, nc, length, N, factor, mult, out):
+    """Steps per chunk for a nominal N over the arm (at least one), times ``factor`` and its
+    interval's multiplier ``mult[i]`` (the intervals refined for their local error)."""
     for c in range(nc):
-        out[c] = factor * max(1, math.floor(N * chunks[c, _CL] / length + 0.5))
+        out[c] = factor * mult[int(chunks[c, _CI])] * max(
+            1, math.floor(N * chunks[c, _CL] / length + 0.5))
 
 
 @_jit
@@ -3662,6 +3664,8 @@ def solve_stiff_cases(base, arm, act, loads, options, s_out, out, verdicts, inpu
             rowscale[n - 6 + k] = scale[k]
         Z = np.zeros((M, y.size))
         Z_f = np.zeros((M, y.size))
+        mult = np.ones(M, dtype=np.int64)
+        local = np.empty(M)
         if n_fixed > 0:
             N = n_fixed // 2
         else:
@@ -3676,7 +3680,7 @@ def solve_stiff_cases(base, arm, act, loads, options, s_out, out, verdicts, inpu
         while not done:
             if path:
                 # the unloaded arm at the node positions (λ = 0: no load, no growth)
-                _chunk_steps(chunks, nc, length, N, np.int64(1), csteps)
+                _chunk_steps(chunks, nc, length, N, np.int64(1), mult, csteps)
                 _set_loads(0.0, case, scratch[4], scratch[5])
                 for k in range(6):
                     x[k] = 0.0
@@ -3709,7 +3713,7 @@ def solve_stiff_cases(base, arm, act, loads, options, s_out, out, verdicts, inpu
             # the fine solution at 2N: chord iterations with the factors at N, else Newton
             _copy(x, x_f)
             _copy(Z, Z_f)
-            _chunk_steps(chunks, nc, length, N, np.int64(2), csteps)
+            _chunk_steps(chunks, nc, length, N, np.int64(2), mult, csteps)
             if not _ms_chord(x_f, Z_f, M, chunks, first, csteps, base, arm, act, case, scratch,
                              colscale, rowscale, work, threshold, max_iterations, tip_f,
                              counter):
@@ -3733,12 +3737,30 @@ def solve_stiff_cases(base, arm, act, loads, options, s_out, out, verdicts, inpu
             if estimate <= tol or n_fixed > 0:
                 done = True
                 break
-            if 2 * N >= n_max:
+            total = 0
+            for c in range(nc):
+                total += csteps[c]  # (at 2N)
+            if total >= n_max:
                 status[b] = TOO_MANY_STEPS
                 break
             grow = (estimate / (0.3 * tol)) ** 0.25
-            N = min(n_max // 2, max(N + 1, math.ceil(N * grow)))
-            _chunk_steps(chunks, nc, length, N, np.int64(1), csteps)
+            if M > 1:
+                # refine where the error is made: the intervals whose local error (N against
+                # 2N from the same start) is within a factor 20 of the largest; a boundary
+                # layer (the clamp's, width 1/k) then gets the steps, not the whole arm
+                _ms_local_errors(x_f, Z_f, M, chunks, first, csteps, base, arm, act, case,
+                                 scratch, colscale, rowscale, work, length, nc, N, mult,
+                                 local)
+                largest = 0.0
+                for i in range(M):
+                    largest = max(largest, local[i])
+                factor = max(2, math.ceil(grow))
+                for i in range(M):
+                    if local[i] >= 0.05 * largest or not largest > 0.0:
+                        mult[i] *= factor
+            else:
+                N = min(n_max // 2, max(N + 1, math.ceil(N * grow)))
+            _chunk_steps(chunks, nc, length, N, np.int64(1), mult, csteps)
             _copy(x_f, x)
             _copy(Z_f, Z)
             ok, _, _ = _ms_corrector(
@@ -3759,7 +3781,7 @@ def solve_stiff_cases(base, arm, act, loads, options, s_out, out, verdicts, inpu
         info[b, 0] = residual
         if status[b] != OK:
             continue
-        _chunk_steps(chunks, nc, length, N, np.int64(2), csteps)
+        _chunk_steps(chunks, nc, length, N, np.int64(2), mult, csteps)
         if inputs is None:
             _ms_record(x_f, Z_f, M, chunks, first, csteps, base, arm, act, case, scratch,
                        s_out, out, b, None, None)
@@ -3773,6 +3795,27 @@ def solve_stiff_cases(base, arm, act, loads, options, s_out, out, verdicts, inpu
         if verdicts is not None and status[b] == OK:
             _ms_verdict(x_f, Z_f, M, chunks, first, csteps, base, arm, act, case, scratch, N,
                         piece_loads[b], tip_loads[b], out, b, verdicts)
+
+
+@_jit
+def _ms_local_errors(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, colscale,
+                     rowscale, work, length, nc, N, mult, local):
+    """Each interval's local error ``local[i]`` (L, rad): its end state integrated from the
+    solution's own start on N steps against on 2N (``work``'s ends: the last integration,
+    at 2N, of this solution), in position / L and rotation. Leaves ``csteps`` at N."""
+    F, B, G, ends, lengths = work[0], work[1], work[2], work[3], work[4]
+    fine = ends.copy()
+    _chunk_steps(chunks, nc, length, N, np.int64(1), mult, csteps)
+    none = M - M
+    _ms_evaluate(x, Z, M, 1.0, none, chunks, first, csteps, base, arm, act, case, scratch,
+                 colscale, rowscale, F, B, G, ends, lengths, None)
+    for i in range(M):
+        e = 0.0
+        for a in range(3):
+            e = max(e, abs(ends[i, _P + a] - fine[i, _P + a]) / length)
+        for a in range(9):
+            e = max(e, abs(ends[i, _R + a] - fine[i, _R + a]))
+        local[i] = e if math.isfinite(e) else np.inf
 
 
 @_jit
