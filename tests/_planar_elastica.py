@@ -96,7 +96,7 @@ def _bc(tip):
 
 
 def solve_planar(length, EI, EA, GA, *, distributed=(0.0, 0.0), tip=(0.0, 0.0), tol=1e-8,
-                 path_tol=1e-6, start=1.0, growth=4.0, max_nodes=400_000,
+                 path_tol=1e-6, start=1.0, growth=4.0, max_turn=0.5, max_nodes=400_000,
                  previous=None) -> PlanarSolution:
     """The planar rod under a dead distributed force (q_x, q_z) N/m and tip force (F_x, F_z) N.
 
@@ -106,10 +106,12 @@ def solve_planar(length, EI, EA, GA, *, distributed=(0.0, 0.0), tip=(0.0, 0.0), 
 
     Continuation: the loads are scaled by λ from the λ whose largest nondimensional load
     (q L³/EI or F L²/EI) is ``start`` (λ = 1 if that is already small), λ multiplied by
-    ``growth`` per step (the factor's square root after a failed step), each step started
-    from the previous solution and its mesh, solved to ``path_tol``; the full load is then
-    solved again to ``tol``. ``previous`` (a PlanarSolution of the same arm and loads) skips
-    the continuation.
+    ``growth`` per step, each step started from the previous solution and its mesh, solved
+    to ``path_tol``; the full load is then solved again to ``tol``. A step that fails or
+    turns a section by more than ``max_turn`` rad (a jump to another branch: a hard pull
+    at 150° can otherwise wind the arm the wrong way round) is retried with the square root
+    of the factor, which is squared back after a success. ``previous`` (a PlanarSolution of
+    the same arm and loads) skips the continuation.
 
     Raises RuntimeError if a step fails with the growth factor below 1.01.
     """
@@ -136,21 +138,22 @@ def solve_planar(length, EI, EA, GA, *, distributed=(0.0, 0.0), tip=(0.0, 0.0), 
         trial = solve_bvp(_rhs(lam * q, eps_a, eps_g), _bc(lam * f), t, y,
                           tol=tol if last else max(tol, path_tol), max_nodes=max_nodes)
         steps += 1
-        if trial.success:
-            sol = trial
+        turn = (np.max(np.abs(trial.sol(sol.x)[2] - sol.y[2]))
+                if trial.success and sol is not None else 0.0)
+        if trial.success and turn <= max_turn:
+            sol, reached = trial, lam
             if last:
                 break
             if lam == 1.0:
                 path_tol = tol  # once more, to tol
                 continue
-            lam = min(1.0, lam * factor)
+            factor = min(growth, factor**2)
         else:
             if previous is not None or sol is None or factor < 1.01:
                 raise RuntimeError(f"solve_bvp failed at load factor {lam:.6g}: "
-                                   f"{trial.message}")
-            lam = lam / factor
+                                   f"{trial.message} (turn {turn:.3g} rad)")
             factor = math.sqrt(factor)
-            lam = min(1.0, lam * factor)
+        lam = min(1.0, reached * factor)
     return PlanarSolution(L, EI, sol, steps, sol.x.size)
 
 
