@@ -119,7 +119,8 @@ def test_a_tendon_robot_under_large_tensions_solves_alike_on_both_routes():
     tau = np.array([2500.0, 750.0])
     results = [Solver(arm, s=3, shooting=shooting).solve(loads(*tau), jacobians=True)
                for shooting in ("single", "multiple")]
-    assert np.abs(results[0].positions - results[1].positions).max() < 1e-9
+    # (each within tol = 1e-8 L of the exact answer: within 2e-8 L of each other)
+    assert np.abs(results[0].positions - results[1].positions).max() < 2e-8
     tight = Solver(arm, s=3, tol=1e-12, stability=False, shooting="multiple")
     h = 1e-3
     for k in range(2):

@@ -2896,6 +2896,12 @@ _STIFF_STEPS = 0.6  # coarse RK4 steps per unit of kL at least: hk <= 1.7 (RK4 i
 # sharply near λ = 0 (k grows like √λ: the predicted lateral motion at λ = 0 is that of an
 # arm without tension), so steps far below _DLAM_MIN are needed there, doubling from then on.
 _DLAM_MIN_STIFF = 1e-12
+# The Richardson estimate |p_2N - p_N| / 15 times this: at hk near 1 (a boundary layer of
+# width 1/k resolved by a few steps) RK4 is not yet in its asymptotic regime, and the fine
+# solution's error against the separatrix was measured up to 2.2 times |p_2N - p_N| / 15
+# (a hard pull at 150°, kL = 1e4).
+_STIFF_SAFETY = 2.0
+_NODE_WEIGHT = 0.2  # the interior nodes' weight in the path's distance (_ms_distance)
 _BAND = 17  # the Jacobian's lower and upper bandwidth (rows of a join, columns of two nodes)
 _COLS = 13  # tangent columns of an interval from an interior node
 # Chunk rows (_chunk_table): piece, start s, length, 1.0 if it starts its piece (the point
@@ -3258,13 +3264,19 @@ def _ms_motion(T, M, du, colscale, lam_rate, out):
 
 @_jit
 def _ms_distance(du, n, T, M, colscale, w, length, motion):
-    """The size of a scaled change du of the unknowns: the largest of its components
-    (forces relative to the case's load size 1 + w, positions in L, angles in rad) and of the
-    tip motion it causes (L, rad)."""
+    """The size of a scaled change du of the unknowns: as single shooting measures it
+    (:func:`_distance`), the largest of the base reaction's change relative to the case's
+    load size 1 + w and of the tip motion it causes (L, rad), and the interior nodes'
+    changes at a fifth of their weight (forces relative to 1 + w, positions in L, angles in
+    rad). Under a hard oblique pull the clamp's boundary layer sweeps past node after node as
+    k grows like √λ, turning each by up to the pull's angle: at full weight those turns held
+    the path to 300 steps at kL = 1e4; without them it jumped to an arm wound the wrong way
+    round (a node turning by more than π in one step)."""
     out = 0.0
     for k in range(n):
         force = k < 6 or (k - 6) % 12 < 6
-        out = max(out, abs(du[k]) / (1.0 + w) if force else abs(du[k]))
+        size = abs(du[k]) / (1.0 + w) if force else abs(du[k])
+        out = max(out, size if k < 6 else _NODE_WEIGHT * size)
     _ms_motion(T, M, du, colscale, 0.0, motion)
     for k in range(6):
         out = max(out, abs(motion[k]) / (length if k < 3 else 1.0))
@@ -3733,7 +3745,7 @@ def solve_stiff_cases(base, arm, act, loads, options, s_out, out, verdicts, inpu
             d2 = 0.0
             for i in range(3):
                 d2 += (tip_f[i] - tip_c[i]) ** 2
-            estimate = math.sqrt(d2) / 15.0
+            estimate = _STIFF_SAFETY * math.sqrt(d2) / 15.0
             if estimate <= tol or n_fixed > 0:
                 done = True
                 break
