@@ -532,7 +532,7 @@ def _cold_compile_section(comp) -> list[str]:
 
 
 def report(env, comp, rows, ref_notes, pyel_note, closed_runs, batch, verdict,
-           quick: bool, elapsed: float) -> str:
+           quick: bool, elapsed: float, stiff_lines=()) -> str:
     cold = comp["cold_first_call_s"]
     big = batch[1]  # (batch: the small one, the full one, the full one on one thread)
     lines = [
@@ -632,6 +632,7 @@ def report(env, comp, rows, ref_notes, pyel_note, closed_runs, batch, verdict,
             f"| {b['output_bytes'] / 2**20:.1f} | {(growth - b['output_bytes']) / 2**20:.1f} "
             f"| {b['max_error_estimate_over_L']:.1e} | {b['max_gap_to_tight_over_L']:.1e} |"
         )
+    lines += ["", *stiff_lines]
     lines += ["", "## Verdicts", "", *[f"- {v}" for v in verdict], ""]
     return "\n".join(lines)
 
@@ -701,9 +702,20 @@ def main(argv=None) -> int:
         wall = comp["demo"]["beside"][0]
         verdict.append(f"a cold `softarm demo` (install excluded) ≤ 20 s (issue 30): "
                        f"{'met' if wall <= 20.0 else 'NOT met'}: {wall:.1f} s wall")
+    import stiff  # (benchmarks/stiff.py, beside this script)
+
+    stiff_repeats = 1 if quick else 3
+    stiff_rows = stiff.measure(stiff_repeats)
+    for name, route, wall, *_ in stiff_rows:
+        if route == "softarm auto" and name.startswith("tension F L²/EI = 1e+06"):
+            verdict.append(f"F L²/EI = 1e6 with a lateral force ≤ 5 ms (issue 31): "
+                           f"{'met' if wall <= 5e-3 else 'NOT met'}: {1e3 * wall:.1f} ms")
+        if route == "softarm auto" and name.startswith("hose L = 3 m"):
+            verdict.append(f"a 3 m hanging hose ≤ 5 ms (issue 31): "
+                           f"{'met' if wall <= 5e-3 else 'NOT met'}: {1e3 * wall:.1f} ms")
     elapsed = time.perf_counter() - t_start
     text = report(env, comp, rows, ref_notes, pyel_note, (closed, closed_principal, closed_serial),
-                  batch, verdict, quick, elapsed)
+                  batch, verdict, quick, elapsed, stiff.markdown(stiff_rows, stiff_repeats))
     print()
     print(table(rows))
     print()

@@ -8,11 +8,12 @@ and CPU time (``process_time``) per solve, best of several after a warm-up call;
 that fails is timed once and reported as ``fails: <message>``. The tip error is against an
 exact closed form (tension: the pendulum separatrix, exact to e^{−kL}) or solve_bvp at
 tol 1e-9 (hoses). softarm runs without its stability verdict (``stability=False``: it is not
-part of the solve, and it fails in strong tension, tests/test_stiff_tension.py). Run::
+part of the solve; with it, add 5-40 %). Run::
 
     python benchmarks/stiff.py [--repeats 5]
 
-Times are printed, never asserted.
+Times are printed, never asserted. ``benchmarks/run.py`` puts the same table in
+docs/performance.md ("Stiff problems", :func:`markdown`).
 """
 
 from __future__ import annotations
@@ -77,16 +78,12 @@ def best_time(fn, repeats):
     return min(walls), min(cpus), result
 
 
-def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--repeats", type=int, default=5)
-    args = parser.parse_args(argv)
+def measure(repeats: int) -> list[tuple]:
+    """Rows (case, route, wall s, CPU s, tip error / L or the failure's message, wall / the
+    auto route's), every case on every route."""
     cases = [tension_case(load) for load in (1e2, 1e4, 1e6, 1e8)]
     cases += [hose_case(length) for length in (1.0, 2.0, 3.0)]
-    print(f"tol = {TOL:g} L; best of {args.repeats} after a warm-up; ms wall / ms CPU; "
-          f"tip error / L against the exact tip")
-    print(f"{'case':34s} {'route':14s} {'wall ms':>9s} {'CPU ms':>9s} {'error/L':>8s}  "
-          f"{'wall / auto':>11s}")
+    rows = []
     for name, arm, loads, planar, exact in cases:
         length = planar["length"]
         routes = {
@@ -99,18 +96,40 @@ def main(argv=None):
         }
         auto_wall = None
         for route, fn in routes.items():
-            repeats = 1 if route == "solve_bvp" and "1e+08" in name else args.repeats
-            wall, cpu, result = best_time(fn, repeats)
+            count = 1 if route == "solve_bvp" and "1e+08" in name else repeats
+            wall, cpu, result = best_time(fn, count)
             if isinstance(result, Exception):
-                text = f"fails: {str(result)[:60]}"
-                print(f"{name:34s} {route:14s} {1e3 * wall:9.1f} {1e3 * cpu:9.1f} {text}")
+                rows.append((name, route, wall, cpu, f"fails: {str(result)[:60]}", None))
                 continue
             error = float(np.max(np.abs(result - exact))) / length
             auto_wall = wall if route == "softarm auto" else auto_wall
-            ratio = f"{wall / auto_wall:10.1f}x" if auto_wall else ""
-            print(f"{name:34s} {route:14s} {1e3 * wall:9.2f} {1e3 * cpu:9.2f} {error:8.1e}  "
-                  f"{ratio:>11s}")
-        sys.stdout.flush()
+            rows.append((name, route, wall, cpu, error, wall / auto_wall if auto_wall else None))
+    return rows
+
+
+def markdown(rows, repeats: int) -> list[str]:
+    """The rows as the "Stiff problems" section of docs/performance.md."""
+    lines = ["## Stiff problems (multiple shooting)", "",
+             f"`python benchmarks/stiff.py`: tol {TOL:g} L, best of {repeats} after a warm-up "
+             "(solve_bvp at F L²/EI = 1e8 timed once), without the stability verdict. The tip "
+             "error is against the pendulum separatrix (tension, exact to e^{-kL}) or "
+             "solve_bvp at tol 1e-9 (hoses, tests/_planar_elastica.py). softarm's auto route "
+             "takes multiple shooting from kL = 15 (docs/solver.md).", "",
+             "| case | route | wall ms | CPU ms | tip error / L | wall / auto |",
+             "|---|---|---|---|---|---|"]
+    for name, route, wall, cpu, error, ratio in rows:
+        error = error if isinstance(error, str) else f"{error:.1e}"
+        ratio = "" if ratio is None else f"{ratio:.1f}×"
+        lines.append(f"| {name} | {route} | {1e3 * wall:.1f} | {1e3 * cpu:.1f} | {error} | "
+                     f"{ratio} |")
+    return [*lines, ""]
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeats", type=int, default=5)
+    args = parser.parse_args(argv)
+    print("\n".join(markdown(measure(args.repeats), args.repeats)))
 
 
 if __name__ == "__main__":
