@@ -42,9 +42,9 @@ def quick_report(tmp_path_factory):
 def test_quick_run_writes_report(quick_report):
     text, stdout = quick_report
     for heading in ("## Machine", "## Compilation", "## Against peers", "## Throughput",
-                    "## Verdicts"):
+                    "## Stiff problems", "## Verdicts"):
         assert heading in text
-    assert stdout.count("VERDICT") == 8
+    assert stdout.count("VERDICT") == 10
 
 
 def test_table_parses_and_covers_every_case_and_tool(quick_report):

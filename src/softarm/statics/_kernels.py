@@ -792,7 +792,13 @@ def _station_rotation(y0, f0, y1, f1, u, h, out):
     a0 = c1 * c[0, 0] + c2 * t0 + c3 * d0
     a1 = c1 * c[0, 1] + c2 * t1 + c3 * d1
     a2 = c1 * c[0, 2] + c2 * t2 + c3 * d2
-    # exp(θ~) by Rodrigues, then R0 exp(θ~)
+    _rotated(y0, a0, a1, a2, out)
+
+
+@_inline
+def _rotated(y0, a0, a1, a2, out):
+    """out's rotation = y0's R times exp(a~) (a material, by Rodrigues; the series below
+    1e-4 rad, to round-off); ``out`` must not be ``y0``."""
     angle = math.sqrt(a0 * a0 + a1 * a1 + a2 * a2)
     if angle < 1e-4:
         sa, ca = 1.0 - angle * angle / 6.0, 0.5 - angle * angle / 24.0
@@ -1218,6 +1224,26 @@ def _tangent(J, t):
     return _linear_solve(J, rhs, t)
 
 
+@_inline
+def _load_step(lam, dl):
+    """(Δλ, the target λ + Δλ): a step that would leave less than half a step to λ = 1 is
+    stretched to reach it."""
+    if lam + 1.5 * dl >= 1.0:
+        dl = 1.0 - lam
+    target = lam + dl
+    if target >= 1.0 - 1e-12:
+        target = 1.0
+    return dl, target
+
+
+@_inline
+def _grown(dl, moved, max_load_step):
+    """The next Δλ after an accepted step whose corrector moved ``moved`` from the
+    prediction: Δλ (aim/δ)^(1/3) within [Δλ/2, 2Δλ], at most max_load_step."""
+    grow = 2.0 if moved <= 0.0 else min(2.0, max(0.5, (_DIST_AIM / moved) ** (1 / 3)))
+    return min(max_load_step, dl * grow)
+
+
 @_jit
 def _follow(x, steps, base, arm, act, case, scratch, scale, dscale, length, threshold,
             max_iterations, max_load_step, max_shootings, open_end, final, r, J, tip,
@@ -1265,11 +1291,7 @@ def _follow(x, steps, base, arm, act, case, scratch, scale, dscale, length, thre
     while lam < 1.0:
         if counter[0] > max_shootings:
             return False
-        if lam + 1.5 * dl >= 1.0:
-            dl = 1.0 - lam
-        target = lam + dl
-        if target >= 1.0 - 1e-12:
-            target = 1.0
+        dl, target = _load_step(lam, dl)
         for i in range(6):
             x0[i] = x[i]
         h = lam - lam_p
@@ -1319,9 +1341,7 @@ def _follow(x, steps, base, arm, act, case, scratch, scale, dscale, length, thre
             lam_p = lam
             lam = target
             reached[0] = lam
-            moved = _distance(dx, scratch[1], dscale, length)
-            grow = 2.0 if moved <= 0.0 else min(2.0, max(0.5, (_DIST_AIM / moved) ** (1 / 3)))
-            dl = min(max_load_step, dl * grow)
+            dl = _grown(dl, _distance(dx, scratch[1], dscale, length), max_load_step)
         else:
             for i in range(6):
                 x[i] = x0[i]
@@ -1652,6 +1672,23 @@ def _output(x, nt, steps, base, arm, act, case, piece_loads, tip_loads, inputs, 
             J_out)
 
 
+@_inline
+def _retry_finer(n_fixed, N, n_max, failures, reached, failed_at):
+    """Whether a path that failed at load factor ``reached`` is tried again on twice the
+    steps: a fold persists under refinement at about the same load factor; a failure of an
+    under-resolved path moves or disappears (at most 4 times, within the step limit)."""
+    return (n_fixed == 0 and 2 * N <= n_max // 2 and failures < 4
+            and abs(reached - failed_at) > 0.02)
+
+
+@_inline
+def _read_options(options):
+    """(tol, max_iterations, max_load_step, fixed step count, largest step count, budget)
+    from the solver options (see solve_cases)."""
+    return (options[_O_TOL], int(options[_O_ITER]), options[_O_LOADSTEP],
+            int(options[_O_NFIXED]), int(options[_O_NMAX]), int(options[_O_BUDGET]))
+
+
 @_entry(_solver, nogil=True)
 def solve_cases(base, arm, act, loads, first, options, s_out, memory, inputs, out):
     """Solve every load case of a flattened batch.
@@ -1710,12 +1747,7 @@ def solve_cases(base, arm, act, loads, first, options, s_out, memory, inputs, ou
     npieces = arm[1].size
     scale = arm[7]
     length = arm[6]
-    tol = options[_O_TOL]
-    max_iterations = int(options[_O_ITER])
-    max_load_step = options[_O_LOADSTEP]
-    n_fixed = int(options[_O_NFIXED])
-    n_max = int(options[_O_NMAX])
-    budget = int(options[_O_BUDGET])
+    tol, max_iterations, max_load_step, n_fixed, n_max, budget = _read_options(options)
     near = memory is not None and options[_O_NEAR] > 0.0
     # (nb - nb: a variable, not the literal 0, which would compile _record and everything
     # below it a second time, for the type Literal[int](0))
@@ -1889,10 +1921,7 @@ def solve_cases(base, arm, act, loads, first, options, s_out, memory, inputs, ou
                     if n_path < N:
                         fine_path = True
                         continue
-                    # a fold persists under refinement at about the same load factor; a
-                    # failure of an under-resolved path moves or disappears
-                    if (n_fixed == 0 and 2 * N <= n_max // 2 and failures < 4
-                            and abs(reached[0] - failed_at) > 0.02):
+                    if _retry_finer(n_fixed, N, n_max, failures, reached[0], failed_at):
                         failures += 1
                         failed_at = reached[0]
                         N = 2 * N
@@ -3208,39 +3237,16 @@ def _ms_apply(x, Z, M, du, colscale, sign):
     R ← R exp(δθ~) (material)."""
     for k in range(6):
         x[k] += sign * du[k] * colscale[k]
-    e = np.empty((3, 3))
-    R = np.empty((3, 3))
+    before = np.empty(Z.shape[1])
     for i in range(1, M):
         o = 6 + 12 * (i - 1)
         for k in range(3):
             Z[i, _N + k] += sign * du[o + k] * colscale[o + k]
             Z[i, _M + k] += sign * du[o + 3 + k] * colscale[o + 3 + k]
             Z[i, _P + k] += sign * du[o + 6 + k] * colscale[o + 6 + k]
-        a0 = sign * du[o + 9] * colscale[o + 9]
-        a1 = sign * du[o + 10] * colscale[o + 10]
-        a2 = sign * du[o + 11] * colscale[o + 11]
-        angle = math.sqrt(a0 * a0 + a1 * a1 + a2 * a2)
-        if angle < 1e-4:  # the series, to round-off
-            sa = 1.0 - angle * angle / 6.0
-            ca = 0.5 - angle * angle / 24.0
-        else:
-            sa, ca = math.sin(angle) / angle, (1.0 - math.cos(angle)) / (angle * angle)
-        e[0, 0] = 1.0 - ca * (a1 * a1 + a2 * a2)
-        e[1, 1] = 1.0 - ca * (a0 * a0 + a2 * a2)
-        e[2, 2] = 1.0 - ca * (a0 * a0 + a1 * a1)
-        e[0, 1] = -sa * a2 + ca * a0 * a1
-        e[1, 0] = sa * a2 + ca * a0 * a1
-        e[0, 2] = sa * a1 + ca * a0 * a2
-        e[2, 0] = -sa * a1 + ca * a0 * a2
-        e[1, 2] = -sa * a0 + ca * a1 * a2
-        e[2, 1] = sa * a0 + ca * a1 * a2
-        for a in range(3):
-            for b in range(3):
-                R[a, b] = (Z[i, _R + 3 * a] * e[0, b] + Z[i, _R + 3 * a + 1] * e[1, b]
-                           + Z[i, _R + 3 * a + 2] * e[2, b])
-        for a in range(3):
-            for b in range(3):
-                Z[i, _R + 3 * a + b] = R[a, b]
+        _copy(Z[i], before)
+        _rotated(before, sign * du[o + 9] * colscale[o + 9], sign * du[o + 10] * colscale[o + 10],
+                 sign * du[o + 11] * colscale[o + 11], Z[i])
 
 
 @_jit
@@ -3370,11 +3376,7 @@ def _ms_follow(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, co
     while lam < 1.0:
         if counter[0] > max_shootings:
             return False
-        if lam + 1.5 * dl >= 1.0:
-            dl = 1.0 - lam
-        target = lam + dl
-        if target >= 1.0 - 1e-12:
-            target = 1.0
+        dl, target = _load_step(lam, dl)
         _copy(x, x_keep)
         _copy(Z, Z_keep)
         for i in range(n):
@@ -3402,8 +3404,7 @@ def _ms_follow(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, co
                 t[i] = du[i]
             lam = target
             reached[0] = lam
-            grow = 2.0 if dist <= 0.0 else min(2.0, max(0.5, (_DIST_AIM / dist) ** (1 / 3)))
-            dl = min(max_load_step, dl * grow)
+            dl = _grown(dl, dist, max_load_step)
         else:
             _copy(x_keep, x)
             _copy(Z_keep, Z)
@@ -3618,12 +3619,7 @@ def solve_stiff_cases(base, arm, act, loads, options, s_out, out, verdicts, inpu
     npieces = arm[1].size
     length = arm[6]
     scale = arm[7]
-    tol = options[_O_TOL]
-    max_iterations = int(options[_O_ITER])
-    max_load_step = options[_O_LOADSTEP]
-    n_fixed = int(options[_O_NFIXED])
-    n_max = int(options[_O_NMAX])
-    budget = int(options[_O_BUDGET])
+    tol, max_iterations, max_load_step, n_fixed, n_max, budget = _read_options(options)
     info, status = out[3], out[4]
     width = piece_loads.shape[2]
     scratch = _scratch(npieces, width - PIECE_LOADS, _COLS)
@@ -3710,8 +3706,7 @@ def solve_stiff_cases(base, arm, act, loads, options, s_out, out, verdicts, inpu
                     if counter[0] > budget:
                         status[b] = BUDGET
                         break
-                    if (n_fixed == 0 and 2 * N <= n_max // 2 and failures < 4
-                            and abs(reached[0] - failed_at) > 0.02):
+                    if _retry_finer(n_fixed, N, n_max, failures, reached[0], failed_at):
                         failures += 1
                         failed_at = reached[0]
                         N = 2 * N
