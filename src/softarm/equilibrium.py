@@ -155,8 +155,9 @@ class Equilibrium:
         The total wrench (N; N m) the base carries, spatial components: the load the rod
         puts on the clamp (the clamp's reaction on the rod is its negative: an arm hanging
         under its weight W gives (0, 0, -W) with gravity along -z) plus what the actuators
-        pull or push on the base (tendons' motors, the chambers' fluid). The rod's own share is ``forces_spatial[..., 0, :]`` and
-        ``moments_spatial[..., 0, :]``. Numerical route only (None from closed forms).
+        pull or push on the base (tendons' motors, the chambers' fluid). The rod's own share
+        is ``forces_spatial[..., 0, :]`` and ``moments_spatial[..., 0, :]``. Numerical route
+        only (None from closed forms).
     actuation_jacobian : ndarray, shape (B..., 6, n), or None
         With ``solve(..., jacobians=True)`` and actuators: the tip's (δp; δθ) (spatial,
         δR(L) = δθ~ R(L)) per unit change of each actuation input, in the order of the loads:
