@@ -1225,14 +1225,14 @@ def _tangent(J, t):
 
 
 @_inline
-def _load_step(lam, dl):
-    """(Δλ, the target λ + Δλ): a step that would leave less than half a step to λ = 1 is
-    stretched to reach it."""
-    if lam + 1.5 * dl >= 1.0:
-        dl = 1.0 - lam
+def _load_step(lam, dl, end):
+    """(Δλ, the target λ + Δλ): a step that would leave less than half a step to ``end``
+    (the path's end, λ = 1 but on a level of the stiff path) is stretched to reach it."""
+    if lam + 1.5 * dl >= end:
+        dl = end - lam
     target = lam + dl
-    if target >= 1.0 - 1e-12:
-        target = 1.0
+    if target >= end - 1e-12 * end:
+        target = end
     return dl, target
 
 
@@ -1267,6 +1267,7 @@ def _follow(x, steps, base, arm, act, case, scratch, scale, dscale, length, thre
     ``_DIST_MAX`` and contraction test, so the last step is checked as any other).
     """
     reached[0] = 0.0
+    end = 1.0
     nt = J.shape[1]  # all 7 columns (a variable, not a literal: one compiled version)
     if not _corrector(x, 0.0, nt, steps, base, arm, act, case, scratch, scale, dscale, length,
                       threshold, max_iterations, _REFINE_MAX, _LOOSE, r, J, tip, counter):
@@ -1291,7 +1292,7 @@ def _follow(x, steps, base, arm, act, case, scratch, scale, dscale, length, thre
     while lam < 1.0:
         if counter[0] > max_shootings:
             return False
-        dl, target = _load_step(lam, dl)
+        dl, target = _load_step(lam, dl, end)
         for i in range(6):
             x0[i] = x[i]
         h = lam - lam_p
@@ -2930,7 +2931,9 @@ _DLAM_MIN_STIFF = 1e-12
 # solution's error against the separatrix was measured up to 2.2 times |p_2N - p_N| / 15
 # (a hard pull at 150°, kL = 1e4).
 _STIFF_SAFETY = 2.0
-_NODE_WEIGHT = 0.2  # the interior nodes' weight in the path's distance (_ms_distance)
+_NODE_WEIGHT = 0.2
+# The levels of the stiff path: each has 2^_LEVEL times the intervals of the one before
+_LEVEL = 2  # the interior nodes' weight in the path's distance (_ms_distance)
 _BAND = 17  # the Jacobian's lower and upper bandwidth (rows of a join, columns of two nodes)
 _COLS = 13  # tangent columns of an interval from an interior node
 # Chunk rows (_chunk_table): piece, start s, length, 1.0 if it starts its piece (the point
@@ -3343,17 +3346,18 @@ def _ms_corrector(x, Z, M, lam, nt, chunks, first, csteps, base, arm, act, case,
 @_jit
 def _ms_follow(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, colscale, rowscale,
                work, w, length, threshold, max_iterations, max_load_step, max_shootings, final,
-               tip, counter, reached):
-    """:func:`_follow` on the block system: the path from λ = 0 (x, Z: the solution there)
-    to λ = 1, predicted along the tangent -J⁻¹ ∂F/∂λ, corrected by :func:`_ms_corrector`,
-    with the same step control and branch guards (the sign of the whole banded Jacobian's
-    determinant, the tip's direction of motion). True on success (x, Z at λ = 1, the band
-    factors there); else reached[0] is the last load factor reached."""
+               tip, counter, reached, lam0, end):
+    """:func:`_follow` on the block system: the path from λ = lam0 (x, Z: the solution there,
+    exact or close) to λ = ``end``, predicted along the tangent -J⁻¹ ∂F/∂λ, corrected by
+    :func:`_ms_corrector`, with the same step control and branch guards (the sign of the
+    whole banded Jacobian's determinant, the tip's direction of motion). True on success
+    (x, Z at λ = end, the band factors there); else reached[0] is the last load factor
+    reached."""
     B, G, piv, Lm, du, motion = work[1], work[2], work[5], work[6], work[7], work[8]
     n = 12 * M - 6
     nt = M - M + _COLS  # (a variable: one compiled version of the callees)
-    reached[0] = 0.0
-    ok, sign, dist = _ms_corrector(x, Z, M, 0.0, nt, chunks, first, csteps, base, arm, act, case,
+    reached[0] = lam0
+    ok, sign, dist = _ms_corrector(x, Z, M, lam0, nt, chunks, first, csteps, base, arm, act, case,
                              scratch, colscale, rowscale, work, w, length, threshold,
                              max_iterations, _REFINE_MAX, _LOOSE, tip, counter)
     if not ok:
@@ -3370,13 +3374,13 @@ def _ms_follow(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, co
     motion_new = np.empty(6)
     _ms_motion(scratch[1], M, t, colscale, 1.0, motion_prev)
     moved = np.empty(n)
-    lam = 0.0
+    lam = lam0
     size = _ms_distance(t, n, scratch[1], M, colscale, w, length, motion)
     dl = max_load_step if size <= 0.0 else min(max_load_step, _FIRST_MOTION / size)
-    while lam < 1.0:
+    while lam < end:
         if counter[0] > max_shootings:
             return False
-        dl, target = _load_step(lam, dl)
+        dl, target = _load_step(lam, dl, end)
         _copy(x, x_keep)
         _copy(Z, Z_keep)
         for i in range(n):
@@ -3411,6 +3415,94 @@ def _ms_follow(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, co
             dl *= 0.4
             if dl < _DLAM_MIN_STIFF:
                 return False
+    return True
+
+
+@_jit
+def _ms_grid(arm, M, width):
+    """The block system's grid with M intervals: (chunks, their count, each interval's first
+    chunk, steps per chunk, work arrays, column scales, row scales)."""
+    length, scale = arm[6], arm[7]
+    chunks = np.empty((M + arm[1].size, 5))
+    nc, first = _chunk_table(arm, M, chunks)
+    n = 12 * M - 6
+    colscale = np.empty(n)
+    rowscale = np.empty(n)
+    for k in range(6):
+        colscale[k] = scale[k]
+    for i in range(1, M):
+        o = 6 + 12 * (i - 1)
+        for k in range(6):
+            colscale[o + k] = scale[k]
+            colscale[o + 6 + k] = length if k < 3 else 1.0
+    for i in range(M - 1):  # rows p, θ, n, m of join i
+        o = 12 * i
+        for k in range(3):
+            rowscale[o + k] = length
+            rowscale[o + 3 + k] = 1.0
+            rowscale[o + 6 + k] = scale[k]
+            rowscale[o + 9 + k] = scale[3 + k]
+    for k in range(6):
+        rowscale[n - 6 + k] = scale[k]
+    return (chunks, nc, first, np.empty(nc, dtype=np.int64), _ms_work(M, width), colscale,
+            rowscale)
+
+
+@_jit
+def _ms_path(x, Z, M, levels, kl, N, n_fixed, arm, act, base, case, scratch, w, threshold,
+             max_iterations, max_load_step, budget, final_step, tip, counter, reached, chunks,
+             first, csteps, work, colscale, rowscale, mult):
+    """The loading path from the unloaded arm to λ = 1 on the final grid (M intervals,
+    ``csteps`` at N), in levels: k grows like √λ, so the path runs on M / 2^levels
+    intervals and proportionally fewer steps while k√λ L <= _GROWTH times their number,
+    then on twice as many, each finer grid's nodes the coarser's plus the states halfway
+    (integrated on the finer grid from the coarser nodes, then corrected at that λ). The
+    early load steps, most of the path's, cost a fraction of the last ones'. True on success,
+    x and Z the solution at λ = 1 on the final grid (its band factors in ``work``)."""
+    length = arm[6]
+    y, T = scratch[0], scratch[1]
+    none = M - M
+    lam = 0.0
+    for k in range(6):
+        x[k] = 0.0
+    prev_Z = np.zeros((1, y.size))
+    prev_M = 0
+    for level in range(levels, -1, -1):
+        Ml = M >> (_LEVEL * level)
+        final = level == 0
+        end = 1.0 if final or not kl > 0.0 else min(1.0, (_GROWTH * Ml / kl) ** 2)
+        if final:
+            g_chunks, g_first, g_csteps, g_work = chunks, first, csteps, work
+            g_colscale, g_rowscale, Zl = colscale, rowscale, Z
+        else:
+            g_chunks, nc, g_first, g_csteps, g_work, g_colscale, g_rowscale = _ms_grid(
+                arm, Ml, y.size)
+            Zl = np.zeros((Ml, y.size))
+            # steps in proportion to k at the level's end (N is the final grid's)
+            Nl = N if n_fixed > 0 else max(nc, math.ceil(N * math.sqrt(end)))
+            _chunk_steps(g_chunks, nc, length, Nl, np.int64(1), np.ones(Ml, dtype=np.int64),
+                         g_csteps)
+        _set_loads(lam, case, scratch[4], scratch[5])
+        # the nodes: the coarser level's (every other one) and the states between them,
+        # integrated from those; on the first level the unloaded arm's (x = 0, λ = 0)
+        _start(y, T, none, base, x)
+        for i in range(Ml):
+            if i > 0:
+                if prev_M > 0 and i % (1 << _LEVEL) == 0:
+                    _copy(prev_Z[i >> _LEVEL], y)
+                _copy(y, Zl[i])
+            _run_chunks(y, T, none, g_first[i], g_first[i + 1], g_chunks, g_csteps, arm, act,
+                        case[1], scratch)
+        if not _ms_follow(x, Zl, Ml, g_chunks, g_first, g_csteps, base, arm, act, case, scratch,
+                          g_colscale, g_rowscale, g_work, w, length, threshold, max_iterations,
+                          max_load_step, budget, final_step if final else _LOOSE, tip, counter,
+                          reached, lam, end):
+            return False
+        lam = end
+        if final:
+            return True
+        prev_Z = Zl
+        prev_M = Ml
     return True
 
 
@@ -3635,7 +3727,7 @@ def solve_stiff_cases(base, arm, act, loads, options, s_out, out, verdicts, inpu
     x_f = np.zeros(6)
     tip_c = np.empty(3)
     tip_f = np.empty(3)
-    y, T = scratch[0], scratch[1]
+    y = scratch[0]
     for b in range(nb):
         counter[0] = 0
         for j in range(npieces):
@@ -3646,30 +3738,14 @@ def solve_stiff_cases(base, arm, act, loads, options, s_out, out, verdicts, inpu
         w, turning = _load_size(arm, act, scale, start, piece_loads[b], tip_start, tip_loads[b])
         threshold = 1e-12 * w + 1e-300
         kl = _stiffness_size(arm, w)
-        M = max(1, min(math.ceil(kl / _GROWTH), n_max // 4))
-        chunks = np.empty((M + npieces, 5))
-        nc, first = _chunk_table(arm, M, chunks)
-        csteps = np.empty(nc, dtype=np.int64)
+        # M = M_base 2^levels >= kL / _GROWTH (within 25 %): the path's levels halve it
+        needed = max(1, min(math.ceil(kl / _GROWTH), n_max // 4))
+        levels = 0
+        while (needed >> (_LEVEL * (levels + 1))) >= 4:
+            levels += 1
+        M = ((needed + (1 << (_LEVEL * levels)) - 1) >> (_LEVEL * levels)) << (_LEVEL * levels)
+        chunks, nc, first, csteps, work, colscale, rowscale = _ms_grid(arm, M, y.size)
         n = 12 * M - 6
-        work = _ms_work(M, y.size)
-        colscale = np.empty(n)
-        rowscale = np.empty(n)
-        for k in range(6):
-            colscale[k] = scale[k]
-        for i in range(1, M):
-            o = 6 + 12 * (i - 1)
-            for k in range(6):
-                colscale[o + k] = scale[k]
-                colscale[o + 6 + k] = length if k < 3 else 1.0
-        for i in range(M - 1):  # rows p, θ, n, m of join i
-            o = 12 * i
-            for k in range(3):
-                rowscale[o + k] = length
-                rowscale[o + 3 + k] = 1.0
-                rowscale[o + 6 + k] = scale[k]
-                rowscale[o + 9 + k] = scale[3 + k]
-        for k in range(6):
-            rowscale[n - 6 + k] = scale[k]
         Z = np.zeros((M, y.size))
         Z_f = np.zeros((M, y.size))
         mult = np.ones(M, dtype=np.int64)
@@ -3687,22 +3763,11 @@ def solve_stiff_cases(base, arm, act, loads, options, s_out, out, verdicts, inpu
         done = False
         while not done:
             if path:
-                # the unloaded arm at the node positions (λ = 0: no load, no growth)
                 _chunk_steps(chunks, nc, length, N, np.int64(1), mult, csteps)
-                _set_loads(0.0, case, scratch[4], scratch[5])
-                for k in range(6):
-                    x[k] = 0.0
-                _start(y, T, M - M, base, x)
-                for i in range(M):
-                    if i > 0:
-                        for a in range(y.size):
-                            Z[i, a] = y[a]
-                    _run_chunks(y, T, M - M, first[i], first[i + 1], chunks, csteps, arm, act,
-                                rate, scratch)
-                if not _ms_follow(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch,
-                                  colscale, rowscale, work, w, length, threshold,
-                                  max_iterations, max_load_step, budget, final_step, tip_c,
-                                  counter, reached):
+                if not _ms_path(x, Z, M, levels, kl, N, n_fixed, arm, act, base, case, scratch,
+                                w, threshold, max_iterations, max_load_step, budget,
+                                final_step, tip_c, counter, reached, chunks, first, csteps,
+                                work, colscale, rowscale, mult):
                     if counter[0] > budget:
                         status[b] = BUDGET
                         break
