@@ -3690,13 +3690,15 @@ def _stiff_capability(args):
 def solve_stiff_cases(base, arm, act, loads, options, s_out, out, verdicts, inputs):
     """Solve every load case of a flattened batch by multiple shooting, each from the
     unloaded arm (λ = 0) along its own loading path (the stiff route of
-    :func:`solve_cases`: same arguments where they exist, same outputs but the Jacobians).
+    :func:`solve_cases`: the same arguments where they exist, the same outputs).
 
-    The stages follow solve_cases': the path at N steps, the solution at 2N (chord
-    iterations with the factors at N, else Newton), the Richardson estimate
-    |p_2N - p_N| / 15 against tol, N grown by the order-4 model until it is met, the output
-    pass. The intervals (kL/M <= _GROWTH, k from the case's load size) and their cut by the
-    pieces are fixed per case; N spreads over them as over the arm.
+    The stages follow solve_cases': the path (in levels of intervals, :func:`_ms_path`),
+    the solution at 2N (chord iterations with the factors at N, else Newton), the
+    Richardson estimate |p_2N - p_N| / 15 times _STIFF_SAFETY against tol, the steps grown
+    by the order-4 model until it is met (in the intervals whose local error calls for it,
+    :func:`_ms_local_errors`; with one interval, N itself), the output pass. The intervals
+    (kL/M <= _GROWTH, k from the case's load size) and their cut by the pieces are fixed per
+    case; N spreads over them as over the arm.
 
     ``verdicts``: None, or (index (B,), conservative (B,)): each solved case's stability
     verdict (:func:`stability_cases`' Morse index on the grid of N steps per piece, its
