@@ -3451,7 +3451,7 @@ def _ms_grid(arm, M, width):
 @_jit
 def _ms_path(x, Z, M, levels, kl, N, n_fixed, arm, act, base, case, scratch, w, threshold,
              max_iterations, max_load_step, budget, final_step, tip, counter, reached, chunks,
-             first, csteps, work, colscale, rowscale, mult):
+             first, csteps, work, colscale, rowscale):
     """The loading path from the unloaded arm to λ = 1 on the final grid (M intervals,
     ``csteps`` at N), in levels: k grows like √λ, so the path runs on M / 2^levels
     intervals and proportionally fewer steps while k√λ L <= _GROWTH times their number,
@@ -3769,7 +3769,7 @@ def solve_stiff_cases(base, arm, act, loads, options, s_out, out, verdicts, inpu
                 if not _ms_path(x, Z, M, levels, kl, N, n_fixed, arm, act, base, case, scratch,
                                 w, threshold, max_iterations, max_load_step, budget,
                                 final_step, tip_c, counter, reached, chunks, first, csteps,
-                                work, colscale, rowscale, mult):
+                                work, colscale, rowscale):
                     if counter[0] > budget:
                         status[b] = BUDGET
                         break
