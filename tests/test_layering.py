@@ -106,7 +106,7 @@ LAYERS = (
     # limits both routes check it against
     ("analytic", "statics"),  # two independent routes (see the tests above)
     ("dispatch",),
-    ("stability", "control"),
+    ("stability", "control", "dynamics"),
     ("_sweep_table",),  # the plain data of a [sweep] table
     ("_schema",),
     ("_keypath",),

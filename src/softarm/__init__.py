@@ -10,6 +10,7 @@ from . import analytic, routing, sweep
 from .case import Case, CaseError, load_case
 from .control import ForwardResult, ForwardSolver, InverseResult, InverseSolver, inverse
 from .dispatch import solve
+from .dynamics import Damping, Energy, Simulator, State, Trajectory, simulate
 from .equilibrium import Equilibrium, Stability
 from .errors import (
     ApproximationWarning,
@@ -42,8 +43,10 @@ __all__ = [
     "Circle",
     "ConvergenceError",
     "CriticalPoint",
+    "Damping",
     "DistributedForce",
     "DistributedMoment",
+    "Energy",
     "Equilibrium",
     "ForwardResult",
     "ForwardSolver",
@@ -58,11 +61,14 @@ __all__ = [
     "Rectangle",
     "Rigidities",
     "Section",
+    "Simulator",
     "SegmentedArm",
     "Stability",
+    "State",
     "StabilityWarning",
     "Tendon",
     "TipLoad",
+    "Trajectory",
     "Tube",
     "__version__",
     "analytic",
@@ -72,6 +78,7 @@ __all__ = [
     "load_case",
     "open_sweep",
     "routing",
+    "simulate",
     "solve",
     "sweep",
 ]

@@ -45,6 +45,11 @@ class Arm:
     tip_magnet : array_like, shape (3,), optional
         A dipole (A m²), material components, at the arm's distal end (on a segment of a
         :class:`SegmentedArm`, at that segment's distal end).
+    inertia_per_length : array_like, shape (3,), optional
+        Rotary inertia per length ρ (J_p, Iy, Iz) in kg m (about the material e1, e2, e3;
+        J_p = Iy + Iz is the section's polar moment): for dynamics
+        (:func:`softarm.simulate`). Default: from the section and the density, scaled to
+        ``mass_per_length`` if that is given.
 
     Examples
     --------
@@ -62,6 +67,7 @@ class Arm:
     mass_per_length: float | None = None
     magnetization: tuple[float, float, float] | None = None
     tip_magnet: tuple[float, float, float] | None = None
+    inertia_per_length: tuple[float, float, float] | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "length", length(self.length, "Arm.length"))
@@ -87,7 +93,7 @@ class Arm:
             object.__setattr__(self, "mass_per_length",
                                nonnegative(self.mass_per_length, "Arm.mass_per_length",
                                            "kg/m"))
-        for name in ("magnetization", "tip_magnet"):
+        for name in ("magnetization", "tip_magnet", "inertia_per_length"):
             value = getattr(self, name)
             if value is not None:
                 vector = as_vectors(value, f"Arm.{name}", 3)
@@ -95,10 +101,14 @@ class Arm:
                     raise ValueError(f"Arm.{name} must have shape (3,), got shape "
                                      f"{vector.shape}")
                 object.__setattr__(self, name, tuple(float(c) for c in vector))
+        if self.inertia_per_length is not None and min(self.inertia_per_length) < 0.0:
+            raise ValueError(f"Arm.inertia_per_length must be >= 0 kg m, got "
+                             f"{self.inertia_per_length!r}")
 
     @classmethod
     def from_stiffness_matrix(cls, length, K, curvature=(0.0, 0.0, 0.0), mass_per_length=None,
-                              magnetization=None, tip_magnet=None) -> Arm:
+                              magnetization=None, tip_magnet=None,
+                              inertia_per_length=None) -> Arm:
         """An arm with a full symmetric positive-definite 6 × 6 stiffness K (N, N m, N m²;
         linear part first), coupling extension, shear, twist and bending (a fibre-reinforced
         actuator). ValueError for a K that is not symmetric positive definite.
@@ -110,11 +120,12 @@ class Arm:
         np.float64(20.0)
         """
         return cls(length, StiffnessMatrix(K), None, curvature, mass_per_length,
-                   magnetization, tip_magnet)
+                   magnetization, tip_magnet, inertia_per_length)
 
     @classmethod
     def from_stiffness(cls, length, EA, GAy, GAz, GJ, EIy, EIz, curvature=(0.0, 0.0, 0.0),
-                       mass_per_length=None, magnetization=None, tip_magnet=None) -> Arm:
+                       mass_per_length=None, magnetization=None, tip_magnet=None,
+                       inertia_per_length=None) -> Arm:
         """An arm known only by its stiffnesses (N for EA, GAy, GAz; N m² for GJ, EIy, EIz).
 
         Examples
@@ -124,7 +135,7 @@ class Arm:
         np.float64(1.0)
         """
         return cls(length, Rigidities(EA, GAy, GAz, GJ, EIy, EIz), None, curvature,
-                   mass_per_length, magnetization, tip_magnet)
+                   mass_per_length, magnetization, tip_magnet, inertia_per_length)
 
     @functools.cached_property
     def rigidities(self) -> Rigidities:
@@ -155,6 +166,22 @@ class Arm:
         if self.material is None or self.material.density is None:
             return None
         return self.material.density * self.section.area
+
+    @property
+    def rotary_inertia(self) -> np.ndarray | None:
+        """Rotary inertia per length ρ (J_p, Iy, Iz) in kg m, material axes e1, e2, e3
+        (``inertia_per_length``, else from the section and the density, scaled to
+        ``mass_per_length`` if given), or None if unknown."""
+        if self.inertia_per_length is not None:
+            return np.array(self.inertia_per_length)
+        if isinstance(self.section, (Rigidities, StiffnessMatrix)):
+            return None
+        mu = self.linear_density
+        if mu is None:
+            return None
+        section = self.section.properties(self.material.nu)
+        per_area = mu / section.area  # ρ, or the density that gives mass_per_length
+        return per_area * np.array([section.Iy + section.Iz, section.Iy, section.Iz])
 
     @property
     def radius(self) -> float | None:

@@ -3173,12 +3173,11 @@ def _ms_evaluate(x, Z, M, lam, nt, chunks, first, csteps, base, arm, act, case, 
 
 
 @_jit
-def _band_factor(B, n, piv, Lm):
+def _band_factor(B, n, kl, piv, Lm):
     """Gaussian elimination with partial pivoting of the band matrix B (n rows; row r holds
-    columns r - _BAND .. r + 2 _BAND, the last _BAND for the fill of the row exchanges) in
-    place: U in B, the multipliers in Lm, the exchanges in piv (LAPACK's gbtrf, written out).
-    Returns the sign of the determinant, 0.0 if singular."""
-    kl = _BAND
+    columns r - kl .. r + 2 kl, the last kl for the fill of the row exchanges; the upper
+    width is at most kl) in place: U in B, the multipliers in Lm, the exchanges in piv
+    (LAPACK's gbtrf, written out). Returns the sign of the determinant, 0.0 if singular."""
     sign = 1.0
     for c in range(n):
         last = min(n - 1, c + kl)
@@ -3213,9 +3212,8 @@ def _band_factor(B, n, piv, Lm):
 
 
 @_jit
-def _band_solve(B, n, piv, Lm, b):
+def _band_solve(B, n, kl, piv, Lm, b):
     """b ← A⁻¹ b from :func:`_band_factor`'s factors. False if the result is not finite."""
-    kl = _BAND
     for c in range(n):
         p = piv[c]
         if p != c:
@@ -3316,14 +3314,14 @@ def _ms_corrector(x, Z, M, lam, nt, chunks, first, csteps, base, arm, act, case,
             tip[i] = ends[M - 1, _P + i]
         if not math.isfinite(res):
             return False, 0.0, travelled
-        sign = _band_factor(B, n, piv, Lm)
+        sign = _band_factor(B, n, np.int64(_BAND), piv, Lm)
         if res <= threshold:
             return sign != 0.0, sign, travelled
         if k == max_iterations or sign == 0.0:
             return False, 0.0, travelled
         for i in range(n):
             du[i] = -F[i]
-        if not _band_solve(B, n, piv, Lm, du):
+        if not _band_solve(B, n, np.int64(_BAND), piv, Lm, du):
             return False, 0.0, travelled
         size = _ms_distance(du, n, scratch[1], M, colscale, w, length, motion)
         if k == 0:
@@ -3365,7 +3363,7 @@ def _ms_follow(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, co
     t = np.empty(n)
     for i in range(n):
         t[i] = -G[i]
-    if not _band_solve(B, n, piv, Lm, t):
+    if not _band_solve(B, n, np.int64(_BAND), piv, Lm, t):
         return False
     reached[1] = sign
     x_keep = np.empty(6)
@@ -3393,7 +3391,7 @@ def _ms_follow(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, co
         if ok:
             for i in range(n):
                 du[i] = -G[i]
-            ok = _band_solve(B, n, piv, Lm, du)
+            ok = _band_solve(B, n, np.int64(_BAND), piv, Lm, du)
         if ok:
             _ms_motion(scratch[1], M, du, colscale, 1.0, motion_new)
             ok = dl <= _DLAM_CROSS or (new_sign == sign
@@ -3529,7 +3527,7 @@ def _ms_chord(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, col
             return res <= _STALL * threshold
         for i in range(n):
             du[i] = -F[i]
-        if not _band_solve(B, n, piv, Lm, du):
+        if not _band_solve(B, n, np.int64(_BAND), piv, Lm, du):
             return False
         if not math.isfinite(previous):
             size = 0.0
@@ -3920,7 +3918,7 @@ def _ms_sensitivities(x, Z, M, chunks, first, csteps, base, arm, act, piece, tip
     Gq = np.empty((n, max(n_in, 1)))
     _ms_evaluate(x, Z, M, 1.0, nt, chunks, first, csteps, base, arm, act, case, scratch,
                  colscale, rowscale, F, B, G, ends, lengths, Gq)
-    if _band_factor(B, n, piv, Lm) == 0.0:
+    if _band_factor(B, n, np.int64(_BAND), piv, Lm) == 0.0:
         return False
     U = np.zeros((n, 6 + n_in))
     column = np.empty(n)
@@ -3932,7 +3930,7 @@ def _ms_sensitivities(x, Z, M, chunks, first, csteps, base, arm, act, piece, tip
         else:
             for i in range(n):
                 column[i] = -Gq[i, c - 6]
-        if not _band_solve(B, n, piv, Lm, column):
+        if not _band_solve(B, n, np.int64(_BAND), piv, Lm, column):
             return False
         for i in range(n):
             U[i, c] = column[i]
@@ -3975,3 +3973,560 @@ def _ms_verdict(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, N
     t0 = np.zeros((nt, nt))
     verdicts[0][b] = _sweep(x, 1.0, steps, base, arm, act, one_case, scratch, nt, r, J,
                             np.empty((0, 1)), np.empty((0, 1, 1)), t0, np.empty((0, 1)), states)
+
+
+# ==================================================================== dynamics (begin)
+# One implicit time step of Cosserat rod dynamics is a boundary value problem in s (Till,
+# Aloi & Rucker 2019). Node state (DYN = 24): centreline p (spatial), frame R (row-major),
+# internal force n and moment m (material), velocity q and angular velocity ω (material).
+_DP, _DR, _DN, _DM, _DQ, _DW = 0, 3, 12, 15, 18, 21
+DYN = 24
+# Unknowns and rates per node (DUNK = 18): δp, δθ (material), δn, δm, δq, δω; a node's rate
+# vector holds p', u, n', m', q', ω' in the same order.
+DUNK = 18
+_DKL = 29  # the band's lower width: rows of interval k meet node k's columns 29 back
+# History per node (DHIST = 36): x = (ε (6), q, ω) at t - Δt, at t - 2Δt, and ẋ at t - Δt.
+DHIST = 36
+# Per-piece properties (DPROPS): K (36), B (36), (K + c0 B)⁻¹ (36), f⁰ (6), μ (1), ρJ (3),
+# then the loads: dead and follower force and moment per length (12), point wrench at the
+# piece start, dead and follower (12), from the statics channels.
+_PK, _PB, _PKD, _PF0, _PMU, _PRJ, _PFD, _PFF, _PLD, _PLF, _PJD, _PJF = (
+    0, 36, 72, 108, 114, 115, 118, 121, 124, 127, 130, 136)
+DPROPS = 142
+# BDF-α coefficients (DCOEF): c0, c1, c2, d1, Δt, α.
+DCOEF = 6
+# Statuses
+DYN_OK, DYN_NEWTON, DYN_NOT_FINITE = 0, 1, 2
+
+
+@_jit
+def _mat_t_vec(R, o, x0, x1, x2, out, k):
+    """out[k:k+3] = Rᵀ x with R row-major at R[o:o+9]."""
+    out[k] = R[o] * x0 + R[o + 3] * x1 + R[o + 6] * x2
+    out[k + 1] = R[o + 1] * x0 + R[o + 4] * x1 + R[o + 7] * x2
+    out[k + 2] = R[o + 2] * x0 + R[o + 5] * x1 + R[o + 8] * x2
+
+
+@_jit
+def _rotate_by(z, a0, a1, a2):
+    """R ← R exp(a~) for the node state z (Rodrigues), re-orthonormalised."""
+    th2 = a0 * a0 + a1 * a1 + a2 * a2
+    th = math.sqrt(th2)
+    if th < 1e-4:
+        A = 1.0 - th2 / 6.0
+        Bc = 0.5 - th2 / 24.0
+    else:
+        A = math.sin(th) / th
+        Bc = (1.0 - math.cos(th)) / th2
+    E = np.empty(9)
+    E[0] = 1.0 - Bc * (a1 * a1 + a2 * a2)
+    E[4] = 1.0 - Bc * (a0 * a0 + a2 * a2)
+    E[8] = 1.0 - Bc * (a0 * a0 + a1 * a1)
+    E[1] = -A * a2 + Bc * a0 * a1
+    E[3] = A * a2 + Bc * a0 * a1
+    E[2] = A * a1 + Bc * a0 * a2
+    E[6] = -A * a1 + Bc * a0 * a2
+    E[5] = -A * a0 + Bc * a1 * a2
+    E[7] = A * a0 + Bc * a1 * a2
+    R = np.empty(9)
+    for i in range(3):
+        for j in range(3):
+            R[3 * i + j] = (z[_DR + 3 * i] * E[j] + z[_DR + 3 * i + 1] * E[3 + j]
+                            + z[_DR + 3 * i + 2] * E[6 + j])
+    for i in range(9):
+        z[_DR + i] = R[i]
+
+
+@_jit
+def _log_relative(za, zb, out):
+    """out = log(R_aᵀ R_b) (material components of a), and θ = |out|."""
+    M = np.empty(9)
+    for i in range(3):
+        for j in range(3):
+            M[3 * i + j] = (za[_DR + i] * zb[_DR + j] + za[_DR + 3 + i] * zb[_DR + 3 + j]
+                            + za[_DR + 6 + i] * zb[_DR + 6 + j])
+    c = 0.5 * (M[0] + M[4] + M[8] - 1.0)
+    c = min(1.0, max(-1.0, c))
+    th = math.acos(c)
+    s = math.sin(th)
+    f = 0.5 + th * th / 12.0 if th < 1e-4 else 0.5 * th / s
+    out[0] = f * (M[7] - M[5])
+    out[1] = f * (M[2] - M[6])
+    out[2] = f * (M[3] - M[1])
+    return th
+
+
+@_jit
+def _inverse_jacobian(a0, a1, a2, sign, out):
+    """out (3×3) = J_r⁻¹(sign · a) = I + sign a~/2 + β a~², β = 1/θ² - (1 + cos θ)/(2θ sin θ)."""
+    th2 = a0 * a0 + a1 * a1 + a2 * a2
+    th = math.sqrt(th2)
+    if th < 1e-3:
+        beta = 1.0 / 12.0 + th2 / 720.0
+    else:
+        beta = 1.0 / th2 - (1.0 + math.cos(th)) / (2.0 * th * math.sin(th))
+    h = 0.5 * sign
+    # a~ = [[0, -a2, a1], [a2, 0, -a0], [-a1, a0, 0]]; a~² = a aᵀ - θ² I
+    out[0, 0] = 1.0 + beta * (a0 * a0 - th2)
+    out[1, 1] = 1.0 + beta * (a1 * a1 - th2)
+    out[2, 2] = 1.0 + beta * (a2 * a2 - th2)
+    out[0, 1] = -h * a2 + beta * a0 * a1
+    out[1, 0] = h * a2 + beta * a0 * a1
+    out[0, 2] = h * a1 + beta * a0 * a2
+    out[2, 0] = -h * a1 + beta * a0 * a2
+    out[1, 2] = -h * a0 + beta * a1 * a2
+    out[2, 1] = h * a0 + beta * a1 * a2
+
+
+@_jit
+def _node_rates(z, props, hist_h, jump, coef, out, eps):
+    """The node's rates (p', u, n', m', q', ω') under the piece's properties and loads,
+    with the history terms ``hist_h`` (ε_h, q_h, ω_h) of the step; ``jump`` (6, material)
+    is subtracted from (n, m) first (a point wrench at the piece start). ``eps`` gets the
+    strain f = (v; u)."""
+    c0 = coef[0]
+    sig = np.empty(6)
+    for k in range(3):
+        sig[k] = z[_DN + k] - jump[k]
+        sig[3 + k] = z[_DM + k] - jump[3 + k]
+    rhs = np.empty(6)
+    for i in range(6):
+        acc = sig[i]
+        for j in range(6):
+            acc += props[_PK + 6 * i + j] * props[_PF0 + j] - props[_PB + 6 * i + j] * hist_h[j]
+        rhs[i] = acc
+    for i in range(6):
+        acc = 0.0
+        for j in range(6):
+            acc += props[_PKD + 6 * i + j] * rhs[j]
+        eps[i] = acc
+    v0, v1, v2 = eps[0], eps[1], eps[2]
+    u0, u1, u2 = eps[3], eps[4], eps[5]
+    vt0 = c0 * v0 + hist_h[0]
+    vt1 = c0 * v1 + hist_h[1]
+    vt2 = c0 * v2 + hist_h[2]
+    ut0 = c0 * u0 + hist_h[3]
+    ut1 = c0 * u1 + hist_h[4]
+    ut2 = c0 * u2 + hist_h[5]
+    q0, q1, q2 = z[_DQ], z[_DQ + 1], z[_DQ + 2]
+    w0, w1, w2 = z[_DW], z[_DW + 1], z[_DW + 2]
+    qt0 = c0 * q0 + hist_h[6]
+    qt1 = c0 * q1 + hist_h[7]
+    qt2 = c0 * q2 + hist_h[8]
+    wt0 = c0 * w0 + hist_h[9]
+    wt1 = c0 * w1 + hist_h[10]
+    wt2 = c0 * w2 + hist_h[11]
+    n0, n1, n2 = sig[0], sig[1], sig[2]
+    m0, m1, m2 = sig[3], sig[4], sig[5]
+    # p' = R v
+    for i in range(3):
+        out[i] = z[_DR + 3 * i] * v0 + z[_DR + 3 * i + 1] * v1 + z[_DR + 3 * i + 2] * v2
+    out[3] = u0
+    out[4] = u1
+    out[5] = u2
+    fl = np.empty(6)  # the loads per length, material: Rᵀ f_d + f_f, Rᵀ l_d + l_f
+    _mat_t_vec(z, _DR, props[_PFD], props[_PFD + 1], props[_PFD + 2], fl, 0)
+    _mat_t_vec(z, _DR, props[_PLD], props[_PLD + 1], props[_PLD + 2], fl, 3)
+    for k in range(3):
+        fl[k] += props[_PFF + k]
+        fl[3 + k] += props[_PLF + k]
+    mu = props[_PMU]
+    # n' = -u × n + μ (ω × q + q_t) - f
+    out[6] = -(u1 * n2 - u2 * n1) + mu * (w1 * q2 - w2 * q1 + qt0) - fl[0]
+    out[7] = -(u2 * n0 - u0 * n2) + mu * (w2 * q0 - w0 * q2 + qt1) - fl[1]
+    out[8] = -(u0 * n1 - u1 * n0) + mu * (w0 * q1 - w1 * q0 + qt2) - fl[2]
+    # m' = -u × m - v × n + ρJ ω_t + ω × ρJ ω - l
+    j0, j1, j2 = props[_PRJ], props[_PRJ + 1], props[_PRJ + 2]
+    h0, h1, h2 = j0 * w0, j1 * w1, j2 * w2
+    out[9] = (-(u1 * m2 - u2 * m1) - (v1 * n2 - v2 * n1) + j0 * wt0 + (w1 * h2 - w2 * h1)
+              - fl[3])
+    out[10] = (-(u2 * m0 - u0 * m2) - (v2 * n0 - v0 * n2) + j1 * wt1 + (w2 * h0 - w0 * h2)
+               - fl[4])
+    out[11] = (-(u0 * m1 - u1 * m0) - (v0 * n1 - v1 * n0) + j2 * wt2 + (w0 * h1 - w1 * h0)
+               - fl[5])
+    # q' = v_t - u × q + ω × v
+    out[12] = vt0 - (u1 * q2 - u2 * q1) + (w1 * v2 - w2 * v1)
+    out[13] = vt1 - (u2 * q0 - u0 * q2) + (w2 * v0 - w0 * v2)
+    out[14] = vt2 - (u0 * q1 - u1 * q0) + (w0 * v1 - w1 * v0)
+    # ω' = u_t - u × ω
+    out[15] = ut0 - (u1 * w2 - u2 * w1)
+    out[16] = ut1 - (u2 * w0 - u0 * w2)
+    out[17] = ut2 - (u0 * w1 - u1 * w0)
+
+
+@_jit
+def _dyn_column(k, c):
+    """The unknown's column of node k's component c (node 0: only n, m are unknown)."""
+    if k == 0:
+        return c - 6
+    return 6 + DUNK * (k - 1) + c
+
+
+@_jit
+def _dyn_residual(Z, h, node_piece, props, tip, hh, coef, S, r, rates, eps):
+    """The scaled residual r (18 (G - 1) + 6) of the step's discrete equations: the
+    trapezoidal rule in s on every interval (a joint of zero length: continuity, n and m
+    jumping by the point wrench), then the tip's boundary condition. ``rates`` (G, 18) and
+    ``eps`` (G, 6) get each node's rates and strains. Returns the largest |r|."""
+    G = Z.shape[0]
+    jump0 = np.zeros(6)
+    for k in range(G):
+        _node_rates(Z[k], props[node_piece[k]], hh[k], jump0, coef, rates[k], eps[k])
+    lg = np.empty(3)
+    worst = 0.0
+    for k in range(G - 1):
+        za, zb = Z[k], Z[k + 1]
+        o = DUNK * k
+        hk = h[k]
+        _log_relative(za, zb, lg)
+        for i in range(3):
+            r[o + i] = zb[_DP + i] - za[_DP + i] - 0.5 * hk * (rates[k, i] + rates[k + 1, i])
+            r[o + 3 + i] = lg[i] - 0.5 * hk * (rates[k, 3 + i] + rates[k + 1, 3 + i])
+        for i in range(12):
+            r[o + 6 + i] = (zb[_DN + i] - za[_DN + i]
+                            - 0.5 * hk * (rates[k, 6 + i] + rates[k + 1, 6 + i]))
+        if hk == 0.0:  # a joint: the point wrench at the next piece's start
+            pr = props[node_piece[k + 1]]
+            jw = np.empty(6)
+            _mat_t_vec(za, _DR, pr[_PJD], pr[_PJD + 1], pr[_PJD + 2], jw, 0)
+            _mat_t_vec(za, _DR, pr[_PJD + 3], pr[_PJD + 4], pr[_PJD + 5], jw, 3)
+            for i in range(6):
+                r[o + 6 + i] += jw[i] + pr[_PJF + i]
+        for i in range(DUNK):
+            r[o + i] /= S[i]
+            worst = max(worst, abs(r[o + i]))
+    zt = Z[G - 1]
+    o = DUNK * (G - 1)
+    tw = np.empty(6)
+    _mat_t_vec(zt, _DR, tip[0], tip[1], tip[2], tw, 0)
+    _mat_t_vec(zt, _DR, tip[3], tip[4], tip[5], tw, 3)
+    for i in range(6):
+        r[o + i] = (zt[_DN + i] - tw[i] - tip[6 + i]) / S[6 + i]
+        worst = max(worst, abs(r[o + i]))
+    return worst
+
+
+@_jit
+def _dyn_put(Bm, kl, row, col, value):
+    Bm[row, col - row + kl] += value
+
+
+@_jit
+def _dyn_jacobian(Z, h, node_piece, props, tip, hh, coef, S, rates, eps, Gk, Bm, kl):
+    """The scaled Jacobian of :func:`_dyn_residual` in band storage (rates and eps as the
+    residual left them). Each node's ∂(rates)/∂(unknowns) by forward differences."""
+    G = Z.shape[0]
+    Bm[:, :] = 0.0
+    jump0 = np.zeros(6)
+    zp = np.empty(DYN)
+    g1 = np.empty(DUNK)
+    e1 = np.empty(6)
+    Ja = np.empty((3, 3))
+    Jb = np.empty((3, 3))
+    lg = np.empty(3)
+    for k in range(G):
+        pr = props[node_piece[k]]
+        for c in range(3, DUNK):  # (rates do not depend on p)
+            for i in range(DYN):
+                zp[i] = Z[k, i]
+            d = 1e-7 * S[c]
+            if c < 6:
+                a = np.zeros(3)
+                a[c - 3] = d
+                _rotate_by(zp, a[0], a[1], a[2])
+            else:
+                zp[_DN + c - 6] += d
+            _node_rates(zp, pr, hh[k], jump0, coef, g1, e1)
+            for i in range(DUNK):
+                Gk[k, i, c] = (g1[i] - rates[k, i]) / d
+        for i in range(DUNK):
+            for c in range(3):
+                Gk[k, i, c] = 0.0
+    for k in range(G - 1):
+        za, zb = Z[k], Z[k + 1]
+        row0 = DUNK * k
+        hk = h[k]
+        _log_relative(za, zb, lg)
+        _inverse_jacobian(lg[0], lg[1], lg[2], -1.0, Ja)
+        _inverse_jacobian(lg[0], lg[1], lg[2], 1.0, Jb)
+        for side in range(2):
+            node = k + side
+            sgn = 1.0 if side == 1 else -1.0
+            for c in range(DUNK):
+                if node == 0 and (c < 6 or c >= 12):
+                    continue
+                col = _dyn_column(node, c)
+                for i in range(DUNK):
+                    v = -0.5 * hk * Gk[node, i, c]
+                    if 3 <= i < 6 and 3 <= c < 6:
+                        v += (Jb[i - 3, c - 3] if side == 1 else -Ja[i - 3, c - 3])
+                    elif i == c and not (3 <= i < 6):
+                        v += sgn
+                    if v != 0.0:
+                        _dyn_put(Bm, kl, row0 + i, col, v * S[c] / S[i])
+        if hk == 0.0 and k > 0:  # the point wrench turns with the frame at the joint
+            pr = props[node_piece[k + 1]]
+            jw = np.empty(6)
+            _mat_t_vec(za, _DR, pr[_PJD], pr[_PJD + 1], pr[_PJD + 2], jw, 0)
+            _mat_t_vec(za, _DR, pr[_PJD + 3], pr[_PJD + 4], pr[_PJD + 5], jw, 3)
+            for blk in range(2):
+                w0, w1, w2 = jw[3 * blk], jw[3 * blk + 1], jw[3 * blk + 2]
+                _dyn_skew_put(Bm, kl, row0 + 6 + 3 * blk, _dyn_column(k, 3), w0, w1, w2,
+                              1.0, S[6 + 3 * blk], S[3])
+    zt = Z[G - 1]
+    row0 = DUNK * (G - 1)
+    tw = np.empty(6)
+    _mat_t_vec(zt, _DR, tip[0], tip[1], tip[2], tw, 0)
+    _mat_t_vec(zt, _DR, tip[3], tip[4], tip[5], tw, 3)
+    for i in range(6):
+        _dyn_put(Bm, kl, row0 + i, _dyn_column(G - 1, 6 + i), 1.0 * S[6 + i] / S[6 + i])
+    if G - 1 > 0:
+        for blk in range(2):
+            _dyn_skew_put(Bm, kl, row0 + 3 * blk, _dyn_column(G - 1, 3), tw[3 * blk],
+                          tw[3 * blk + 1], tw[3 * blk + 2], -1.0, S[6 + 3 * blk], S[3])
+
+
+@_jit
+def _dyn_skew_put(Bm, kl, row, col, w0, w1, w2, sign, srow, scol):
+    """Bm[row:row+3, col:col+3] += sign · w~ (scaled)."""
+    f = sign * scol / srow
+    _dyn_put(Bm, kl, row, col + 1, -w2 * f)
+    _dyn_put(Bm, kl, row, col + 2, w1 * f)
+    _dyn_put(Bm, kl, row + 1, col, w2 * f)
+    _dyn_put(Bm, kl, row + 1, col + 2, -w0 * f)
+    _dyn_put(Bm, kl, row + 2, col, -w1 * f)
+    _dyn_put(Bm, kl, row + 2, col + 1, w0 * f)
+
+
+@_jit
+def _dyn_apply(Z, dx, S):
+    """Z -= the scaled correction dx (rotations R ← R exp(-δθ~))."""
+    G = Z.shape[0]
+    for k in range(G):
+        for c in range(DUNK):
+            if k == 0 and (c < 6 or c >= 12):
+                continue
+            if 3 <= c < 6:
+                continue
+            v = dx[_dyn_column(k, c)] * S[c]
+            if c < 3:
+                Z[k, _DP + c] -= v
+            else:
+                Z[k, _DN + c - 6] -= v
+        if k > 0:
+            o = _dyn_column(k, 3)
+            _rotate_by(Z[k], -dx[o] * S[3], -dx[o + 1] * S[3], -dx[o + 2] * S[3])
+
+
+@_jit
+def _dyn_newton(Z, h, node_piece, props, tip, hh, coef, S, tol, max_iter, Bm, Lm, piv,
+                valid, kl, r, rates, eps, Gk, dx):
+    """Chord-Newton on one step's equations from the guess Z (the factors in Bm, Lm, piv
+    are reused while ``valid[0]`` and the iteration contracts; refreshed otherwise).
+    Returns (status, scaled residual, iterations, factorisations)."""
+    n = r.size
+    last = math.inf
+    factored = 0
+    worst = _dyn_residual(Z, h, node_piece, props, tip, hh, coef, S, r, rates, eps)
+    for it in range(max_iter):
+        if not math.isfinite(worst):
+            return DYN_NOT_FINITE, worst, it, factored
+        if valid[0] == 0:
+            _dyn_jacobian(Z, h, node_piece, props, tip, hh, coef, S, rates, eps, Gk, Bm, kl)
+            if _band_factor(Bm, n, kl, piv, Lm) == 0.0:
+                return DYN_NEWTON, worst, it, factored
+            valid[0] = 1
+            factored += 1
+        for i in range(n):
+            dx[i] = r[i]
+        if not _band_solve(Bm, n, kl, piv, Lm, dx):
+            valid[0] = 0
+            continue
+        step = 0.0
+        for i in range(n):
+            step = max(step, abs(dx[i]))
+        _dyn_apply(Z, dx, S)
+        before = worst
+        worst = _dyn_residual(Z, h, node_piece, props, tip, hh, coef, S, r, rates, eps)
+        if step <= tol and worst <= tol:
+            return DYN_OK, worst, it + 1, factored
+        if not (worst < 0.25 * before) or step > last:
+            valid[0] = 0  # slow or growing: a fresh Jacobian at the current iterate
+        last = step
+    return DYN_NEWTON, worst, max_iter, factored
+
+
+@_jit
+def _dyn_history_terms(H, coef, hh):
+    """x_h = c1 x(t-Δt) + c2 x(t-2Δt) + d1 ẋ(t-Δt) for x = (ε, q, ω) at every node."""
+    c1, c2, d1 = coef[1], coef[2], coef[3]
+    for k in range(H.shape[0]):
+        for i in range(12):
+            hh[k, i] = c1 * H[k, i] + c2 * H[k, 12 + i] + d1 * H[k, 24 + i]
+
+
+@_jit
+def _dyn_energies(Z, h, node_piece, props, eps, hh, coef, gravity, out):
+    """out = kinetic, elastic, gravity energy (J) and dissipation power (W) of the state,
+    by the trapezoidal rule on the grid."""
+    c0 = coef[0]
+    kin = 0.0
+    ela = 0.0
+    grav = 0.0
+    power = 0.0
+    G = Z.shape[0]
+    for k in range(G):
+        wl = 0.0
+        if k > 0:
+            wl += 0.5 * h[k - 1]
+        if k < G - 1:
+            wl += 0.5 * h[k]
+        if wl == 0.0:
+            continue
+        pr = props[node_piece[k]]
+        z = Z[k]
+        mu = pr[_PMU]
+        e = kin
+        for i in range(3):
+            e += 0.5 * wl * (mu * z[_DQ + i] ** 2 + pr[_PRJ + i] * z[_DW + i] ** 2)
+            grav -= wl * mu * gravity[i] * z[_DP + i]
+        kin = e
+        et = np.empty(6)
+        for i in range(6):
+            et[i] = c0 * eps[k, i] + hh[k, i]
+        for i in range(6):
+            for j in range(6):
+                de_i = eps[k, i] - pr[_PF0 + i]
+                de_j = eps[k, j] - pr[_PF0 + j]
+                ela += 0.5 * wl * de_i * pr[_PK + 6 * i + j] * de_j
+                power += wl * et[i] * pr[_PB + 6 * i + j] * et[j]
+    out[0] = kin
+    out[1] = ela
+    out[2] = grav
+    out[3] = power
+
+
+@_jit
+def _dyn_predict(Z, Zold):
+    """Z ← the linear extrapolation of (Zold, Z) (rotations R (R_oldᵀ R)); Zold ← Z."""
+    lg = np.empty(3)
+    for k in range(Z.shape[0]):
+        _log_relative(Zold[k], Z[k], lg)
+        for i in range(DYN):
+            if not (_DR <= i < _DR + 9):
+                d = Z[k, i] - Zold[k, i]
+                Zold[k, i] = Z[k, i]
+                Z[k, i] += d
+            else:
+                Zold[k, i] = Z[k, i]
+        _rotate_by(Z[k], lg[0], lg[1], lg[2])
+
+
+@_entry(_fixed("dynamics", "the dynamics (implicit time steps)"), nogil=True)
+def dynamic_steps(Z, Zold, H, aux, props, tip, h, node_piece, coef, S, options, base,
+                  gravity, stations, first, last, Bm, Lm, piv, valid, positions, rotations,
+                  velocities, spins, strains, stresses, energy, info, status):
+    """Advance the cases [first, last) by base.shape[1] implicit time steps each.
+
+    Z, Zold (B, G, DYN): the state now and one step before (for the predictor); H (B, G,
+    DHIST) the BDF-α history; aux (B, 2): the dissipated energy so far (J) and the last
+    dissipation power (W). props (B, P, DPROPS), tip (B, 12): properties and loads. h (G - 1)
+    interval lengths (0: a joint between pieces), node_piece (G,). coef (DCOEF,), S (18,)
+    scales, options = (tol, max_iter). base (B or 1, T, 18): the base's p, R (row-major),
+    q, ω (material) at each new step. gravity (B, 3) (for the energy). stations (S,) the
+    recorded nodes. Bm, Lm, piv, valid: factor storage, per case (B) or one shared (1).
+    Outputs per case and step: positions, rotations (9), velocities, spins (spatial),
+    strains, stresses (material), energy (kinetic, elastic, gravity, dissipated), info
+    (residual, iterations, factorisations, predictor - corrector distance / L). status (B,)
+    is the number of steps done (= T on success); a failed step leaves Z, Zold, H and aux at
+    the last solved step and info's row at the failed step holds (residual, -1, ...).
+    """
+    tol = options[0]
+    max_iter = int(options[1])
+    length_scale = S[0]
+    G = Z.shape[1]
+    T = base.shape[1]
+    kl = np.int64(_DKL)
+    n = DUNK * (G - 1) + 6
+    r = np.empty(n)
+    dx = np.empty(n)
+    rates = np.empty((G, DUNK))
+    eps = np.empty((G, 6))
+    Gk = np.empty((G, DUNK, DUNK))
+    hh = np.empty((G, 12))
+    Zw = np.empty((G, DYN))
+    Zp = np.empty((G, DYN))
+    en = np.empty(4)
+    c0 = coef[0]
+    for b in range(first, last):
+        f = b if Bm.shape[0] > 1 else 0
+        if Bm.shape[0] == 1:
+            valid[0] = 0
+        vb = valid[f:f + 1]
+        bb = b if base.shape[0] > 1 else 0
+        status[b] = 0
+        for t in range(T):
+            _dyn_history_terms(H[b], coef, hh)
+            # guess: the extrapolated state, the base's pose and velocity set
+            for k in range(G):
+                for i in range(DYN):
+                    Zw[k, i] = Z[b, k, i]
+                    Zp[k, i] = Zold[b, k, i]
+            _dyn_predict(Zw, Zp)
+            for i in range(3):
+                Zw[0, _DP + i] = base[bb, t, i]
+                Zw[0, _DQ + i] = base[bb, t, 12 + i]
+                Zw[0, _DW + i] = base[bb, t, 15 + i]
+            for i in range(9):
+                Zw[0, _DR + i] = base[bb, t, 3 + i]
+
+            code, res, its, nf = _dyn_newton(Zw, h, node_piece, props[b], tip[b], hh, coef, S,
+                                             tol, max_iter, Bm[f], Lm[f], piv[f], vb, kl, r,
+                                             rates, eps, Gk, dx)
+            info[b, t, 0] = res
+            info[b, t, 2] = nf
+            if code != DYN_OK:
+                info[b, t, 1] = -1.0
+                vb[0] = 0
+                break
+            moved = 0.0
+            for k in range(G):
+                for i in range(3):
+                    moved = max(moved, abs(Zw[k, _DP + i] - Z[b, k, _DP + i]
+                                           - (Z[b, k, _DP + i] - Zold[b, k, _DP + i])))
+            info[b, t, 1] = its
+            info[b, t, 3] = moved / length_scale
+            # accept: shift the history, x_t = c0 x + x_h
+            for k in range(G):
+                for i in range(DYN):
+                    Zold[b, k, i] = Z[b, k, i]
+                    Z[b, k, i] = Zw[k, i]
+                for i in range(12):
+                    x = eps[k, i] if i < 6 else Zw[k, _DQ + i - 6]
+                    H[b, k, 12 + i] = H[b, k, i]
+                    H[b, k, i] = x
+                    H[b, k, 24 + i] = c0 * x + hh[k, i]
+            _dyn_energies(Zw, h, node_piece, props[b], eps, hh, coef, gravity[b], en)
+            aux[b, 0] += 0.5 * (aux[b, 1] + en[3]) * coef[4]
+            aux[b, 1] = en[3]
+            energy[b, t, 0] = en[0]
+            energy[b, t, 1] = en[1]
+            energy[b, t, 2] = en[2]
+            energy[b, t, 3] = aux[b, 0]
+            for si in range(stations.size):
+                k = stations[si]
+                z = Zw[k]
+                pr = props[b, node_piece[k]]
+                for i in range(3):
+                    positions[b, t, si, i] = z[_DP + i]
+                    velocities[b, t, si, i] = (z[_DR + 3 * i] * z[_DQ] + z[_DR + 3 * i + 1]
+                                               * z[_DQ + 1] + z[_DR + 3 * i + 2] * z[_DQ + 2])
+                    spins[b, t, si, i] = (z[_DR + 3 * i] * z[_DW] + z[_DR + 3 * i + 1]
+                                          * z[_DW + 1] + z[_DR + 3 * i + 2] * z[_DW + 2])
+                for i in range(9):
+                    rotations[b, t, si, i] = z[_DR + i]
+                for i in range(6):
+                    strains[b, t, si, i] = eps[k, i] - pr[_PF0 + i]
+                    stresses[b, t, si, i] = z[_DN + i]
+            status[b] = t + 1
+

@@ -1,0 +1,141 @@
+"""The results of a simulation: the arm's :class:`State` at one time and its
+:class:`Trajectory` over many, with the :class:`Energy` budget."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["Energy", "State", "Trajectory"]
+
+
+def _frozen(array) -> np.ndarray:
+    array = np.array(array, dtype=np.float64)
+    array.setflags(write=False)
+    return array
+
+
+@dataclass(frozen=True, eq=False)
+class Energy:
+    """The energy budget of a trajectory (J), each of shape (B..., T).
+
+    Attributes
+    ----------
+    kinetic : ndarray
+        ∫ ½ (μ |q|² + ω · ρJ ω) ds, translation and rotation of the sections.
+    elastic : ndarray
+        ∫ ½ (ε - ε⁰) · K (ε - ε⁰) ds, the strain energy.
+    gravity : ndarray
+        -∫ μ g · p ds, the potential of gravity (zero without :class:`~softarm.Gravity`).
+    dissipated : ndarray
+        ∫₀ᵗ ∫ ε̇ · B ε̇ ds dt, the work of the damping so far (cumulative; trapezoidal rule
+        in time).
+    """
+
+    kinetic: np.ndarray
+    elastic: np.ndarray
+    gravity: np.ndarray
+    dissipated: np.ndarray
+
+    @property
+    def total(self) -> np.ndarray:
+        """kinetic + elastic + gravity + dissipated: constant for a free arm under gravity
+        (to the time step's error), damped or not."""
+        return self.kinetic + self.elastic + self.gravity + self.dissipated
+
+
+@dataclass(frozen=True, eq=False)
+class State:
+    """The arm at one time: what :meth:`Simulator.step` returns and what a simulation may
+    start from (``initial=state``: the same arm, stations, time step and scheme).
+
+    Attributes (S stations, the batch axes B... of the loads first)
+    ----------
+    time : float
+        t in s.
+    s : ndarray, shape (S,)
+        Stations in m.
+    positions : ndarray, shape (B..., S, 3)
+        Centreline p (m, spatial).
+    rotations : ndarray, shape (B..., S, 3, 3)
+        Material frames R (columns e1, e2, e3 in the spatial frame).
+    velocities, angular_velocities : ndarray, shape (B..., S, 3)
+        ṗ (m/s) and the sections' angular velocity (rad/s), spatial components.
+    strains : ndarray, shape (B..., S, 6)
+        ε - ε⁰ = (γ; κ), material frame.
+    stresses : ndarray, shape (B..., S, 6)
+        The internal wrench (n; m) (N, N m), material frame, elastic plus viscous part.
+    error : ndarray, shape (B...)
+        The distance between the step's predicted (extrapolated) and solved centreline,
+        relative to L: the size of the time step's correction, an indicator of its local
+        error (0 for a state that was not stepped to).
+    iterations : ndarray of int, shape (B...)
+        Newton iterations of the step.
+    """
+
+    time: float
+    s: np.ndarray
+    positions: np.ndarray
+    rotations: np.ndarray
+    velocities: np.ndarray
+    angular_velocities: np.ndarray
+    strains: np.ndarray
+    stresses: np.ndarray
+    error: np.ndarray
+    iterations: np.ndarray
+    _arrays: tuple = ()  # the kernel's state (nodes, previous nodes, history, energy)
+    _signature: tuple = ()  # what the state is valid for (arm, grid, Δt, scheme, batch)
+
+    @property
+    def tip_position(self) -> np.ndarray:
+        """p(L), shape (B..., 3) (m, spatial)."""
+        return self.positions[..., -1, :]
+
+
+@dataclass(frozen=True, eq=False)
+class Trajectory:
+    """An arm's motion: T times from the initial state on (T = steps + 1), S stations.
+
+    Attributes (the batch axes B... of the loads first)
+    ----------
+    times : ndarray, shape (T,)
+        t in s.
+    s : ndarray, shape (S,)
+        Stations in m.
+    positions : ndarray, shape (B..., T, S, 3)
+    rotations : ndarray, shape (B..., T, S, 3, 3)
+    velocities, angular_velocities : ndarray, shape (B..., T, S, 3)
+        Spatial components (m/s, rad/s).
+    strains, stresses : ndarray, shape (B..., T, S, 6)
+        Material frame, as :class:`State`'s.
+    energy : Energy
+        Kinetic, elastic, gravity and dissipated energy, shape (B..., T) each.
+    errors : ndarray, shape (B..., T)
+        Each step's predictor-corrector distance relative to L (:attr:`State.error`).
+    iterations : ndarray of int, shape (B..., T)
+    final : State
+        The last state (to continue from: ``simulate(..., initial=trajectory.final)``).
+    """
+
+    times: np.ndarray
+    s: np.ndarray
+    positions: np.ndarray
+    rotations: np.ndarray
+    velocities: np.ndarray
+    angular_velocities: np.ndarray
+    strains: np.ndarray
+    stresses: np.ndarray
+    energy: Energy
+    errors: np.ndarray
+    iterations: np.ndarray
+    final: State
+
+    @property
+    def tip_position(self) -> np.ndarray:
+        """p(L, t), shape (B..., T, 3) (m, spatial)."""
+        return self.positions[..., -1, :]
+
+    @property
+    def batch_shape(self) -> tuple[int, ...]:
+        return self.positions.shape[:-3]

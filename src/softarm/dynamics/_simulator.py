@@ -1,0 +1,556 @@
+"""Simulation: the time loop around the compiled implicit step (statics/_kernels.py,
+section "dynamics"). The equations, the scheme and its accuracy: docs/dynamics.md."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._threads import in_threads, threads_for
+from .._validate import (
+    as_matrices,
+    count,
+    format_value,
+    positive,
+    real,
+    rigid_transform,
+)
+from ..equilibrium import Equilibrium
+from ..errors import ConvergenceError
+from ..statics import Solver
+from ..statics.solver import _kernels, check_tol
+from ._results import Energy, State, Trajectory
+
+__all__ = ["Damping", "Simulator", "simulate"]
+
+#: Newton iterations of one step before it is declared failed.
+MAX_ITERATIONS = 25
+#: The relative step of the central difference that gives a moving base's velocity, in Δt.
+_BASE_DIFFERENCE = 1e-3
+
+
+@dataclass(frozen=True)
+class Damping:
+    """Kelvin–Voigt damping of the sections: stresses K (ε - ε⁰) + B ε̇.
+
+    Give one of:
+
+    retardation : float
+        τ in s: B = τ K (every mode's damping ratio ζ = τ ω / 2).
+    matrix : array_like, shape (6, 6)
+        B itself, symmetric positive semi-definite (N s, N m² s; linear part first).
+
+    Examples
+    --------
+    >>> Damping(retardation=0.01).matrix_for(np.diag([2.0, 1, 1, 1, 1, 1]))[0, 0]
+    np.float64(0.02)
+    """
+
+    retardation: float | None = None
+    matrix: np.ndarray | None = None
+
+    def __post_init__(self):
+        if (self.retardation is None) == (self.matrix is None):
+            raise ValueError("Damping takes exactly one of retardation= (τ in s) or matrix= "
+                             f"(6 × 6 B), got retardation={self.retardation!r}, "
+                             f"matrix={format_value(self.matrix)}")
+        if self.retardation is not None:
+            tau = real(self.retardation, "Damping.retardation", "s")
+            if not tau >= 0.0:
+                raise ValueError(f"Damping.retardation must be >= 0 s, got {tau!r}")
+            object.__setattr__(self, "retardation", tau)
+        else:
+            B = as_matrices(self.matrix, "Damping.matrix", 6, 6)
+            if B.shape != (6, 6):
+                raise ValueError(f"Damping.matrix must have shape (6, 6), got shape {B.shape}")
+            scale = max(float(np.max(np.abs(B))), 1e-300)
+            if not np.allclose(B, B.T, rtol=0.0, atol=1e-12 * scale):
+                raise ValueError("Damping.matrix must be symmetric, got "
+                                 f"{format_value(B)}")
+            if np.min(np.linalg.eigvalsh(B)) < -1e-12 * scale:
+                raise ValueError("Damping.matrix must be positive semi-definite (a damper "
+                                 f"cannot give energy), got eigenvalues "
+                                 f"{np.linalg.eigvalsh(B).tolist()}")
+            B = B.copy()
+            B.setflags(write=False)
+            object.__setattr__(self, "matrix", B)
+
+    def matrix_for(self, K: np.ndarray) -> np.ndarray:
+        """B for a section of stiffness K."""
+        return self.retardation * K if self.retardation is not None else np.array(self.matrix)
+
+
+def _bdf_alpha(dt: float, alpha: float) -> np.ndarray:
+    """BDF-α (Till, Aloi & Rucker 2019): ẋ(t) ≈ c0 x(t) + c1 x(t-Δt) + c2 x(t-2Δt) +
+    d1 ẋ(t-Δt); α = -1/2 is the trapezoidal rule, α = 0 BDF2."""
+    c0 = (1.5 + alpha) / (dt * (1.0 + alpha))
+    c1 = -2.0 / dt
+    c2 = (0.5 + alpha) / (dt * (1.0 + alpha))
+    d1 = alpha / (1.0 + alpha)
+    return np.array([c0, c1, c2, d1, dt, alpha])
+
+
+def _check_base(base):
+    """(callable t -> (4, 4) pose or None, the fixed pose)."""
+    if base is None:
+        return None, np.eye(4)
+    if callable(base):
+        return base, None
+    return None, rigid_transform(base, "base")
+
+
+def _grid(length: float, starts: np.ndarray, count_: int):
+    """The nodes of the step's equations: the uniform stations (``count_``) and the piece
+    boundaries, a boundary inside the arm twice (a joint: the end of one piece and the
+    start of the next). Returns (s of the nodes, interval lengths (0 at a joint), the piece
+    of each node, the node of each station)."""
+    s_out = np.linspace(0.0, length, count_)
+    ends = np.append(starts[1:], length)
+    nodes, piece = [], []
+    for j, (a, b) in enumerate(zip(starts, ends, strict=True)):
+        inside = s_out[(s_out > a) & (s_out < b)]
+        here = np.concatenate([[a], inside, [b]])
+        nodes.append(here)
+        piece.append(np.full(here.size, j))
+    s = np.concatenate(nodes)
+    node_piece = np.concatenate(piece).astype(np.int64)
+    h = np.diff(s)
+    h[h < 1e-12 * length] = 0.0
+    at = np.array([np.flatnonzero(np.abs(s - x) <= 1e-12 * length)[0] for x in s_out],
+                  dtype=np.int64)
+    return s, h, node_piece, at, s_out
+
+
+class Simulator:
+    """An arm in motion, stepped in time by one implicit step per call: the real-time
+    loop of a controller or an estimator.
+
+    Each step of Δt discretises the rod's equations of motion in time by BDF-α and solves
+    the resulting boundary value problem in s (the trapezoidal rule on the stations, all
+    nodes' states solved together by Newton on a banded system), warm-started from the
+    last step (docs/dynamics.md).
+
+    Parameters
+    ----------
+    arm : Arm or SegmentedArm
+        Its mass (density or ``mass_per_length``) and rotary inertia
+        (``inertia_per_length`` for an arm given by its stiffnesses) are required.
+    actuators : sequence
+        Not yet modelled in dynamics (tendons, chambers, magnets: ValueError).
+    loads : load or sequence of loads
+        Gravity, tip loads, distributed and point loads (dead or follower), constant in
+        time; batch axes give one trajectory per case.
+    dt : float
+        Δt in s.
+    damping : Damping, optional
+        Kelvin–Voigt damping of the sections (default: none).
+    initial : None, Equilibrium or State
+        None: the unloaded arm at rest; an Equilibrium: that shape, at rest (the loads act
+        from t = 0); a State: continue from it.
+    base : None, (4, 4) array or callable
+        The base pose, fixed, or a function of time t -> (4, 4) pose (a moving base; its
+        velocity is taken by central differences).
+    stations : int
+        Uniform stations on [0, L] (≥ 3): the grid of the step's equations (its error is of
+        second order in L/stations) and the outputs.
+    tol : float
+        Newton tolerance of each step, relative (positions in L).
+    alpha : float
+        BDF-α parameter in [-1/2, 0]: -1/2 the trapezoidal rule (no numerical damping),
+        0 BDF2; default -0.2 (Till et al.'s choice: damps the unresolved high frequencies).
+
+    Examples
+    --------
+    >>> from softarm import Arm, Circle, Gravity, Material
+    >>> arm = Arm(0.5, Circle(0.02), Material(1e6, poisson_ratio=0.5, density=1100.0))
+    >>> sim = Simulator(arm, loads=[Gravity()], dt=1e-3, stations=21)
+    >>> state = sim.step()
+    >>> round(float(state.tip_position[2]) * 1e6, 1)  # ≈ -g Δt²/2 (a free fall, at first)
+    -4.9
+    """
+
+    def __init__(self, arm, actuators=(), loads=(), *, dt, damping=None, initial=None,
+                 base=None, stations=101, tol=1e-6, alpha=-0.2):
+        self.dt = positive(dt, "dt", "s")
+        self.alpha = real(alpha, "alpha")
+        if not -0.5 <= self.alpha <= 0.0:
+            raise ValueError(f"alpha must lie in [-0.5, 0] (BDF-α), got {alpha!r}")
+        self.tol = check_tol(tol)
+        stations = count(stations, "stations", 3)
+        if damping is not None and not isinstance(damping, Damping):
+            raise TypeError(f"damping must be a softarm.Damping or None, got "
+                            f"{format_value(damping)}")
+        self.damping = damping
+        actuators = tuple(actuators) if isinstance(actuators, (list, tuple)) else (actuators,)
+        if actuators:
+            raise ValueError("softarm's dynamics does not model actuators yet (tendons, "
+                             "chambers, magnets): got actuators="
+                             f"{format_value(actuators)}")
+        self._solver = Solver(arm, s=2, stability=False)
+        self.arm = self._solver.arm
+        self.loads, shape, _, pieces, channels = self._solver._prepare(loads)
+        self.shape = shape
+        if channels.actuators or np.any(pieces[9]) or np.any(pieces[10]):
+            raise ValueError("softarm's dynamics does not model actuators or magnets yet, got "
+                             f"loads {format_value(self.loads)}")
+        self._motion, self._pose = _check_base(base)
+        self.length = self._solver.length
+        s, h, node_piece, at, s_out = _grid(self.length, pieces[0], stations)
+        self.s = s_out
+        self.s.setflags(write=False)
+        self._nodes, self._h, self._node_piece, self._at = s, h, node_piece, at
+        self._coef = _bdf_alpha(self.dt, self.alpha)
+        self._props = self._properties(pieces, channels)
+        self._tip = np.ascontiguousarray(channels.tip_loads)
+        self._gravity = self._gravity_of(self.loads, shape)
+        data = self._solver._data
+        self._scales = np.array([self.length] * 3 + [1.0] * 3 + [data.force_scale] * 3
+                                + [data.force_scale * self.length] * 3
+                                + [self.length / self.dt] * 3 + [1.0 / self.dt] * 3)
+        self._options = np.array([self.tol, MAX_ITERATIONS], dtype=np.float64)
+        self._signature = (id(self.arm), s.tobytes(), self.dt, self.alpha, shape)
+        self.t0 = 0.0
+        self._initial = self._initial_arrays(initial)
+        self.reset()
+
+    # ------------------------------------------------------------------ set-up
+
+    def _properties(self, pieces, channels) -> np.ndarray:
+        """(B, P, DPROPS): each piece's K, B, (K + c0 B)⁻¹, ε⁰, μ, ρJ and loads."""
+        k = _kernels()
+        P = pieces[0].size
+        segments = self.arm.segments
+        props = np.zeros((channels.count, P, k.DPROPS))
+        c0 = self._coef[0]
+        for j in range(P):
+            segment = segments[int(pieces[12][j])]
+            K = pieces[8][j]
+            mu = segment.linear_density
+            inertia = segment.rotary_inertia
+            if mu is None or inertia is None:
+                raise ValueError(
+                    "dynamics needs the arm's mass and rotary inertia: give the material a "
+                    "density, or mass_per_length and inertia_per_length to an arm built "
+                    f"from its stiffnesses (segment {int(pieces[12][j])} has "
+                    f"mass_per_length={mu!r}, inertia_per_length="
+                    f"{None if inertia is None else inertia.tolist()!r})")
+            B = (self.damping.matrix_for(K) if self.damping is not None
+                 else np.zeros((6, 6)))
+            props[:, j, k._PK:k._PK + 36] = K.ravel()
+            props[:, j, k._PB:k._PB + 36] = B.ravel()
+            props[:, j, k._PKD:k._PKD + 36] = np.linalg.inv(K + c0 * B).ravel()
+            props[:, j, k._PF0:k._PF0 + 6] = pieces[3][j]
+            props[:, j, k._PMU] = mu
+            props[:, j, k._PRJ:k._PRJ + 3] = inertia
+            loads = channels.piece[:, j]
+            props[:, j, k._PFD:k._PFD + 12] = loads[:, k.FD:k.FD + 12]
+            props[:, j, k._PJD:k._PJD + 12] = loads[:, k.JD:k.JD + 12]
+        return props
+
+    @staticmethod
+    def _gravity_of(loads, shape) -> np.ndarray:
+        g = np.zeros((*shape, 3))
+        for load in loads:
+            if type(load).__name__ == "Gravity":
+                g = g + np.asarray(load.acceleration)
+        return np.ascontiguousarray(np.broadcast_to(g, (*shape, 3)).reshape(-1, 3))
+
+    def _base_rows(self, times) -> np.ndarray:
+        """(1, T, 18): the base's p, R (row-major), q and ω (material) at ``times``."""
+        rows = np.zeros((1, len(times), 18))
+        if self._motion is None:
+            rows[0, :, :3] = self._pose[:3, 3]
+            rows[0, :, 3:12] = self._pose[:3, :3].ravel()
+            return rows
+        d = _BASE_DIFFERENCE * self.dt
+        for i, t in enumerate(times):
+            pose = self._base_at(t)
+            before, after = self._base_at(t - d), self._base_at(t + d)
+            R = pose[:3, :3]
+            rows[0, i, :3] = pose[:3, 3]
+            rows[0, i, 3:12] = R.ravel()
+            rows[0, i, 12:15] = R.T @ ((after[:3, 3] - before[:3, 3]) / (2 * d))
+            W = R.T @ ((after[:3, :3] - before[:3, :3]) / (2 * d))
+            rows[0, i, 15:18] = 0.5 * np.array([W[2, 1] - W[1, 2], W[0, 2] - W[2, 0],
+                                                W[1, 0] - W[0, 1]])
+        return rows
+
+    def _base_at(self, t: float) -> np.ndarray:
+        try:
+            pose = self._motion(t)
+        except Exception as error:
+            raise ValueError(f"base({t!r}) raised {type(error).__name__}: {error}") from None
+        return rigid_transform(pose, f"base({t!r})")
+
+    def _initial_arrays(self, initial) -> tuple:
+        """(Z, Zold, H, aux) of the initial state."""
+        k = _kernels()
+        B = int(np.prod(self.shape))
+        if isinstance(initial, State):
+            if initial._signature != self._signature:
+                raise ValueError("initial: this State belongs to another simulation (its arm, "
+                                 "stations, dt, alpha or batch shape differ)")
+            self.t0 = initial.time
+            return tuple(a.copy() for a in initial._arrays)
+        base0 = self._base_rows([self.t0])[0, 0]
+        pose0 = np.eye(4)
+        pose0[:3, 3], pose0[:3, :3] = base0[:3], base0[3:12].reshape(3, 3)
+        unique = np.unique(self._nodes)
+        solver = Solver(self.arm, s=unique, base=pose0, stability=False, tol=1e-10)
+        if initial is None:
+            eq = solver.solve_from_unloaded([])
+            poses = np.broadcast_to(eq.poses, (B, *eq.poses.shape))
+            stresses = np.zeros((B, unique.size, 6))
+        elif isinstance(initial, Equilibrium):
+            if initial.arm != self.arm:
+                raise ValueError("initial: the Equilibrium is of another arm")
+            eq = solver.solve_from_unloaded(initial.loads)
+            poses = np.broadcast_to(eq.poses, (*self.shape, *eq.poses.shape[-3:])).reshape(
+                B, unique.size, 4, 4)
+            stresses = np.broadcast_to(eq.stresses, (*self.shape, unique.size, 6)).reshape(
+                B, unique.size, 6)
+        else:
+            raise TypeError("initial must be None, a softarm.Equilibrium or a "
+                            f"softarm.State, got {format_value(initial)}")
+        index = np.searchsorted(unique, self._nodes)
+        G = self._nodes.size
+        Z = np.zeros((B, G, k.DYN))
+        at_nodes = poses[:, index]
+        Z[:, :, k._DP:k._DP + 3] = at_nodes[..., :3, 3]
+        Z[:, :, k._DR:k._DR + 9] = at_nodes[..., :3, :3].reshape(B, G, 9)
+        Z[:, :, k._DN:k._DN + 6] = stresses[:, index]
+        H = np.zeros((B, G, k.DHIST))
+        for j in range(self._props.shape[1]):
+            mine = self._node_piece == j
+            K = self._props[0, j, k._PK:k._PK + 36].reshape(6, 6)
+            strain = np.linalg.solve(K, Z[:, mine, k._DN:k._DN + 6, None])[..., 0]
+            strain = strain + self._props[0, j, k._PF0:k._PF0 + 6]
+            H[:, mine, 0:6] = strain
+            H[:, mine, 12:18] = strain
+        return Z, Z.copy(), H, np.zeros((B, 2))
+
+    def reset(self) -> None:
+        """Back to the initial state (and its time)."""
+        self._arrays = tuple(a.copy() for a in self._initial)
+        self.time = self.t0
+        self._factors = None
+        self._state = None
+
+    @property
+    def state(self) -> State:
+        """The current state."""
+        if self._state is None:
+            self._state = self._make_state(self._record_now(), np.zeros(self.shape),
+                                           np.zeros(self.shape, dtype=np.int64))
+        return self._state
+
+    # ------------------------------------------------------------------ stepping
+
+    def _storage(self, per_case: bool, B: int):
+        k = _kernels()
+        n = k.DUNK * (self._nodes.size - 1) + 6
+        C = B if per_case else 1
+        return (np.zeros((C, n, 3 * k._DKL + 1)), np.zeros((C, n, k._DKL)),
+                np.zeros((C, n), dtype=np.int64), np.zeros(C, dtype=np.int64))
+
+    def _advance(self, steps: int, factors, threads: int | None = None):
+        """Run ``steps`` steps in the kernel on copies of the state; returns (outputs, new
+        arrays, done per case). The simulator's own state is not touched."""
+        k = _kernels()
+        Z, Zold, H, aux = (a.copy() for a in self._arrays)
+        B, S = Z.shape[0], self._at.size
+        times = self.time + self.dt * np.arange(1, steps + 1)
+        base = self._base_rows(times)
+        out = {name: np.zeros((B, steps, S, width)) for name, width in
+               (("positions", 3), ("rotations", 9), ("velocities", 3), ("spins", 3),
+                ("strains", 6), ("stresses", 6))}
+        energy = np.zeros((B, steps, 4))
+        info = np.zeros((B, steps, 4))
+        done = np.zeros(B, dtype=np.int64)
+        shared = factors is None
+        local = [self._storage(False, 1) for _ in range(max(1, threads or 1))] if shared \
+            else None
+
+        def run(first, last, slot=[0]):  # noqa: B006 (a counter of the threads started)
+            if shared:
+                index = slot[0]
+                slot[0] += 1
+                Bm, Lm, piv, valid = local[index]
+            else:
+                Bm, Lm, piv, valid = factors
+            k.dynamic_steps(Z, Zold, H, aux, self._props, self._tip, self._h, self._node_piece,
+                            self._coef, self._scales, self._options, base, self._gravity,
+                            self._at, first, last, Bm, Lm, piv, valid, out["positions"],
+                            out["rotations"], out["velocities"], out["spins"], out["strains"],
+                            out["stresses"], energy, info, done)
+
+        if shared and threads and threads > 1:
+            in_threads(run, B, threads)
+        else:
+            run(0, B)
+        return times, out, energy, info, done, (Z, Zold, H, aux)
+
+    def step(self, inputs=None) -> State:
+        """One implicit step of Δt from the current state; returns the new state.
+
+        Raises ConvergenceError (with the step's residual) if a case's step cannot be
+        solved: the simulator's state is then unchanged."""
+        if inputs is not None:
+            raise ValueError("inputs: this arm has no actuators (dynamics does not model "
+                             f"actuators yet), got {format_value(inputs)}")
+        if self._factors is None:
+            self._factors = self._storage(True, int(np.prod(self.shape)))
+        times, out, energy, info, done, arrays = self._advance(1, self._factors)
+        self._check(done, info, 1, times)
+        self._arrays = arrays
+        self.time = float(times[-1])
+        self._state = self._make_state(
+            {name: value[:, 0] for name, value in out.items()},
+            info[:, 0, 3].reshape(self.shape), info[:, 0, 1].astype(np.int64).reshape(
+                self.shape))
+        return self._state
+
+    def run(self, steps: int) -> Trajectory:
+        """``steps`` steps from the current state, in one compiled call (the cases of a
+        batch in threads); returns the trajectory, the current state first."""
+        steps = count(steps, "steps", 1)
+        B = int(np.prod(self.shape))
+        first = self.state
+        threads = threads_for(B, 1)
+        times, out, energy, info, done, arrays = self._advance(steps, None, threads)
+        self._check(done, info, steps, times)
+        self._arrays = arrays
+        self.time = float(times[-1])
+        self._factors = None
+        start = self._record_now(initial=first)
+        return self._trajectory(first, times, out, energy, info, start)
+
+    def _check(self, done, info, steps, times) -> None:
+        failed = np.flatnonzero(done < steps)
+        if failed.size:
+            b = int(failed[0])
+            t = int(done[b])
+            raise ConvergenceError(
+                f"the time step to t = {times[t]:.6g} s (step {t + 1}) could not be solved "
+                f"for case {np.unravel_index(b, self.shape) if self.shape else ()}: Newton "
+                f"did not converge to tol {self.tol:g} in {MAX_ITERATIONS} iterations (a "
+                "smaller dt, a looser tol or damping may help; the state is unchanged)",
+                float(info[b, t, 0]), f"{MAX_ITERATIONS} Newton iterations")
+
+    # ------------------------------------------------------------------ results
+
+    def _record_now(self, initial=None) -> dict:
+        """The outputs of the current state (stations), shape (B, S, ...)."""
+        if initial is not None:
+            shape = (-1, self._at.size)
+            return {"positions": initial.positions.reshape(*shape, 3),
+                    "rotations": initial.rotations.reshape(*shape, 9),
+                    "velocities": initial.velocities.reshape(*shape, 3),
+                    "spins": initial.angular_velocities.reshape(*shape, 3),
+                    "strains": initial.strains.reshape(*shape, 6),
+                    "stresses": initial.stresses.reshape(*shape, 6)}
+        k = _kernels()
+        Z, _, H, _ = self._arrays
+        z = Z[:, self._at]
+        R = z[..., k._DR:k._DR + 9].reshape(*z.shape[:2], 3, 3)
+        f0 = self._props[:, self._node_piece[self._at], k._PF0:k._PF0 + 6]
+        return {"positions": z[..., k._DP:k._DP + 3],
+                "rotations": z[..., k._DR:k._DR + 9],
+                "velocities": np.einsum("...ij,...j->...i", R, z[..., k._DQ:k._DQ + 3]),
+                "spins": np.einsum("...ij,...j->...i", R, z[..., k._DW:k._DW + 3]),
+                "strains": H[:, self._at, 0:6] - f0,
+                "stresses": z[..., k._DN:k._DN + 6]}
+
+    def _make_state(self, record, error, iterations) -> State:
+        shape, S = self.shape, self._at.size
+        return State(
+            time=self.time, s=self.s,
+            positions=_frozen(record["positions"].reshape(*shape, S, 3)),
+            rotations=_frozen(record["rotations"].reshape(*shape, S, 3, 3)),
+            velocities=_frozen(record["velocities"].reshape(*shape, S, 3)),
+            angular_velocities=_frozen(record["spins"].reshape(*shape, S, 3)),
+            strains=_frozen(record["strains"].reshape(*shape, S, 6)),
+            stresses=_frozen(record["stresses"].reshape(*shape, S, 6)),
+            error=_frozen(error), iterations=np.asarray(iterations),
+            _arrays=tuple(a.copy() for a in self._arrays), _signature=self._signature)
+
+    def _energy_now(self, first: State) -> np.ndarray:
+        """(B, 4): the energies of ``first`` (the trajectory's first row), from its arrays."""
+        k = _kernels()
+        Z, _, H, aux = first._arrays
+        w = np.zeros(self._nodes.size)
+        w[:-1] += 0.5 * self._h
+        w[1:] += 0.5 * self._h
+        props = self._props[:, self._node_piece]
+        mu = props[..., k._PMU]
+        rj = props[..., k._PRJ:k._PRJ + 3]
+        q, om = Z[..., k._DQ:k._DQ + 3], Z[..., k._DW:k._DW + 3]
+        kinetic = 0.5 * np.sum(w * (mu * np.sum(q**2, -1) + np.sum(rj * om**2, -1)), -1)
+        K = props[..., k._PK:k._PK + 36].reshape(*props.shape[:2], 6, 6)
+        e = H[..., 0:6] - props[..., k._PF0:k._PF0 + 6]
+        elastic = 0.5 * np.sum(w * np.einsum("...i,...ij,...j->...", e, K, e), -1)
+        gravity = -np.sum(w * mu * np.einsum("...i,...ki->...k", self._gravity,
+                                              Z[..., k._DP:k._DP + 3]), -1)
+        return np.stack([kinetic, elastic, gravity, aux[:, 0]], -1)
+
+    def _trajectory(self, first, times, out, energy, info, start) -> Trajectory:
+        shape, S = self.shape, self._at.size
+        T = times.size + 1
+
+        def joined(name, width):
+            both = np.concatenate([start[name].reshape(-1, 1, S, width), out[name]], axis=1)
+            return both.reshape(*shape, T, S, width)
+
+        energies = np.concatenate([self._energy_now(first)[:, None], energy], axis=1)
+        energies = energies.reshape(*shape, T, 4)
+        errors = np.concatenate([np.zeros((info.shape[0], 1)), info[..., 3]], axis=1)
+        iterations = np.concatenate([np.zeros((info.shape[0], 1)), info[..., 1]], axis=1)
+        return Trajectory(
+            times=_frozen(np.concatenate([[first.time], times])), s=self.s,
+            positions=_frozen(joined("positions", 3)),
+            rotations=_frozen(joined("rotations", 9).reshape(*shape, T, S, 3, 3)),
+            velocities=_frozen(joined("velocities", 3)),
+            angular_velocities=_frozen(joined("spins", 3)),
+            strains=_frozen(joined("strains", 6)), stresses=_frozen(joined("stresses", 6)),
+            energy=Energy(*(_frozen(energies[..., i]) for i in range(4))),
+            errors=_frozen(errors.reshape(*shape, T)),
+            iterations=iterations.astype(np.int64).reshape(*shape, T),
+            final=self.state)
+
+
+def _frozen(array) -> np.ndarray:
+    array = np.array(array, dtype=np.float64)
+    array.setflags(write=False)
+    return array
+
+
+def simulate(arm, loads=(), *, duration, dt, actuators=(), inputs=None, damping=None,
+             initial=None, base=None, stations=101, tol=1e-6, alpha=-0.2) -> Trajectory:
+    """The motion of an arm over ``duration`` seconds, in implicit steps of ``dt``.
+
+    The parameters are :class:`Simulator`'s; ``duration`` (s) must be a whole number of
+    steps (to 1e-9). Returns a :class:`Trajectory` of steps + 1 times, the initial state
+    first. Raises ConvergenceError (with the residual) if a step cannot be solved.
+
+    Examples
+    --------
+    >>> from softarm import Arm, Circle, Gravity, Material
+    >>> arm = Arm(0.5, Circle(0.02), Material(1e6, poisson_ratio=0.5, density=1100.0))
+    >>> path = simulate(arm, [Gravity()], duration=0.01, dt=1e-3, stations=21)
+    >>> path.positions.shape, path.times[-1]
+    ((11, 21, 3), np.float64(0.01))
+    """
+    duration = positive(duration, "duration", "s")
+    dt = positive(dt, "dt", "s")
+    steps = round(duration / dt)
+    if steps < 1 or abs(steps * dt - duration) > 1e-9 * duration:
+        raise ValueError(f"duration must be a whole number of time steps dt = {dt!r} s, got "
+                         f"duration={duration!r} s ({duration / dt:.6g} steps)")
+    if inputs is not None:
+        raise ValueError("inputs: this arm has no actuators (dynamics does not model "
+                         f"actuators yet), got {format_value(inputs)}")
+    simulator = Simulator(arm, actuators, loads, dt=dt, damping=damping, initial=initial,
+                          base=base, stations=stations, tol=tol, alpha=alpha)
+    return simulator.run(steps)
+
