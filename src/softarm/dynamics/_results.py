@@ -86,6 +86,7 @@ class State:
     iterations: np.ndarray
     _arrays: tuple = ()  # the kernel's state (nodes, previous nodes, history, energy)
     _signature: tuple = ()  # what the state is valid for (arm, grid, Δt, scheme, batch)
+    _fresh: bool = False  # at rest with no step taken yet (its first step: backward Euler)
 
     @property
     def tip_position(self) -> np.ndarray:
