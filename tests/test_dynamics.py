@@ -23,6 +23,7 @@ from softarm import Arm, Circle, Damping, Gravity, Material, Simulator, TipLoad,
 SOFT = Material(1e6, poisson_ratio=0.5, density=1100.0)
 HEAVY = Arm(0.5, Circle(0.02), SOFT)  # the swinging arm of tests/_mol_rod.py
 SHORT = Arm(0.2, Circle(0.01), Material(1e7, poisson_ratio=0.5, density=1100.0))
+STRAIGHT = softarm.routing.Straight(0.0, 0.01)
 
 
 def _first_period(arm) -> float:
@@ -137,7 +138,9 @@ def test_a_free_fall_starts_at_g_to_second_order_in_dt():
     ({"dt": 1e-3, "alpha": 0.3}, "alpha"),
     ({"dt": 1e-3, "stations": 2}, "stations"),
     ({"dt": 1e-3, "damping": 0.1}, "damping"),
-    ({"dt": 1e-3, "actuators": [softarm.Tendon(tension=1.0, routing=softarm.routing.Straight(0.0, 0.01))]}, "actuators"),
+    ({"dt": 1e-3, "actuators": [TipLoad([0.0, 0.0, 1.0])]}, "actuators"),
+    ({"dt": 1e-3, "actuators": [softarm.Tendon(displacement=-1e-3, routing=STRAIGHT)]},
+     "displacement"),
     ({"dt": 1e-3, "initial": "rest"}, "initial"),
 ])
 def test_bad_simulator_input_is_named(kwargs, match):
@@ -162,3 +165,82 @@ def test_bad_damping_and_durations_are_named():
     with_mass = Arm.from_stiffness(0.5, 1e3, 1e3, 1e3, 1.0, 1.0, 1.0, mass_per_length=0.1,
                                    inertia_per_length=(2e-6, 1e-6, 1e-6))
     assert Simulator(with_mass, dt=1e-3, stations=5).step().time == pytest.approx(1e-3)
+
+
+# --------------------------------------------------------------------------- actuators
+
+ROBOT = Arm(0.3, Circle(0.01), SOFT)
+
+
+def _settled_error(arm, loads, actuators, stations):
+    """Positions of a damped arm after it settled against softarm.solve's equilibrium of
+    the same loads and actuators (relative to L), and the tendons' lengths of both."""
+    path = simulate(arm, loads, actuators=actuators, duration=3.0, dt=4e-3, stations=stations,
+                    damping=Damping(retardation=0.3), tol=1e-10)
+    eq = softarm.solve(arm, [*loads, *actuators], s=stations, tol=1e-10)
+    assert np.abs(path.velocities[-1]).max() < 1e-5
+    error = np.abs(path.positions[-1] - eq.positions).max() / arm.length
+    return error, path, eq
+
+
+@pytest.mark.parametrize("actuator", [
+    softarm.Tendon(tension=0.5, routing=softarm.routing.Straight(0.0, 0.008), end=0.2),
+    softarm.Chamber(pressure=2e4, area=2e-5, routing=softarm.routing.Straight(0.0, -0.005)),
+], ids=["tendon", "chamber"])
+def test_an_actuated_arm_settles_to_the_static_equilibrium(actuator):
+    errors = []
+    for stations in (26, 51):
+        error, path, eq = _settled_error(ROBOT, [Gravity()], [actuator], stations)
+        errors.append(error)
+    assert np.abs(eq.tip_position - [ROBOT.length, 0, 0]).max() > 0.05 * ROBOT.length
+    assert errors[1] < 3e-4  # measured 1.6e-4 L for the tendon (6.3e-4 L at 26 stations)
+    assert 3.5 < errors[0] / errors[1] < 4.5  # second order in the spacing
+    if eq.tendon_lengths is not None:
+        assert path.tendon_lengths[0, 0] == pytest.approx(0.2, rel=1e-12)  # unloaded
+        assert path.tendon_lengths[-1, 0] == pytest.approx(eq.tendon_lengths[0], abs=1e-5)
+
+
+def test_a_magnetic_arm_settles_to_the_static_equilibrium():
+    field = softarm.MagneticField([0.0, 0.0, 0.02])
+    # a magnetisation along the arm turns it up by 85° (2.6e-3 L and 6.6e-4 L measured)
+    magnetic = Arm(0.3, Circle(0.01), SOFT, magnetization=(1e3, 0.0, 0.0))
+    errors = [_settled_error(magnetic, [field], [], stations)[0] for stations in (26, 51)]
+    assert errors[1] < 1e-3
+    assert 3.5 < errors[0] / errors[1] < 4.5
+    # a tip magnet: a tip couple that turns with the tip
+    tipped = Arm(0.3, Circle(0.01), SOFT, tip_magnet=(0.5, 0.0, 0.0))
+    errors = [_settled_error(tipped, [field], [], stations)[0] for stations in (26, 51)]
+    assert errors[1] < 1e-4  # measured 1.7e-5 L at 26 stations
+    assert 3.5 < errors[0] / errors[1] < 4.5
+
+
+def test_a_slowly_pulled_tendon_follows_the_quasi_static_path():
+    tendon = softarm.Tendon(tension=0.0, routing=softarm.routing.Straight(0.0, 0.008))
+    duration, dt = 8.0, 0.01
+
+    def tension(t):
+        return [0.8 * min(t / (0.75 * duration), 1.0)]
+
+    path = simulate(ROBOT, [Gravity()], actuators=[tendon], inputs=tension, duration=duration,
+                    dt=dt, stations=51, damping=Damping(retardation=0.3), tol=1e-10)
+    for t in (2.0, 4.0, 8.0):
+        i = round(t / dt)
+        eq = softarm.solve(ROBOT, [Gravity(), tendon.replace(tension=tension(t)[0])], s=51)
+        # the lag behind the quasi-static path is of the order of τ × the pull rate
+        assert np.abs(path.positions[i] - eq.positions).max() < 2e-3 * ROBOT.length
+
+
+def test_simulator_steps_take_the_inputs_given():
+    tendon = softarm.Tendon(tension=0.2, routing=softarm.routing.Straight(0.0, 0.008))
+    sim = Simulator(ROBOT, [tendon], dt=2e-3, stations=21, damping=Damping(retardation=0.1))
+    schedule = 0.2 + 0.3 * np.sin(np.arange(11) * 0.3)
+    path = simulate(ROBOT, actuators=[tendon], inputs=schedule[:, None], duration=0.02,
+                    dt=2e-3, stations=21, damping=Damping(retardation=0.1))
+    for q in schedule[1:]:
+        state = sim.step([q])
+    np.testing.assert_allclose(state.positions, path.positions[-1], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(state.tendon_lengths, path.tendon_lengths[-1], atol=1e-12)
+    with pytest.raises(ValueError, match="inputs"):
+        sim.step([1.0, 2.0])
+    with pytest.raises(ValueError, match="finite"):
+        sim.step([np.nan])

@@ -72,6 +72,8 @@ class State:
         error (0 for a state that was not stepped to).
     iterations : ndarray of int, shape (B...)
         Newton iterations of the step.
+    tendon_lengths : ndarray, shape (B..., tendons), or None
+        Each tendon's length along its path (m), in the order of the actuators.
     """
 
     time: float
@@ -84,6 +86,7 @@ class State:
     stresses: np.ndarray
     error: np.ndarray
     iterations: np.ndarray
+    tendon_lengths: np.ndarray | None = None
     _arrays: tuple = ()  # the kernel's state (nodes, previous nodes, history, energy)
     _signature: tuple = ()  # what the state is valid for (arm, grid, Δt, scheme, batch)
     _fresh: bool = False  # at rest with no step taken yet (its first step: backward Euler)
@@ -115,6 +118,8 @@ class Trajectory:
     errors : ndarray, shape (B..., T)
         Each step's predictor-corrector distance relative to L (:attr:`State.error`).
     iterations : ndarray of int, shape (B..., T)
+    tendon_lengths : ndarray, shape (B..., T, tendons), or None
+        Each tendon's length (m), in the order of the actuators.
     final : State
         The last state (to continue from: ``simulate(..., initial=trajectory.final)``).
     """
@@ -130,6 +135,7 @@ class Trajectory:
     energy: Energy
     errors: np.ndarray
     iterations: np.ndarray
+    tendon_lengths: np.ndarray | None
     final: State
 
     @property

@@ -18,6 +18,7 @@ from .._validate import (
 )
 from ..equilibrium import Equilibrium
 from ..errors import ConvergenceError
+from ..loads import as_loads
 from ..statics import Solver
 from ..statics.solver import _kernels, check_tol
 from ._results import Energy, State, Trajectory
@@ -89,6 +90,23 @@ def _bdf_alpha(dt: float, alpha: float) -> np.ndarray:
     c2 = (0.5 + alpha) / (dt * (1.0 + alpha))
     d1 = alpha / (1.0 + alpha)
     return np.array([c0, c1, c2, d1, dt, alpha])
+
+
+def _actuator_loads(actuators) -> tuple:
+    """The actuators: single loads with actuation inputs (Tendon under tension control,
+    Chamber, MagneticField)."""
+    actuators = as_loads(actuators)
+    for load in actuators:
+        if not load.inputs:
+            raise TypeError(f"actuators must be loads with actuation inputs (Tendon, "
+                            f"Chamber, MagneticField), got {format_value(load)}")
+        if load.batch_shape != ():
+            raise ValueError(f"actuators must be single (unbatched) loads, got "
+                             f"{type(load).__name__} of batch shape {load.batch_shape}")
+        if getattr(load, "displacement_controlled", False):
+            raise ValueError("actuators: a tendon under displacement control is not modelled "
+                             "in dynamics yet (give its tension)")
+    return actuators
 
 
 def _check_base(base):
@@ -184,18 +202,30 @@ class Simulator:
             raise TypeError(f"damping must be a softarm.Damping or None, got "
                             f"{format_value(damping)}")
         self.damping = damping
-        actuators = tuple(actuators) if isinstance(actuators, (list, tuple)) else (actuators,)
-        if actuators:
-            raise ValueError("softarm's dynamics does not model actuators yet (tendons, "
-                             "chambers, magnets): got actuators="
-                             f"{format_value(actuators)}")
+        self.actuators = _actuator_loads(actuators)
         self._solver = Solver(arm, s=2, stability=False)
         self.arm = self._solver.arm
-        self.loads, shape, _, pieces, channels = self._solver._prepare(loads)
+        everything = [*as_loads(loads), *self.actuators]
+        cuts = ()  # (an initial equilibrium's loads over part of the arm cut it there too)
+        if isinstance(initial, Equilibrium) and initial.arm == self._solver.arm:
+            cuts = tuple(c for load in initial.loads for c in load.cuts(initial.arm))
+        self.loads, shape, _, pieces, channels = self._solver._prepare(everything, cuts)
+        self.loads = self.loads[:len(self.loads) - len(self.actuators)]
         self.shape = shape
-        if channels.actuators or np.any(pieces[9]) or np.any(pieces[10]):
-            raise ValueError("softarm's dynamics does not model actuators or magnets yet, got "
-                             f"loads {format_value(self.loads)}")
+        self._channels = channels
+        self._act = channels.arm_tuple()[1]
+        # time-varying inputs: the loads at zero inputs plus the inputs times their unit
+        # channels (the channels are affine in the inputs, statics/README.md)
+        self.inputs = np.array([v for load in self.actuators for name in load.inputs
+                                for v in np.ravel(np.asarray(getattr(load, name), float))])
+        self._unit = None
+        if self.actuators:
+            width = channels.piece.shape[2]
+            unit, unit_tip = self._solver._input_channels(everything, pieces, width)
+            n = self.inputs.size
+            self._unit = (np.ascontiguousarray(unit[-n:]), np.ascontiguousarray(unit_tip[-n:]))
+            self._loads0 = (channels.piece - np.einsum("i,ipw->pw", self.inputs, unit[-n:]),
+                            channels.tip_loads - self.inputs @ unit_tip[-n:])
         self._motion, self._pose = _check_base(base)
         self.length = self._solver.length
         s, h, node_piece, at, s_out = _grid(self.length, pieces[0], stations)
@@ -206,28 +236,34 @@ class Simulator:
         # history of ẋ would inject the wrong one, an O(Δt) error for good), then BDF-α.
         self._coef = _bdf_alpha(self.dt, self.alpha)
         self._coef_first = np.array([1.0 / self.dt, -1.0 / self.dt, 0.0, 0.0, self.dt, 0.0])
-        self._props = self._properties(pieces, channels, self._coef)
-        self._props_first = self._properties(pieces, channels, self._coef_first)
+        self._props = self._properties(pieces, self._coef)
+        self._props_first = self._properties(pieces, self._coef_first)
+        self._pieces = pieces
+        self._tendon_columns = channels.tendons()[0] if self._act is not None else \
+            np.zeros(0, dtype=np.int64)
+        self._loads = np.ascontiguousarray(channels.piece)
         self._tip = np.ascontiguousarray(channels.tip_loads)
+        self._grid = (self._h, self._node_piece, np.ascontiguousarray(s))
         self._gravity = self._gravity_of(self.loads, shape)
         data = self._solver._data
         self._scales = np.array([self.length] * 3 + [1.0] * 3 + [data.force_scale] * 3
                                 + [data.force_scale * self.length] * 3
                                 + [self.length / self.dt] * 3 + [1.0 / self.dt] * 3)
         self._options = np.array([self.tol, MAX_ITERATIONS], dtype=np.float64)
-        self._signature = (id(self.arm), s.tobytes(), self.dt, self.alpha, shape)
+        self._signature = (id(self.arm), s.tobytes(), self.dt, self.alpha, shape,
+                           channels.signature())
         self.t0 = 0.0
         self._initial = self._initial_arrays(initial)
         self.reset()
 
     # ------------------------------------------------------------------ set-up
 
-    def _properties(self, pieces, channels, coef) -> np.ndarray:
-        """(B, P, DPROPS): each piece's K, B, (K + c0 B)⁻¹, ε⁰, μ, ρJ and loads."""
+    def _properties(self, pieces, coef) -> np.ndarray:
+        """(P, DPROPS): each piece's K, B, (K + c0 B)⁻¹, ε⁰, μ and ρJ."""
         k = _kernels()
         P = pieces[0].size
         segments = self.arm.segments
-        props = np.zeros((channels.count, P, k.DPROPS))
+        props = np.zeros((P, k.DPROPS))
         c0 = coef[0]
         for j in range(P):
             segment = segments[int(pieces[12][j])]
@@ -243,16 +279,29 @@ class Simulator:
                     f"{None if inertia is None else inertia.tolist()!r})")
             B = (self.damping.matrix_for(K) if self.damping is not None
                  else np.zeros((6, 6)))
-            props[:, j, k._PK:k._PK + 36] = K.ravel()
-            props[:, j, k._PB:k._PB + 36] = B.ravel()
-            props[:, j, k._PKD:k._PKD + 36] = np.linalg.inv(K + c0 * B).ravel()
-            props[:, j, k._PF0:k._PF0 + 6] = pieces[3][j]
-            props[:, j, k._PMU] = mu
-            props[:, j, k._PRJ:k._PRJ + 3] = inertia
-            loads = channels.piece[:, j]
-            props[:, j, k._PFD:k._PFD + 12] = loads[:, k.FD:k.FD + 12]
-            props[:, j, k._PJD:k._PJD + 12] = loads[:, k.JD:k.JD + 12]
+            props[j, k._PK:k._PK + 36] = K.ravel()
+            props[j, k._PB:k._PB + 36] = B.ravel()
+            props[j, k._PKD:k._PKD + 36] = np.linalg.inv(K + c0 * B).ravel()
+            props[j, k._PF0:k._PF0 + 6] = pieces[3][j]
+            props[j, k._PMU] = mu
+            props[j, k._PRJ:k._PRJ + 3] = inertia
         return props
+
+    @staticmethod
+    def _actuation(pieces, props, act):
+        """A thread's (law arm, law scratch) for the actuated law, or None (``act`` None):
+        the statics' arm tuple with the damping folded in, K + c0 B and its inverse (from
+        ``props``), and f⁰ as a scratch the kernel fills per node."""
+        if act is None:
+            return None
+        k = _kernels()
+        P = pieces[0].size
+        compliance = np.ascontiguousarray(props[:, k._PKD:k._PKD + 36].reshape(P, 6, 6))
+        stiffness = np.ascontiguousarray(np.linalg.inv(compliance))
+        law_arm = (pieces[0], pieces[1], compliance, np.zeros((P, 6)), pieces[4], False,
+                   pieces[6], pieces[7], stiffness)
+        A = max(1, act[0].shape[0])
+        return law_arm, (np.empty((6, 7)), np.zeros((A, 8)), np.zeros((6, 6)), np.zeros((6, 6)))
 
     @staticmethod
     def _gravity_of(loads, shape) -> np.ndarray:
@@ -290,58 +339,123 @@ class Simulator:
         return rigid_transform(pose, f"base({t!r})")
 
     def _initial_arrays(self, initial) -> tuple:
-        """(Z, Zold, H, aux) of the initial state."""
+        """(Z, Zold, H, aux) of the initial state: a State's own; or at rest: the unloaded
+        arm (ε = ε⁰, no stress), or the equilibrium of an Equilibrium's loads solved again
+        on this grid (:meth:`_settle`)."""
         k = _kernels()
         B = int(np.prod(self.shape))
         if isinstance(initial, State):
             if initial._signature != self._signature:
                 raise ValueError("initial: this State belongs to another simulation (its arm, "
-                                 "stations, dt, alpha or batch shape differ)")
+                                 "stations, dt, alpha, actuators or batch shape differ)")
             self.t0 = initial.time
             self._starts_at_rest = initial._fresh
             return tuple(a.copy() for a in initial._arrays)
+        if initial is not None and not isinstance(initial, Equilibrium):
+            raise TypeError("initial must be None, a softarm.Equilibrium or a "
+                            f"softarm.State, got {format_value(initial)}")
+        if initial is not None and initial.arm != self.arm:
+            raise ValueError("initial: the Equilibrium is of another arm")
         self._starts_at_rest = True
         base0 = self._base_rows([self.t0])[0, 0]
         pose0 = np.eye(4)
         pose0[:3, 3], pose0[:3, :3] = base0[:3], base0[3:12].reshape(3, 3)
         unique = np.unique(self._nodes)
         solver = Solver(self.arm, s=unique, base=pose0, stability=False, tol=1e-10)
-        if initial is None:
-            eq = solver.solve_from_unloaded([])
-            poses = np.broadcast_to(eq.poses, (B, *eq.poses.shape))
-            stresses = np.zeros((B, unique.size, 6))
-        elif isinstance(initial, Equilibrium):
-            if initial.arm != self.arm:
-                raise ValueError("initial: the Equilibrium is of another arm")
-            eq = solver.solve_from_unloaded(initial.loads)
-            poses = np.broadcast_to(eq.poses, (*self.shape, *eq.poses.shape[-3:])).reshape(
-                B, unique.size, 4, 4)
-            stresses = np.broadcast_to(eq.stresses, (*self.shape, unique.size, 6)).reshape(
-                B, unique.size, 6)
-        else:
-            raise TypeError("initial must be None, a softarm.Equilibrium or a "
-                            f"softarm.State, got {format_value(initial)}")
+        eq = solver.solve_from_unloaded([] if initial is None else initial.loads)
+        S = unique.size
+        poses = np.broadcast_to(eq.poses, (*self.shape, S, 4, 4)).reshape(B, S, 4, 4)
+        stresses = np.broadcast_to(eq.stresses, (*self.shape, S, 6)).reshape(B, S, 6)
         index = np.searchsorted(unique, self._nodes)
         G = self._nodes.size
         Z = np.zeros((B, G, k.DYN))
         at_nodes = poses[:, index]
         Z[:, :, k._DP:k._DP + 3] = at_nodes[..., :3, 3]
         Z[:, :, k._DR:k._DR + 9] = at_nodes[..., :3, :3].reshape(B, G, 9)
-        Z[:, :, k._DN:k._DN + 6] = stresses[:, index]
         H = np.zeros((B, G, k.DHIST))
-        for j in range(self._props.shape[1]):
+        for j in range(self._props.shape[0]):
             mine = self._node_piece == j
-            K = self._props[0, j, k._PK:k._PK + 36].reshape(6, 6)
-            strain = np.linalg.solve(K, Z[:, mine, k._DN:k._DN + 6, None])[..., 0]
-            strain = strain + self._props[0, j, k._PF0:k._PF0 + 6]
-            H[:, mine, 0:6] = strain
-            H[:, mine, 12:18] = strain
+            K = self._props[j, k._PK:k._PK + 36].reshape(6, 6)
+            rod = stresses[:, index][:, mine]
+            H[:, mine, 0:6] = self._props[j, k._PF0:k._PF0 + 6] + np.linalg.solve(
+                K, rod[..., None])[..., 0]
+        if initial is not None:
+            Z[:, :, k._DN:k._DN + 6] = stresses[:, index]  # (the rod's: a first guess)
+            self._settle(initial, Z, H, base0)
+        H[..., 12:24] = H[..., 0:12]
+        H[..., 24:36] = 0.0
         return Z, Z.copy(), H, np.zeros((B, 2))
+
+    def _settle(self, initial, Z, H, base0) -> None:
+        """Z, H ← the equilibrium of ``initial``'s loads at rest on this grid: the equations
+        of a step without inertia (c0 = 0: no time derivative), by Newton from the solver's
+        answer. The same discretisation as the steps, so the arm starts at rest to tol
+        (the solver's own answer differs from it by the grid's O(h²) error), and the
+        total wrench of rod and actuators is the state's."""
+        k = _kernels()
+        _, shape, _, pieces, channels = self._solver._prepare(initial.loads,
+                                                                  tuple(self._pieces[0]))
+        if not np.array_equal(pieces[0], self._pieces[0]):
+            raise ValueError("initial: the Equilibrium's loads cut the arm where this "
+                             "simulation does not (loads over part of the arm)")
+        B, P = Z.shape[0], pieces[0].size
+        try:
+            piece = np.broadcast_to(channels.piece.reshape(*shape, P, -1),
+                                    (*self.shape, P, channels.piece.shape[-1]))
+            tip = np.broadcast_to(channels.tip_loads.reshape(*shape, -1),
+                                  (*self.shape, channels.tip_loads.shape[-1]))
+        except ValueError:
+            raise ValueError(f"initial: the Equilibrium's batch shape {shape} does not "
+                             f"broadcast to the loads' {self.shape}") from None
+        act = channels.arm_tuple()[1]
+        coef = np.zeros(6)
+        props = self._properties(pieces, coef)
+        base = base0.reshape(1, 1, 18).copy()
+        base[..., 12:] = 0.0
+        dummy = {name: np.zeros((B, 1, self._at.size, width)) for name, width in
+                 (("p", 3), ("R", 9), ("v", 3), ("w", 3), ("e", 6), ("s", 6))}
+        info, done = np.zeros((B, 1, 4)), np.zeros(B, dtype=np.int64)
+        options = np.array([min(self.tol, 1e-9), 4 * MAX_ITERATIONS])
+        k.dynamic_steps(Z, Z.copy(), H, np.zeros((B, 2)), props,
+                        np.ascontiguousarray(piece.reshape(B, P, -1)),
+                        np.ascontiguousarray(tip.reshape(B, -1)), self._grid, coef,
+                        self._scales, options, base, self._gravity, self._at, 0, B,
+                        self._storage(False, 1), dummy["p"], dummy["R"], dummy["v"],
+                        dummy["w"], dummy["e"], dummy["s"], np.zeros((B, 1, 4)), info, done,
+                        act, self._actuation(pieces, props, act), None, None)
+        if np.any(done < 1):
+            b = int(np.flatnonzero(done < 1)[0])
+            raise ConvergenceError("initial: the Equilibrium's loads could not be balanced "
+                                   "on the simulation's stations (Newton from the solver's "
+                                   "answer)", float(info[b, 0, 0]))
+
+    def _tendon_lengths(self, H) -> np.ndarray | None:
+        """(B, tendons): each tendon's length ∫ |v + u × r + r'| ds (the trapezoidal rule on
+        the nodes, as the steps' lengths) for the strains in H, or None without tendons."""
+        if not self._tendon_columns.size:
+            return None
+        k = _kernels()
+        routes, active = self._act[0], self._act[2]
+        out = np.zeros((H.shape[0], self._tendon_columns.size))
+        eps = H[..., 0:6]
+        for i, a in enumerate(self._tendon_columns):
+            w = np.zeros((H.shape[0], self._nodes.size))
+            for n, (s, j) in enumerate(zip(self._nodes, self._node_piece, strict=True)):
+                if active[j, a] == 0.0:
+                    continue
+                y, z, dy, dz = k._route(routes, np.int64(a), float(s))
+                v, u = eps[:, n, :3], eps[:, n, 3:]
+                w[:, n] = np.sqrt((v[:, 0] + u[:, 1] * z - u[:, 2] * y) ** 2
+                                  + (v[:, 1] - u[:, 0] * z + dy) ** 2
+                                  + (v[:, 2] + u[:, 0] * y + dz) ** 2)
+            out[:, i] = np.sum(0.5 * self._h * (w[:, :-1] + w[:, 1:]), axis=1)
+        return out
 
     def reset(self) -> None:
         """Back to the initial state (and its time)."""
         self._arrays = tuple(a.copy() for a in self._initial)
         self.time = self.t0
+        self._q = self.inputs.copy() if self.actuators else None
         self._fresh = self._starts_at_rest
         self._factors = None
         self._state = None
@@ -363,18 +477,21 @@ class Simulator:
         return (np.zeros((C, n, 3 * k._DKL + 1)), np.zeros((C, n, k._DKL)),
                 np.zeros((C, n), dtype=np.int64), np.zeros(C, dtype=np.int64))
 
-    def _advance(self, steps: int, factors, threads: int | None = None, *, arrays):
-        """Run ``steps`` steps in the kernel on copies of the state; returns (times, outputs,
-        energies, info, steps done per case, new arrays). The simulator's own state is not
-        touched. From a start at rest, the first step is backward Euler (see __init__)."""
+    def _advance(self, steps: int, factors, threads: int | None = None, *, arrays,
+                 inputs=None):
+        """Run ``steps`` steps in the kernel on ``arrays`` (copies of the state, advanced in
+        place); returns (times, outputs, energies, info, steps done per case). From a start
+        at rest, the first step is backward Euler (see __init__). ``inputs`` (steps, n): the
+        actuators' inputs at the new step times, None: constant."""
         times = self.time + self.dt * np.arange(1, steps + 1)
         first = 1 if self._fresh else 0
         parts = []
         for a, b, coef, props in ((0, first, self._coef_first, self._props_first),
                                   (first, steps, self._coef, self._props)):
             if b > a:
+                q = None if inputs is None else inputs[a:b]
                 parts.append(self._kernel_run(arrays, times[a:b], coef, props, factors,
-                                              threads))
+                                              threads, q))
                 if factors is not None:
                     factors[3][:] = 0  # (the Jacobian changes with the scheme)
         if len(parts) == 1:
@@ -384,7 +501,7 @@ class Simulator:
         done = np.where(d1 < 1, d1, 1 + d2)
         return (times, out, np.concatenate([e1, e2], 1), np.concatenate([i1, i2], 1), done)
 
-    def _kernel_run(self, arrays, times, coef, props, factors, threads):
+    def _kernel_run(self, arrays, times, coef, props, factors, threads, q):
         """The kernel over ``times`` (advancing ``arrays`` in place where a case succeeds)."""
         k = _kernels()
         Z, Zold, H, aux = arrays
@@ -396,38 +513,53 @@ class Simulator:
         energy = np.zeros((B, steps, 4))
         info = np.zeros((B, steps, 4))
         done = np.zeros(B, dtype=np.int64)
+        tendons = None
+        if self._act is not None:
+            tendons = np.zeros((B, steps, max(1, self._act[0].shape[0])))
+        loads, tip, schedule = self._loads, self._tip, None
+        if q is not None:
+            loads, tip = self._loads0
+            schedule = (np.ascontiguousarray(q, dtype=np.float64)[None], *self._unit)
         shared = factors is None
-        local = [self._storage(False, 1) for _ in range(max(1, threads or 1))] if shared \
-            else None
-        slots = iter(range(len(local))) if shared else None
+        count_ = max(1, threads or 1)
+        local = [self._storage(False, 1) for _ in range(count_)] if shared else None
+        actuations = [self._actuation(self._pieces, props, self._act) for _ in range(count_)]
+        slots = iter(range(count_))
 
         def run(first, last):
-            Bm, Lm, piv, valid = local[next(slots)] if shared else factors
-            k.dynamic_steps(Z, Zold, H, aux, props, self._tip, self._h, self._node_piece,
-                            coef, self._scales, self._options, base, self._gravity,
-                            self._at, first, last, Bm, Lm, piv, valid, out["positions"],
-                            out["rotations"], out["velocities"], out["spins"], out["strains"],
-                            out["stresses"], energy, info, done)
+            slot = next(slots)
+            mine = local[slot] if shared else factors
+            k.dynamic_steps(Z, Zold, H, aux, props, loads, tip, self._grid, coef, self._scales,
+                            self._options, base, self._gravity, self._at, first, last, mine,
+                            out["positions"], out["rotations"], out["velocities"],
+                            out["spins"], out["strains"], out["stresses"], energy, info, done,
+                            self._act, actuations[slot], schedule, tendons)
 
         if shared and threads and threads > 1:
             in_threads(run, B, threads)
         else:
             run(0, B)
+        if tendons is not None:
+            out["tendons"] = tendons
         return out, energy, info, done
 
     def step(self, inputs=None) -> State:
         """One implicit step of Δt from the current state; returns the new state.
 
-        Raises ConvergenceError (with the step's residual) if a case's step cannot be
-        solved: the simulator's state is then unchanged."""
-        if inputs is not None:
-            raise ValueError("inputs: this arm has no actuators (dynamics does not model "
-                             f"actuators yet), got {format_value(inputs)}")
+        ``inputs`` (n,): the actuators' inputs at the end of the step (tensions in N,
+        pressures in Pa, field components in T, in the order of the actuators' inputs, as
+        :class:`~softarm.ForwardSolver`'s), kept for the next steps; None: as before (at
+        first, the actuators' own values). Raises ConvergenceError (with the step's
+        residual) if a case's step cannot be solved: the simulator's state (and inputs)
+        are then unchanged."""
+        q = self._q if inputs is None else self._checked_inputs(inputs, 1)[0]
         if self._factors is None:
             self._factors = self._storage(True, int(np.prod(self.shape)))
         arrays = tuple(a.copy() for a in self._arrays)
-        times, out, _, info, done = self._advance(1, self._factors, arrays=arrays)
+        times, out, _, info, done = self._advance(
+            1, self._factors, arrays=arrays, inputs=None if q is None else q[None])
         self._check(done, info, 1, times)
+        self._q = q
         self._arrays = arrays
         self._fresh = False
         self.time = float(times[-1])
@@ -437,16 +569,31 @@ class Simulator:
                 self.shape))
         return self._state
 
-    def run(self, steps: int) -> Trajectory:
+    def run(self, steps: int, inputs=None) -> Trajectory:
         """``steps`` steps from the current state, in one compiled call (the cases of a
-        batch in threads); returns the trajectory, the current state first."""
+        batch in threads); returns the trajectory, the current state first.
+
+        ``inputs``: the actuators' inputs over time, a callable t -> (n,) or an array
+        (steps + 1, n) at the trajectory's times (row 0, the current time, is not used);
+        None: constant (as the last step left them)."""
         steps = count(steps, "steps", 1)
         B = int(np.prod(self.shape))
         first = self.state
         threads = threads_for(B, 1)
+        times = self.time + self.dt * np.arange(1, steps + 1)
+        q = None
+        if self.actuators:
+            q = (np.broadcast_to(self._q, (steps, self._q.size)) if inputs is None else
+                 self._schedule(inputs, times))
+        elif inputs is not None:
+            raise ValueError("inputs: these loads have no actuators (give them as "
+                             f"actuators=...), got {format_value(inputs)}")
         arrays = tuple(a.copy() for a in self._arrays)
-        times, out, energy, info, done = self._advance(steps, None, threads, arrays=arrays)
+        times, out, energy, info, done = self._advance(steps, None, threads, arrays=arrays,
+                                                       inputs=q)
         self._check(done, info, steps, times)
+        if q is not None:
+            self._q = np.array(q[-1])
         self._arrays = arrays
         self._fresh = False
         self.time = float(times[-1])
@@ -454,6 +601,36 @@ class Simulator:
         self._state = None  # (the final state is made from the new arrays)
         start = self._record_now(initial=first)
         return self._trajectory(first, times, out, energy, info, start)
+
+    def _checked_inputs(self, values, rows: int) -> np.ndarray:
+        """``values`` as (rows, n) finite floats, else ValueError naming ``inputs``."""
+        n = self.inputs.size
+        if not n:
+            raise ValueError("inputs: these loads have no actuators (give them as "
+                             f"actuators=...), got {format_value(values)}")
+        try:
+            q = np.asarray(values, dtype=np.float64)
+        except (TypeError, ValueError):
+            q = None
+        if q is None or q.shape not in ((rows, n),) + (((n,),) if rows == 1 else ()):
+            raise ValueError(f"inputs must be {'an array (n,)' if rows == 1 else 'a callable'}"
+                             f" {'' if rows == 1 else 'or an array (steps + 1, n)'} of the "
+                             f"actuators' n = {n} inputs, got {format_value(values)}")
+        if not np.all(np.isfinite(q)):
+            raise ValueError(f"inputs must be finite, got {format_value(values)}")
+        return q.reshape(rows, n)
+
+    def _schedule(self, inputs, times) -> np.ndarray:
+        """The inputs (steps, n) at the new step ``times`` from a callable or an array."""
+        if callable(inputs):
+            rows = []
+            for t in times:
+                try:
+                    rows.append(self._checked_inputs(inputs(float(t)), 1)[0])
+                except ValueError as error:
+                    raise ValueError(f"inputs({float(t)!r}): {error}") from None
+            return np.array(rows)
+        return self._checked_inputs(inputs, times.size + 1)[1:]
 
     def _check(self, done, info, steps, times) -> None:
         failed = np.flatnonzero(done < steps)
@@ -483,7 +660,7 @@ class Simulator:
         Z, _, H, _ = self._arrays
         z = Z[:, self._at]
         R = z[..., k._DR:k._DR + 9].reshape(*z.shape[:2], 3, 3)
-        f0 = self._props[:, self._node_piece[self._at], k._PF0:k._PF0 + 6]
+        f0 = self._props[self._node_piece[self._at], k._PF0:k._PF0 + 6]
         return {"positions": z[..., k._DP:k._DP + 3],
                 "rotations": z[..., k._DR:k._DR + 9],
                 "velocities": np.einsum("...ij,...j->...i", R, z[..., k._DQ:k._DQ + 3]),
@@ -493,6 +670,11 @@ class Simulator:
 
     def _make_state(self, record, error, iterations) -> State:
         shape, S = self.shape, self._at.size
+        lengths = record.get("tendons")
+        if lengths is None:
+            lengths = self._tendon_lengths(self._arrays[2])
+        else:
+            lengths = lengths[:, self._tendon_columns]
         return State(
             time=self.time, s=self.s,
             positions=_frozen(record["positions"].reshape(*shape, S, 3)),
@@ -502,6 +684,8 @@ class Simulator:
             strains=_frozen(record["strains"].reshape(*shape, S, 6)),
             stresses=_frozen(record["stresses"].reshape(*shape, S, 6)),
             error=_frozen(error), iterations=np.asarray(iterations),
+            tendon_lengths=None if lengths is None else _frozen(
+                lengths.reshape(*shape, lengths.shape[-1])),
             _arrays=tuple(a.copy() for a in self._arrays), _signature=self._signature,
             _fresh=self._fresh)
 
@@ -512,12 +696,12 @@ class Simulator:
         w = np.zeros(self._nodes.size)
         w[:-1] += 0.5 * self._h
         w[1:] += 0.5 * self._h
-        props = self._props[:, self._node_piece]
+        props = self._props[self._node_piece]
         mu = props[..., k._PMU]
         rj = props[..., k._PRJ:k._PRJ + 3]
         q, om = Z[..., k._DQ:k._DQ + 3], Z[..., k._DW:k._DW + 3]
         kinetic = 0.5 * np.sum(w * (mu * np.sum(q**2, -1) + np.sum(rj * om**2, -1)), -1)
-        K = props[..., k._PK:k._PK + 36].reshape(*props.shape[:2], 6, 6)
+        K = props[..., k._PK:k._PK + 36].reshape(-1, 6, 6)
         e = H[..., 0:6] - props[..., k._PF0:k._PF0 + 6]
         elastic = 0.5 * np.sum(w * np.einsum("...i,...ij,...j->...", e, K, e), -1)
         gravity = -np.sum(w * mu * np.einsum("...i,...ki->...k", self._gravity,
@@ -535,6 +719,12 @@ class Simulator:
         energies = np.concatenate([self._energy_now(first)[:, None], energy], axis=1)
         energies = energies.reshape(*shape, T, 4)
         errors = np.concatenate([np.zeros((info.shape[0], 1)), info[..., 3]], axis=1)
+        lengths = None
+        if first.tendon_lengths is not None:
+            lengths = np.concatenate([first.tendon_lengths.reshape(-1, 1, self._tendon_columns
+                                                                   .size),
+                                      out["tendons"][..., self._tendon_columns]], axis=1)
+            lengths = _frozen(lengths.reshape(*shape, T, -1))
         iterations = np.concatenate([np.zeros((info.shape[0], 1)), info[..., 1]], axis=1)
         return Trajectory(
             times=_frozen(np.concatenate([[first.time], times])), s=self.s,
@@ -546,7 +736,7 @@ class Simulator:
             energy=Energy(*(_frozen(energies[..., i]) for i in range(4))),
             errors=_frozen(errors.reshape(*shape, T)),
             iterations=iterations.astype(np.int64).reshape(*shape, T),
-            final=self.state)
+            tendon_lengths=lengths, final=self.state)
 
 
 def _frozen(array) -> np.ndarray:
@@ -577,10 +767,7 @@ def simulate(arm, loads=(), *, duration, dt, actuators=(), inputs=None, damping=
     if steps < 1 or abs(steps * dt - duration) > 1e-9 * duration:
         raise ValueError(f"duration must be a whole number of time steps dt = {dt!r} s, got "
                          f"duration={duration!r} s ({duration / dt:.6g} steps)")
-    if inputs is not None:
-        raise ValueError("inputs: this arm has no actuators (dynamics does not model "
-                         f"actuators yet), got {format_value(inputs)}")
     simulator = Simulator(arm, actuators, loads, dt=dt, damping=damping, initial=initial,
                           base=base, stations=stations, tol=tol, alpha=alpha)
-    return simulator.run(steps)
+    return simulator.run(steps, inputs)
 

@@ -3987,12 +3987,10 @@ DUNK = 18
 _DKL = 29  # the band's lower width: rows of interval k meet node k's columns 29 back
 # History per node (DHIST = 36): x = (ε (6), q, ω) at t - Δt, at t - 2Δt, and ẋ at t - Δt.
 DHIST = 36
-# Per-piece properties (DPROPS): K (36), B (36), (K + c0 B)⁻¹ (36), f⁰ (6), μ (1), ρJ (3),
-# then the loads: dead and follower force and moment per length (12), point wrench at the
-# piece start, dead and follower (12), from the statics channels.
-_PK, _PB, _PKD, _PF0, _PMU, _PRJ, _PFD, _PFF, _PLD, _PLF, _PJD, _PJF = (
-    0, 36, 72, 108, 114, 115, 118, 121, 124, 127, 130, 136)
-DPROPS = 142
+# Per-piece properties (DPROPS): K (36), B (36), (K + c0 B)⁻¹ (36), f⁰ (6), μ (1), ρJ (3).
+# The loads are the statics' channels (PIECE_LOADS + actuators per piece, TIP_LOADS).
+_PK, _PB, _PKD, _PF0, _PMU, _PRJ = 0, 36, 72, 108, 114, 115
+DPROPS = 118
 # BDF-α coefficients (DCOEF): c0, c1, c2, d1, Δt, α.
 DCOEF = 6
 # Statuses
@@ -4079,27 +4077,52 @@ def _inverse_jacobian(a0, a1, a2, sign, out):
 
 
 @_jit
-def _node_rates(z, props, hist_h, jump, coef, out, eps):
-    """The node's rates (p', u, n', m', q', ω') under the piece's properties and loads,
-    with the history terms ``hist_h`` (ε_h, q_h, ω_h) of the step; ``jump`` (6, material)
-    is subtracted from (n, m) first (a point wrench at the piece start). ``eps`` gets the
-    strain f = (v; u)."""
+def _node_rates(z, s, j, props, now, hist_h, coef, out, eps, act, actuation, lengths):
+    """The node's rates (p', u, n', m', q', ω') on piece j (arc length s) with the step's
+    history terms ``hist_h`` (ε_h, q_h, ω_h) and loads ``now`` (the statics' channels per
+    piece); ``eps`` gets the strain f = (v; u). With actuators (``act``; ``actuation`` =
+    the constitutive law's arm and scratch), (n, m) is the total wrench of rod, tendons and
+    fluid and the strain solves the actuated law with the damping folded into its
+    stiffness (:func:`_law`: K(ε - f⁰) + B ε̇ = (K + c0 B) ε - K f⁰ + B ε_h); ``lengths``
+    gets each tendon's |w| = dℓ/ds."""
     c0 = coef[0]
+    pr = props[j]
     sig = np.empty(6)
-    for k in range(3):
-        sig[k] = z[_DN + k] - jump[k]
-        sig[3 + k] = z[_DM + k] - jump[3 + k]
-    rhs = np.empty(6)
-    for i in range(6):
-        acc = sig[i]
-        for j in range(6):
-            acc += props[_PK + 6 * i + j] * props[_PF0 + j] - props[_PB + 6 * i + j] * hist_h[j]
-        rhs[i] = acc
-    for i in range(6):
-        acc = 0.0
-        for j in range(6):
-            acc += props[_PKD + 6 * i + j] * rhs[j]
-        eps[i] = acc
+    for k in range(6):
+        sig[k] = z[_DN + k]
+    actuated = act is not None and _actuated(act, j)
+    if act is not None and actuated:
+        law_arm, law = actuation[0], actuation[1]
+        K, f0s = pr[_PK:_PK + 36], law_arm[3]
+        Kd = law_arm[2]
+        for i in range(6):  # f⁰' = (K + c0 B)⁻¹ (K f⁰ - B ε_h)
+            acc = 0.0
+            for k in range(6):
+                acc += K[6 * i + k] * pr[_PF0 + k] - pr[_PB + 6 * i + k] * hist_h[k]
+            eps[i] = acc
+        for i in range(6):
+            acc = 0.0
+            for k in range(6):
+                acc += Kd[j, i, k] * eps[k]
+            f0s[j, i] = acc
+        e0, e1, e2, e3, e4, e5, _ = _law(law_arm, act, j, s, now, law, np.int64(0), sig[0],
+                                         sig[1], sig[2], sig[3], sig[4], sig[5])
+        eps[0], eps[1], eps[2], eps[3], eps[4], eps[5] = e0, e1, e2, e3, e4, e5
+        for a in range(lengths.size):
+            lengths[a] = law[1][a, 3] if act[2][j, a] != 0.0 and act[1][a] == TENDON else 0.0
+    else:
+        rhs = np.empty(6)
+        for i in range(6):
+            acc = sig[i]
+            for k in range(6):
+                acc += (pr[_PK + 6 * i + k] * pr[_PF0 + k]
+                        - pr[_PB + 6 * i + k] * hist_h[k])
+            rhs[i] = acc
+        for i in range(6):
+            acc = 0.0
+            for k in range(6):
+                acc += pr[_PKD + 6 * i + k] * rhs[k]
+            eps[i] = acc
     v0, v1, v2 = eps[0], eps[1], eps[2]
     u0, u1, u2 = eps[3], eps[4], eps[5]
     vt0 = c0 * v0 + hist_h[0]
@@ -4124,19 +4147,32 @@ def _node_rates(z, props, hist_h, jump, coef, out, eps):
     out[3] = u0
     out[4] = u1
     out[5] = u2
-    fl = np.empty(6)  # the loads per length, material: Rᵀ f_d + f_f, Rᵀ l_d + l_f
-    _mat_t_vec(z, _DR, props[_PFD], props[_PFD + 1], props[_PFD + 2], fl, 0)
-    _mat_t_vec(z, _DR, props[_PLD], props[_PLD + 1], props[_PLD + 2], fl, 3)
+    # the loads per length, material: Rᵀ f_d + f_f, Rᵀ l_d + l_f (+ a magnetisation's)
+    fd = np.empty(6)
     for k in range(3):
-        fl[k] += props[_PFF + k]
-        fl[3 + k] += props[_PLF + k]
-    mu = props[_PMU]
+        fd[k] = now[j, _FD + k]
+        fd[3 + k] = now[j, _LD + k]
+    ma0 = ma1 = ma2 = 0.0
+    if act is not None:
+        ma0, ma1, ma2 = act[3][j, 0], act[3][j, 1], act[3][j, 2]
+    if act is not None and (ma0 != 0.0 or ma1 != 0.0 or ma2 != 0.0):
+        law = actuation[1]
+        _dipole(z, law[2], np.int64(0), ma0, ma1, ma2, now[j], now[j], law[2][3])
+        for k in range(6):
+            fd[k] += law[2][3, k]
+    fl = np.empty(6)
+    _mat_t_vec(z, _DR, fd[0], fd[1], fd[2], fl, 0)
+    _mat_t_vec(z, _DR, fd[3], fd[4], fd[5], fl, 3)
+    for k in range(3):
+        fl[k] += now[j, _FF + k]
+        fl[3 + k] += now[j, _LF + k]
+    mu = pr[_PMU]
     # n' = -u × n + μ (ω × q + q_t) - f
     out[6] = -(u1 * n2 - u2 * n1) + mu * (w1 * q2 - w2 * q1 + qt0) - fl[0]
     out[7] = -(u2 * n0 - u0 * n2) + mu * (w2 * q0 - w0 * q2 + qt1) - fl[1]
     out[8] = -(u0 * n1 - u1 * n0) + mu * (w0 * q1 - w1 * q0 + qt2) - fl[2]
     # m' = -u × m - v × n + ρJ ω_t + ω × ρJ ω - l
-    j0, j1, j2 = props[_PRJ], props[_PRJ + 1], props[_PRJ + 2]
+    j0, j1, j2 = pr[_PRJ], pr[_PRJ + 1], pr[_PRJ + 2]
     h0, h1, h2 = j0 * w0, j1 * w1, j2 * w2
     out[9] = (-(u1 * m2 - u2 * m1) - (v1 * n2 - v2 * n1) + j0 * wt0 + (w1 * h2 - w2 * h1)
               - fl[3])
@@ -4155,6 +4191,29 @@ def _node_rates(z, props, hist_h, jump, coef, out, eps):
 
 
 @_jit
+def _point_wrench(z, now, tip_now, j, act, actuation, out):
+    """out = the point wrench (material) on the node z at the start of piece j, or with
+    j = -1 at the tip: the dead (spatial) and follower channels, and a segment's dipole
+    there (at its distal end), in the field of the piece channels ``now``."""
+    d = np.empty(6)
+    for k in range(6):
+        d[k] = tip_now[_TD + k] if j < 0 else now[j, _JD + k]
+    if act is not None:
+        row = act[4].shape[0] - 1 if j < 0 else j
+        m0, m1, m2 = act[4][row, 0], act[4][row, 1], act[4][row, 2]
+        if m0 != 0.0 or m1 != 0.0 or m2 != 0.0:
+            law = actuation[1]
+            field = now[now.shape[0] - 1] if j < 0 else now[j]
+            _dipole(z, law[2], np.int64(0), m0, m1, m2, field, field, law[2][3])
+            for k in range(6):
+                d[k] += law[2][3, k]
+    _mat_t_vec(z, _DR, d[0], d[1], d[2], out, 0)
+    _mat_t_vec(z, _DR, d[3], d[4], d[5], out, 3)
+    for k in range(6):
+        out[k] += tip_now[_TF + k] if j < 0 else now[j, _JF + k]
+
+
+@_jit
 def _dyn_column(k, c):
     """The unknown's column of node k's component c (node 0: only n, m are unknown)."""
     if k == 0:
@@ -4163,16 +4222,21 @@ def _dyn_column(k, c):
 
 
 @_jit
-def _dyn_residual(Z, h, node_piece, props, tip, hh, coef, S, r, rates, eps):
+def _dyn_residual(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, r, rates, eps,
+                  lengths):
     """The scaled residual r (18 (G - 1) + 6) of the step's discrete equations: the
     trapezoidal rule in s on every interval (a joint of zero length: continuity, n and m
-    jumping by the point wrench), then the tip's boundary condition. ``rates`` (G, 18) and
-    ``eps`` (G, 6) get each node's rates and strains. Returns the largest |r|."""
+    jumping by the point wrench at the next piece's start), then the tip's boundary
+    condition. ``grid`` = (interval lengths, piece of each node, s of each node).
+    ``rates`` (G, 18), ``eps`` (G, 6) and ``lengths`` (G, tendons) get each node's rates,
+    strains and dℓ/ds. Returns the largest |r|."""
+    h, node_piece, node_s = grid
     G = Z.shape[0]
-    jump0 = np.zeros(6)
     for k in range(G):
-        _node_rates(Z[k], props[node_piece[k]], hh[k], jump0, coef, rates[k], eps[k])
+        _node_rates(Z[k], node_s[k], node_piece[k], props, now, hh[k], coef, rates[k], eps[k],
+                    act, actuation, lengths[k])
     lg = np.empty(3)
+    jw = np.empty(6)
     worst = 0.0
     for k in range(G - 1):
         za, zb = Z[k], Z[k + 1]
@@ -4185,23 +4249,18 @@ def _dyn_residual(Z, h, node_piece, props, tip, hh, coef, S, r, rates, eps):
         for i in range(12):
             r[o + 6 + i] = (zb[_DN + i] - za[_DN + i]
                             - 0.5 * hk * (rates[k, 6 + i] + rates[k + 1, 6 + i]))
-        if hk == 0.0:  # a joint: the point wrench at the next piece's start
-            pr = props[node_piece[k + 1]]
-            jw = np.empty(6)
-            _mat_t_vec(za, _DR, pr[_PJD], pr[_PJD + 1], pr[_PJD + 2], jw, 0)
-            _mat_t_vec(za, _DR, pr[_PJD + 3], pr[_PJD + 4], pr[_PJD + 5], jw, 3)
+        if hk == 0.0:  # a joint: n and m jump by the point wrench at the next piece's start
+            _point_wrench(za, now, tip_now, node_piece[k + 1], act, actuation, jw)
             for i in range(6):
-                r[o + 6 + i] += jw[i] + pr[_PJF + i]
+                r[o + 6 + i] += jw[i]
         for i in range(DUNK):
             r[o + i] /= S[i]
             worst = max(worst, abs(r[o + i]))
     zt = Z[G - 1]
     o = DUNK * (G - 1)
-    tw = np.empty(6)
-    _mat_t_vec(zt, _DR, tip[0], tip[1], tip[2], tw, 0)
-    _mat_t_vec(zt, _DR, tip[3], tip[4], tip[5], tw, 3)
+    _point_wrench(zt, now, tip_now, np.int64(-1), act, actuation, jw)
     for i in range(6):
-        r[o + i] = (zt[_DN + i] - tw[i] - tip[6 + i]) / S[6 + i]
+        r[o + i] = (zt[_DN + i] - jw[i]) / S[6 + i]
         worst = max(worst, abs(r[o + i]))
     return worst
 
@@ -4212,36 +4271,42 @@ def _dyn_put(Bm, kl, row, col, value):
 
 
 @_jit
-def _dyn_jacobian(Z, h, node_piece, props, tip, hh, coef, S, rates, eps, Gk, Bm, kl):
-    """The scaled Jacobian of :func:`_dyn_residual` in band storage (rates and eps as the
-    residual left them). Each node's ∂(rates)/∂(unknowns) by forward differences."""
+def _dyn_jacobian(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, rates, Gk, Bm,
+                  kl):
+    """The scaled Jacobian of :func:`_dyn_residual` in band storage (``rates`` as the
+    residual left them). Each node's ∂(rates)/∂(unknowns) by forward differences; the
+    rotation of the point wrenches at the joints and the tip is exact for the dead channels
+    (a dipole's own turning is left out: the iteration is a chord iteration anyway)."""
+    h, node_piece, node_s = grid
     G = Z.shape[0]
     Bm[:, :] = 0.0
-    jump0 = np.zeros(6)
     zp = np.empty(DYN)
     g1 = np.empty(DUNK)
     e1 = np.empty(6)
+    l1 = np.empty(max(1, 0 if act is None else act[0].shape[0]))
     Ja = np.empty((3, 3))
     Jb = np.empty((3, 3))
     lg = np.empty(3)
     for k in range(G):
-        pr = props[node_piece[k]]
         for c in range(3, DUNK):  # (rates do not depend on p)
             for i in range(DYN):
                 zp[i] = Z[k, i]
             d = 1e-7 * S[c]
             if c < 6:
-                a = np.zeros(3)
-                a[c - 3] = d
-                _rotate_by(zp, a[0], a[1], a[2])
+                a0 = d if c == 3 else 0.0
+                a1 = d if c == 4 else 0.0
+                a2 = d if c == 5 else 0.0
+                _rotate_by(zp, a0, a1, a2)
             else:
                 zp[_DN + c - 6] += d
-            _node_rates(zp, pr, hh[k], jump0, coef, g1, e1)
+            _node_rates(zp, node_s[k], node_piece[k], props, now, hh[k], coef, g1, e1, act,
+                        actuation, l1)
             for i in range(DUNK):
                 Gk[k, i, c] = (g1[i] - rates[k, i]) / d
         for i in range(DUNK):
             for c in range(3):
                 Gk[k, i, c] = 0.0
+    jw = np.empty(6)
     for k in range(G - 1):
         za, zb = Z[k], Z[k + 1]
         row0 = DUNK * k
@@ -4265,25 +4330,27 @@ def _dyn_jacobian(Z, h, node_piece, props, tip, hh, coef, S, rates, eps, Gk, Bm,
                     if v != 0.0:
                         _dyn_put(Bm, kl, row0 + i, col, v * S[c] / S[i])
         if hk == 0.0 and k > 0:  # the point wrench turns with the frame at the joint
-            pr = props[node_piece[k + 1]]
-            jw = np.empty(6)
-            _mat_t_vec(za, _DR, pr[_PJD], pr[_PJD + 1], pr[_PJD + 2], jw, 0)
-            _mat_t_vec(za, _DR, pr[_PJD + 3], pr[_PJD + 4], pr[_PJD + 5], jw, 3)
-            for blk in range(2):
-                w0, w1, w2 = jw[3 * blk], jw[3 * blk + 1], jw[3 * blk + 2]
-                _dyn_skew_put(Bm, kl, row0 + 6 + 3 * blk, _dyn_column(k, 3), w0, w1, w2,
+            _point_wrench(za, now, tip_now, node_piece[k + 1], act, actuation, jw)
+            for blk in range(2):  # (only the dead part turns: Rᵀ F_d)
+                j1 = node_piece[k + 1]
+                f0 = now[j1, _JF + 3 * blk]
+                f1 = now[j1, _JF + 3 * blk + 1]
+                f2 = now[j1, _JF + 3 * blk + 2]
+                _dyn_skew_put(Bm, kl, row0 + 6 + 3 * blk, _dyn_column(k, 3),
+                              jw[3 * blk] - f0, jw[3 * blk + 1] - f1, jw[3 * blk + 2] - f2,
                               1.0, S[6 + 3 * blk], S[3])
     zt = Z[G - 1]
     row0 = DUNK * (G - 1)
-    tw = np.empty(6)
-    _mat_t_vec(zt, _DR, tip[0], tip[1], tip[2], tw, 0)
-    _mat_t_vec(zt, _DR, tip[3], tip[4], tip[5], tw, 3)
+    _point_wrench(zt, now, tip_now, np.int64(-1), act, actuation, jw)
     for i in range(6):
-        _dyn_put(Bm, kl, row0 + i, _dyn_column(G - 1, 6 + i), 1.0 * S[6 + i] / S[6 + i])
+        _dyn_put(Bm, kl, row0 + i, _dyn_column(G - 1, 6 + i), 1.0)
     if G - 1 > 0:
         for blk in range(2):
-            _dyn_skew_put(Bm, kl, row0 + 3 * blk, _dyn_column(G - 1, 3), tw[3 * blk],
-                          tw[3 * blk + 1], tw[3 * blk + 2], -1.0, S[6 + 3 * blk], S[3])
+            _dyn_skew_put(Bm, kl, row0 + 3 * blk, _dyn_column(G - 1, 3),
+                          jw[3 * blk] - tip_now[_TF + 3 * blk],
+                          jw[3 * blk + 1] - tip_now[_TF + 3 * blk + 1],
+                          jw[3 * blk + 2] - tip_now[_TF + 3 * blk + 2],
+                          -1.0, S[6 + 3 * blk], S[3])
 
 
 @_jit
@@ -4319,20 +4386,24 @@ def _dyn_apply(Z, dx, S):
 
 
 @_jit
-def _dyn_newton(Z, h, node_piece, props, tip, hh, coef, S, tol, max_iter, Bm, Lm, piv,
-                valid, kl, r, rates, eps, Gk, dx):
-    """Chord-Newton on one step's equations from the guess Z (the factors in Bm, Lm, piv
-    are reused while ``valid[0]`` and the iteration contracts; refreshed otherwise).
-    Returns (status, scaled residual, iterations, factorisations)."""
+def _dyn_newton(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, tol, max_iter,
+                factors, kl, work):
+    """Chord-Newton on one step's equations from the guess Z (the factors (Bm, Lm, piv,
+    valid) are reused while ``valid[0]`` and the iteration contracts, refreshed
+    otherwise). Returns (status, scaled residual, iterations, factorisations)."""
+    Bm, Lm, piv, valid = factors
+    r, dx, rates, eps, lengths, Gk = work
     n = r.size
     last = math.inf
     factored = 0
-    worst = _dyn_residual(Z, h, node_piece, props, tip, hh, coef, S, r, rates, eps)
+    worst = _dyn_residual(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, r, rates,
+                          eps, lengths)
     for it in range(max_iter):
         if not math.isfinite(worst):
             return DYN_NOT_FINITE, worst, it, factored
         if valid[0] == 0:
-            _dyn_jacobian(Z, h, node_piece, props, tip, hh, coef, S, rates, eps, Gk, Bm, kl)
+            _dyn_jacobian(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, rates, Gk,
+                          Bm, kl)
             if _band_factor(Bm, n, kl, piv, Lm) == 0.0:
                 return DYN_NEWTON, worst, it, factored
             valid[0] = 1
@@ -4347,7 +4418,8 @@ def _dyn_newton(Z, h, node_piece, props, tip, hh, coef, S, tol, max_iter, Bm, Lm
             step = max(step, abs(dx[i]))
         _dyn_apply(Z, dx, S)
         before = worst
-        worst = _dyn_residual(Z, h, node_piece, props, tip, hh, coef, S, r, rates, eps)
+        worst = _dyn_residual(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, r,
+                              rates, eps, lengths)
         if step <= tol and worst <= tol:
             return DYN_OK, worst, it + 1, factored
         if not (worst < 0.25 * before) or step > last:
@@ -4422,50 +4494,88 @@ def _dyn_predict(Z, Zold):
         _rotate_by(Z[k], lg[0], lg[1], lg[2])
 
 
-@_entry(_fixed("dynamics", "the dynamics (implicit time steps)"), nogil=True)
-def dynamic_steps(Z, Zold, H, aux, props, tip, h, node_piece, coef, S, options, base,
-                  gravity, stations, first, last, Bm, Lm, piv, valid, positions, rotations,
-                  velocities, spins, strains, stresses, energy, info, status):
+def _dynamics(args):
+    """dynamic_steps' capability: passive, or with actuators or magnets (``act``)."""
+    actuated = _given(args[26])
+    return ("dynamics" + "+actuated" * actuated,
+            "the dynamics (implicit time steps)" + " for actuated or magnetic arms" * actuated)
+
+
+@_entry(_dynamics, nogil=True)
+def dynamic_steps(Z, Zold, H, aux, props, loads, tip, grid, coef, S, options, base, gravity,
+                  stations, first, last, factors, positions, rotations, velocities, spins,
+                  strains, stresses, energy, info, status, act, actuation, inputs, tendons):
     """Advance the cases [first, last) by base.shape[1] implicit time steps each.
 
     Z, Zold (B, G, DYN): the state now and one step before (for the predictor); H (B, G,
     DHIST) the BDF-α history; aux (B, 2): the dissipated energy so far (J) and the last
-    dissipation power (W). props (B, P, DPROPS), tip (B, 12): properties and loads. h (G - 1)
-    interval lengths (0: a joint between pieces), node_piece (G,). coef (DCOEF,), S (18,)
-    scales, options = (tol, max_iter). base (B or 1, T, 18): the base's p, R (row-major),
-    q, ω (material) at each new step. gravity (B, 3) (for the energy). stations (S,) the
-    recorded nodes. Bm, Lm, piv, valid: factor storage, per case (B) or one shared (1).
-    Outputs per case and step: positions, rotations (9), velocities, spins (spatial),
-    strains, stresses (material), energy (kinetic, elastic, gravity, dissipated), info
-    (residual, iterations, factorisations, predictor - corrector distance / L). status (B,)
-    is the number of steps done (= T on success); a failed step leaves Z, Zold, H and aux at
-    the last solved step and info's row at the failed step holds (residual, -1, ...).
+    dissipation power (W). props (P, DPROPS) the pieces' properties; loads (B, P, W) and
+    tip (B, TIP_LOADS) the statics' load channels (at zero inputs when ``inputs`` is
+    given); grid = (interval lengths (G - 1; 0 at a joint between pieces), piece of each
+    node, s of each node); coef (DCOEF,), S (18,) scales, options = (tol, max_iter). base
+    (B or 1, T, 18): the base's p, R (row-major), q, ω (material) at each new step;
+    gravity (B, 3) (for the energy); stations (S,) the recorded nodes; factors = (Bm, Lm,
+    piv, valid): per case (B) or one shared (1). Outputs per case and step: positions,
+    rotations (9), velocities, spins (spatial), strains, stresses (material), energy
+    (kinetic, elastic, gravity, dissipated), info (residual, iterations, factorisations,
+    predictor - corrector distance / L); status (B,) is the number of steps done (= T on
+    success): a failed step leaves Z, Zold, H and aux at the last solved step, and info's
+    row at the failed step holds (residual, -1, ...).
+
+    Optional (None: compiled without): ``act`` the actuators and magnets (the statics'
+    ``act``), with ``actuation`` = (the constitutive law's arm (the statics' arm with
+    K + c0 B, its inverse and a scratch f⁰), the law's scratch); ``inputs``
+    = (q (B or 1, T, n): the inputs at each step, unit piece channels (n, P, W), unit tip
+    channels (n, TIP_LOADS)): the loads at step t are loads + Σᵢ qᵢ unitᵢ; ``tendons`` (B,
+    T, A) the tendons' lengths (m) at each step.
     """
     tol = options[0]
     max_iter = int(options[1])
     length_scale = S[0]
+    h, node_piece = grid[0], grid[1]
     G = Z.shape[1]
     T = base.shape[1]
     kl = np.int64(_DKL)
     n = DUNK * (G - 1) + 6
-    r = np.empty(n)
-    dx = np.empty(n)
-    rates = np.empty((G, DUNK))
-    eps = np.empty((G, 6))
-    Gk = np.empty((G, DUNK, DUNK))
+    A = 1 if act is None else max(1, act[0].shape[0])
+    work = (np.empty(n), np.empty(n), np.empty((G, DUNK)), np.empty((G, 6)),
+            np.zeros((G, A)), np.empty((G, DUNK, DUNK)))
+    eps, lengths = work[3], work[4]
     hh = np.empty((G, 12))
     Zw = np.empty((G, DYN))
     Zp = np.empty((G, DYN))
     en = np.empty(4)
     c0 = coef[0]
+    now = np.empty((loads.shape[1], loads.shape[2]))
+    tip_now = np.empty(tip.shape[1])
+    Bm_all, Lm_all, piv_all, valid_all = factors
     for b in range(first, last):
-        f = b if Bm.shape[0] > 1 else 0
-        if Bm.shape[0] == 1:
-            valid[0] = 0
-        vb = valid[f:f + 1]
+        f = b if Bm_all.shape[0] > 1 else 0
+        if Bm_all.shape[0] == 1:
+            valid_all[0] = 0
+        fac = (Bm_all[f], Lm_all[f], piv_all[f], valid_all[f:f + 1])
         bb = b if base.shape[0] > 1 else 0
         status[b] = 0
+        for i in range(now.shape[0]):
+            for c in range(now.shape[1]):
+                now[i, c] = loads[b, i, c]
+        for c in range(tip_now.size):
+            tip_now[c] = tip[b, c]
         for t in range(T):
+            if inputs is not None:  # the loads at this step's inputs
+                q, unit, unit_tip = inputs
+                qb = b if q.shape[0] > 1 else 0
+                for i in range(now.shape[0]):
+                    for c in range(now.shape[1]):
+                        acc = loads[b, i, c]
+                        for e in range(q.shape[2]):
+                            acc += q[qb, t, e] * unit[e, i, c]
+                        now[i, c] = acc
+                for c in range(tip_now.size):
+                    acc = tip[b, c]
+                    for e in range(q.shape[2]):
+                        acc += q[qb, t, e] * unit_tip[e, c]
+                    tip_now[c] = acc
             _dyn_history_terms(H[b], coef, hh)
             # guess: the extrapolated state, the base's pose and velocity set
             for k in range(G):
@@ -4479,15 +4589,13 @@ def dynamic_steps(Z, Zold, H, aux, props, tip, h, node_piece, coef, S, options, 
                 Zw[0, _DW + i] = base[bb, t, 15 + i]
             for i in range(9):
                 Zw[0, _DR + i] = base[bb, t, 3 + i]
-
-            code, res, its, nf = _dyn_newton(Zw, h, node_piece, props[b], tip[b], hh, coef, S,
-                                             tol, max_iter, Bm[f], Lm[f], piv[f], vb, kl, r,
-                                             rates, eps, Gk, dx)
+            code, res, its, nf = _dyn_newton(Zw, grid, props, coef, S, now, tip_now, hh, act,
+                                             actuation, tol, max_iter, fac, kl, work)
             info[b, t, 0] = res
             info[b, t, 2] = nf
             if code != DYN_OK:
                 info[b, t, 1] = -1.0
-                vb[0] = 0
+                fac[3][0] = 0
                 break
             moved = 0.0
             for k in range(G):
@@ -4506,17 +4614,23 @@ def dynamic_steps(Z, Zold, H, aux, props, tip, h, node_piece, coef, S, options, 
                     H[b, k, 12 + i] = H[b, k, i]
                     H[b, k, i] = x
                     H[b, k, 24 + i] = c0 * x + hh[k, i]
-            _dyn_energies(Zw, h, node_piece, props[b], eps, hh, coef, gravity[b], en)
+            _dyn_energies(Zw, h, node_piece, props, eps, hh, coef, gravity[b], en)
             aux[b, 0] += 0.5 * (aux[b, 1] + en[3]) * coef[4]
             aux[b, 1] = en[3]
             energy[b, t, 0] = en[0]
             energy[b, t, 1] = en[1]
             energy[b, t, 2] = en[2]
             energy[b, t, 3] = aux[b, 0]
+            if tendons is not None:  # ℓ = ∫ |w| ds, the trapezoidal rule
+                for a in range(tendons.shape[2]):
+                    acc = 0.0
+                    for k in range(G - 1):
+                        acc += 0.5 * h[k] * (lengths[k, a] + lengths[k + 1, a])
+                    tendons[b, t, a] = acc
             for si in range(stations.size):
                 k = stations[si]
                 z = Zw[k]
-                pr = props[b, node_piece[k]]
+                pr = props[node_piece[k]]
                 for i in range(3):
                     positions[b, t, si, i] = z[_DP + i]
                     velocities[b, t, si, i] = (z[_DR + 3 * i] * z[_DQ] + z[_DR + 3 * i + 1]
@@ -4529,4 +4643,3 @@ def dynamic_steps(Z, Zold, H, aux, props, tip, h, node_piece, coef, S, options, 
                     strains[b, t, si, i] = eps[k, i] - pr[_PF0 + i]
                     stresses[b, t, si, i] = z[_DN + i]
             status[b] = t + 1
-
