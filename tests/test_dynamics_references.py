@@ -1,0 +1,167 @@
+"""softarm's dynamics against independent references.
+
+- The natural frequencies of a cantilever from a simulated free vibration against
+  Timoshenko's beam (first two bending modes, shear factor and rotary inertia included), the
+  first torsional and first axial frequency (tests/_timoshenko.py), to 0.2 % at Δt = T/200.
+- The heavy soft arm released horizontal, swinging down under gravity, against the
+  method-of-lines solution of tests/_mol_rod.py (tests/data/swinging_arm_mol.csv).
+- Till, Aloi & Rucker's steel cantilever (their C++ example at a stated commit,
+  tests/data/till_rucker/).
+- The order of the scheme in Δt.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from _mol_rod import load_reference
+from _timoshenko import cantilever_axial, cantilever_bending, cantilever_torsion
+from scipy.optimize import minimize_scalar
+
+import softarm
+from softarm import Arm, Circle, Damping, Gravity, Material, Simulator, TipLoad, simulate
+
+DATA = Path(__file__).parent / "data"
+THICK = Arm(0.2, Circle(0.01), Material(1e7, poisson_ratio=0.5, density=1100.0))  # L/r = 20
+
+
+def _frequency(signal, dt, near) -> float:
+    """The angular frequency of the strongest oscillation near ``near`` (rad/s) in a
+    uniformly sampled signal: the maximum of its Hann-windowed periodogram, found by a
+    bounded search between the neighbouring FFT bins (for a pure sinusoid this is its
+    frequency to far better than a bin)."""
+    x = np.asarray(signal) - np.mean(signal)
+    t = np.arange(x.size) * dt
+    window = np.hanning(x.size)
+
+    def power(omega):
+        return -abs(np.sum(window * x * np.exp(-1j * omega * t)))
+
+    bin_ = 2 * math.pi / (x.size * dt)
+    grid = near + bin_ * np.linspace(-3, 3, 61)
+    start = grid[np.argmin([power(w) for w in grid])]
+    found = minimize_scalar(power, bounds=(start - bin_ / 10, start + bin_ / 10),
+                            method="bounded", options={"xatol": 1e-10 * near})
+    return float(found.x)
+
+
+def _released(arm, loads, mode_omega, stations=51, periods=20):
+    """A free vibration from the equilibrium under ``loads`` (no load after): the
+    trajectory at Δt = T/200 of the mode of angular frequency ``mode_omega``."""
+    dt = 2 * math.pi / mode_omega / 200
+    bent = softarm.solve(arm, loads, s=stations, tol=1e-12)
+    return simulate(arm, [], duration=200 * periods * dt, dt=dt, stations=stations,
+                    initial=bent, tol=1e-11), dt
+
+
+def _section(arm):
+    r = arm.rigidities
+    mu = arm.linear_density
+    rho_j = arm.rotary_inertia
+    return r, mu, rho_j
+
+
+def test_the_first_two_bending_frequencies_are_timoshenkos():
+    r, mu, rho_j = _section(THICK)
+    omega = cantilever_bending(THICK.length, r.EIy, r.GAy, mu, rho_j[1], count=2)
+    assert omega[1] / omega[0] < 6.1  # (Euler-Bernoulli: 6.27: shear and rotary inertia)
+    # mode 1: a small tip force (tip at 1e-3 L)
+    path, dt = _released(THICK, [TipLoad([0.0, 0.0, 3e-3 * r.EIy / THICK.length**2])],
+                         omega[0])
+    found = _frequency(path.tip_position[:, 2], dt, omega[0])
+    assert found == pytest.approx(omega[0], rel=2e-3)  # measured 4.2e-5 (51 stations)
+    # mode 2: forces at the middle and at the tip, opposite (a shape near mode 2's)
+    force = 6e-3 * r.EIy / THICK.length**2
+    path, dt = _released(THICK, [TipLoad([0.0, 0.0, -force]),
+                                 softarm.PointLoad(0.5 * THICK.length, [0.0, 0.0, 2 * force])],
+                         omega[1], stations=101)
+    found = _frequency(path.positions[:, 50, 2], dt, omega[1])
+    # measured 2.9e-4 at the default 101 stations (1.4e-3 at 51: the grid's O(h²))
+    assert found == pytest.approx(omega[1], rel=2e-3)
+
+
+def test_the_first_torsional_and_axial_frequencies_are_the_quarter_waves():
+    r, mu, rho_j = _section(THICK)
+    omega_t = cantilever_torsion(THICK.length, r.GJ, rho_j[0])
+    path, dt = _released(THICK, [TipLoad(moment=[1e-3 * r.GJ / THICK.length, 0.0, 0.0])],
+                         omega_t)
+    twist = np.arctan2(path.rotations[:, -1, 2, 1], path.rotations[:, -1, 1, 1])
+    assert _frequency(twist, dt, omega_t) == pytest.approx(omega_t, rel=2e-3)  # -5.4e-7
+    omega_a = cantilever_axial(THICK.length, r.EA, mu)
+    path, dt = _released(THICK, [TipLoad([1e-3 * r.EA, 0.0, 0.0])], omega_a)
+    found = _frequency(path.tip_position[:, 0], dt, omega_a)
+    assert found == pytest.approx(omega_a, rel=2e-3)  # measured -5.4e-7
+
+
+HEAVY = Arm(0.5, Circle(0.02), Material(1e6, poisson_ratio=0.5, density=1100.0))
+
+
+@pytest.mark.parametrize("case, damping, bound", [
+    ("damped", Damping(retardation=0.01), 4e-4),  # measured 3.1e-4 L (1.3e-3 L at 51)
+    ("undamped", None, 1.2e-3),  # measured 8.4e-4 L
+])
+def test_the_swinging_arm_follows_the_method_of_lines_solution(case, damping, bound):
+    """Released horizontal, the heavy soft arm swings down and back up over 1.5 s (about
+    one period); the tip against the method-of-lines reference (its own error 2e-5 L
+    undamped, 3e-7 L damped), at the default 101 stations and Δt = 1 ms."""
+    times, tip_xz = load_reference(case)
+    dt = 1e-3
+    path = simulate(HEAVY, [Gravity()], duration=1.5, dt=dt, damping=damping)
+    tip = path.tip_position[np.round(times / dt).astype(int)][:, [0, 2]]
+    assert np.ptp(tip_xz[:, 1]) > 0.3  # a large swing
+    assert np.abs(tip - tip_xz).max() < bound * HEAVY.length
+
+
+def test_the_damped_swing_converges_at_second_order_in_the_spacing():
+    times, tip_xz = load_reference("damped")
+    errors = []
+    for stations in (26, 51):
+        path = simulate(HEAVY, [Gravity()], duration=0.5, dt=1e-3, stations=stations,
+                        damping=Damping(retardation=0.01))
+        index = np.round(times[times <= 0.5] / 1e-3).astype(int)
+        errors.append(np.abs(path.tip_position[index][:, [0, 2]]
+                             - tip_xz[times <= 0.5]).max())
+    assert 3.4 < errors[0] / errors[1] < 4.6
+
+
+def test_the_scheme_is_of_second_order_in_dt():
+    tips = [simulate(HEAVY, [Gravity()], duration=0.4, dt=dt, stations=26,
+                     damping=Damping(retardation=0.01), tol=1e-10).tip_position[-1]
+            for dt in (4e-3, 2e-3, 1e-3)]
+    first, second = np.abs(tips[0] - tips[1]).max(), np.abs(tips[1] - tips[2]).max()
+    assert first > 1e-6  # (the comparison has content)
+    assert 3.6 < first / second < 4.4  # measured 4.02 (and 4.01 from 1 to 0.5 ms)
+
+
+def test_till_aloi_ruckers_cantilever():
+    """Their example 02_Dynamics/00_Cosserat_Rod_PDE (tests/data/till_rucker/README.md): a
+    steel rod under gravity released from its equilibrium with a 20 g tip weight, BDF-α
+    (α = -0.2) at Δt = 2 ms, against their code on fine grids (N = 640 and 1280 points,
+    Richardson-extrapolated: 3.6e-5 m of its own). Their first step takes the history of
+    a start at rest (ẋ = 0) where softarm's takes backward Euler (test_dynamics.py): for
+    this comparison softarm starts as they do (through a private switch)."""
+    params = json.loads((DATA / "till_rucker" / "params.json").read_text())["cantilever"]
+    section = params["section"]
+    EA, GA, _ = section["Kse_softarm_order_EA_GA_GA"]
+    GJ, EI, _ = section["Kbt_softarm_order_GJ_EI_EI"]
+    rod = Arm.from_stiffness(params["length"], EA, GA, GA, GJ, EI, EI,
+                             mass_per_length=section["rhoA"],
+                             inertia_per_length=section["rhoJ_softarm_order"])
+    gravity = Gravity(params["gravity_softarm_frame"])
+    loaded = softarm.solve(rod, [gravity, TipLoad(params["initial_tip_force_softarm_frame"])])
+    reference = np.genfromtxt(
+        DATA / "till_rucker" / "cantilever_tip_dt2ms_fine_grid_first2s.csv", delimiter=",",
+        comments="#", skip_header=3, names=True)
+    sim = Simulator(rod, loads=[gravity], dt=params["time"]["dt"], stations=201,
+                    initial=loaded, alpha=params["time"]["alpha"])
+    sim._fresh = False  # their start (see above)
+    path = sim.run(reference.size - 1)
+    tip = path.tip_position  # theirs: x = softarm's y, z = softarm's x
+    assert np.ptp(reference["x_extrap"]) > 0.1  # it swings by 10 cm
+    # measured 3.9e-5 m (1.2e-4 m at 101 stations: the trapezoidal rule's O(h²))
+    assert np.abs(tip[:, 1] - reference["x_extrap"]).max() < 8e-5
+    assert np.abs(tip[:, 0] - reference["z_extrap"]).max() < 8e-5
