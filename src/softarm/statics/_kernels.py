@@ -4007,6 +4007,10 @@ DPROPS = 118
 DCOEF = 6
 # Statuses
 DYN_OK, DYN_NEWTON, DYN_NOT_FINITE = 0, 1, 2
+# A step that took this many chord iterations asks for new factors at the next one: a
+# factorisation costs about ten iterations, an aged factor one more iteration a step for
+# tens of steps (measured: 3.0 -> 2.x iterations a step).
+_DYN_REFRESH = 4
 
 
 @_jit
@@ -4624,6 +4628,8 @@ def dynamic_steps(Z, Zold, H, aux, props, loads, tip, grid, coef, S, options, ba
                     moved = max(moved, abs(Zw[k, _DP + i] - Zp[k, i]))
             info[b, t, 1] = its
             info[b, t, 3] = moved / length_scale
+            if its >= _DYN_REFRESH:
+                fac[3][0] = 0  # the factors have aged: new ones for the next step
             # accept: shift the history, x_t = c0 x + x_h
             for k in range(G):
                 for i in range(DYN):
