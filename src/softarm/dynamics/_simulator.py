@@ -186,8 +186,8 @@ class Simulator:
     >>> arm = Arm(0.5, Circle(0.02), Material(1e6, poisson_ratio=0.5, density=1100.0))
     >>> sim = Simulator(arm, loads=[Gravity()], dt=1e-3, stations=21)
     >>> state = sim.step()
-    >>> round(float(state.tip_position[2]) * 1e6, 1)  # ≈ -g Δt²/2 (a free fall, at first)
-    -4.9
+    >>> round(float(state.tip_position[2]) * 1e6, 1)  # -g Δt²: a free fall's backward-Euler step
+    -9.8
     """
 
     def __init__(self, arm, actuators=(), loads=(), *, dt, damping=None, initial=None,
