@@ -306,7 +306,7 @@ def plot_trajectory(trajectory, *, name: str = "", sweep=None, snapshots: int = 
     """
     matplotlib, Figure = _matplotlib()
     fig = Figure(figsize=FIGSIZE) if fig is None else fig
-    grid = fig.add_gridspec(2, 2, width_ratios=(1.2, 1.0), left=0.07, right=0.97,
+    grid = fig.add_gridspec(2, 2, width_ratios=(1.2, 1.0), left=0.08, right=0.97,
                             bottom=0.1, top=0.88, wspace=0.25, hspace=0.4)
     ax = fig.add_subplot(grid[:, 0])
     ax_tip, ax_energy = fig.add_subplot(grid[0, 1]), fig.add_subplot(grid[1, 1])
@@ -376,7 +376,7 @@ def plot_trajectory(trajectory, *, name: str = "", sweep=None, snapshots: int = 
     ax_energy.set_ylabel("energy change since t = 0 (J)")
     if not batch:
         ax_tip.legend(fontsize=7, loc="best")
-        ax_energy.legend(fontsize=7, loc="best", ncol=2)
+        ax_energy.legend(fontsize=7, loc="best", ncol=3)
     fig.suptitle(_wrapped(f"{name or 'trajectory'}: {times.size - 1} steps to "
                           f"t = {times[-1]:.4g} s"), fontsize=11)
     return _finish(fig, path)
