@@ -191,9 +191,9 @@ def small(tmp_path_factory):
 
 
 def test_the_command_writes_softarm_simulate_s_numbers(small, capsys):
-    folder, path, case, expected = small
+    folder, path, _case, expected = small
     outs = [folder / "arm.npz", folder / "arm.csv", folder / "arm.zarr"]
-    code, out, err = run(capsys, "simulate", path, *sum((["-o", o] for o in outs), []))
+    code, out, err = run(capsys, "simulate", path, *[a for o in outs for a in ("-o", o)])
     assert code == 0, err
     assert "simulated 20 steps of 0.001 s to t = 0.02 s, 11 stations" in out
     with np.load(outs[0]) as data:
@@ -224,14 +224,14 @@ def test_the_command_writes_softarm_simulate_s_numbers(small, capsys):
 def test_ctrl_c_keeps_the_steps_done(small, capsys, monkeypatch):
     """A KeyboardInterrupt from the progress report after the first chunk (one step): the
     file holds that step, marked incomplete; exit code 130, one line on stderr."""
-    folder, path, case, expected = small
+    folder, path, _case, expected = small
 
     def interrupt(self, done, total, failed=0):
         raise KeyboardInterrupt
 
     monkeypatch.setattr(cli._Progress, "__call__", interrupt)
     out = folder / "partial.npz"
-    code, stdout, stderr = run(capsys, "simulate", path, "-o", out)
+    code, _stdout, stderr = run(capsys, "simulate", path, "-o", out)
     assert code == 130
     assert stderr.count("\n") == 1 and stderr.startswith("softarm: interrupted; wrote the 1 "
                                                          "of 20 steps done (to t = 0.001 s)")
@@ -242,7 +242,7 @@ def test_ctrl_c_keeps_the_steps_done(small, capsys, monkeypatch):
 
 
 def test_a_step_that_fails_keeps_the_steps_before(small, capsys, monkeypatch):
-    folder, path, case, expected = small
+    folder, path, _case, _expected = small
     original = softarm.Simulator.run
     calls = []
 
@@ -254,7 +254,7 @@ def test_a_step_that_fails_keeps_the_steps_before(small, capsys, monkeypatch):
 
     monkeypatch.setattr(softarm.Simulator, "run", failing)
     out = folder / "failed.csv"
-    code, stdout, stderr = run(capsys, "simulate", path, "-o", out)
+    code, _stdout, stderr = run(capsys, "simulate", path, "-o", out)
     assert code == 1
     assert stderr.startswith("softarm: the solver did not converge: the time step could not "
                              "be solved") and "wrote the 1 of 20 steps done" in stderr
@@ -264,7 +264,7 @@ def test_a_step_that_fails_keeps_the_steps_before(small, capsys, monkeypatch):
 
 
 def test_an_interrupt_before_any_step_writes_nothing(small, capsys, monkeypatch):
-    folder, path, case, _ = small
+    folder, path, _case, _ = small
 
     def interrupt(self, steps, inputs=None):
         raise KeyboardInterrupt
@@ -347,7 +347,7 @@ def test_a_sweep_gives_one_trajectory_per_case_as_if_run_one_by_one(tmp_path, ca
                                "values = [-0.05, 0.0, 0.05]\n")
     folder = tmp_path
     out = folder / "sweep.zarr"
-    code, stdout, stderr = run(capsys, "simulate", path, "-o", out)
+    code, _stdout, stderr = run(capsys, "simulate", path, "-o", out)
     assert code == 0, stderr
     import xarray
 
