@@ -2,9 +2,10 @@
 
 - The natural frequencies of a cantilever from a simulated free vibration against
   Timoshenko's beam (first two bending modes, shear factor and rotary inertia included), the
-  first torsional and first axial frequency (tests/_timoshenko.py), to 0.2 % at Δt = T/200.
+  first torsional and first axial frequency (softarm/validation/_timoshenko.py), to 0.2 % at
+  Δt = T/200 (softarm reproduce runs the same checks: softarm/validation/_motion.py).
 - The heavy soft arm released horizontal, swinging down under gravity, against the
-  method-of-lines solution of tests/_mol_rod.py (tests/data/swinging_arm_mol.csv).
+  method-of-lines solution of tests/_mol_rod.py (softarm/validation/data/swinging_arm_mol.csv).
 - Till, Aloi & Rucker's steel cantilever (their C++ example at a stated commit,
   tests/data/till_rucker/).
 - The order of the scheme in Δt.
@@ -13,49 +14,24 @@
 from __future__ import annotations
 
 import json
-import math
 from pathlib import Path
 
 import numpy as np
 import pytest
 from _mol_rod import load_reference
-from _timoshenko import cantilever_axial, cantilever_bending, cantilever_torsion
-from scipy.optimize import minimize_scalar
 
 import softarm
 from softarm import Arm, Circle, Damping, Gravity, Material, Simulator, TipLoad, simulate
+from softarm.validation._motion import dominant_frequency as _frequency
+from softarm.validation._motion import free_vibration as _released
+from softarm.validation._timoshenko import (
+    cantilever_axial,
+    cantilever_bending,
+    cantilever_torsion,
+)
 
 DATA = Path(__file__).parent / "data"
 THICK = Arm(0.2, Circle(0.01), Material(1e7, poisson_ratio=0.5, density=1100.0))  # L/r = 20
-
-
-def _frequency(signal, dt, near) -> float:
-    """The angular frequency of the strongest oscillation near ``near`` (rad/s) in a
-    uniformly sampled signal: the maximum of its Hann-windowed periodogram, found by a
-    bounded search between the neighbouring FFT bins (for a pure sinusoid this is its
-    frequency to far better than a bin)."""
-    x = np.asarray(signal) - np.mean(signal)
-    t = np.arange(x.size) * dt
-    window = np.hanning(x.size)
-
-    def power(omega):
-        return -abs(np.sum(window * x * np.exp(-1j * omega * t)))
-
-    bin_ = 2 * math.pi / (x.size * dt)
-    grid = near + bin_ * np.linspace(-3, 3, 61)
-    start = grid[np.argmin([power(w) for w in grid])]
-    found = minimize_scalar(power, bounds=(start - bin_ / 10, start + bin_ / 10),
-                            method="bounded", options={"xatol": 1e-10 * near})
-    return float(found.x)
-
-
-def _released(arm, loads, mode_omega, stations=51, periods=20):
-    """A free vibration from the equilibrium under ``loads`` (no load after): the
-    trajectory at Δt = T/200 of the mode of angular frequency ``mode_omega``."""
-    dt = 2 * math.pi / mode_omega / 200
-    bent = softarm.solve(arm, loads, s=stations, tol=1e-12)
-    return simulate(arm, [], duration=200 * periods * dt, dt=dt, stations=stations,
-                    initial=bent, tol=1e-11), dt
 
 
 def _section(arm):
