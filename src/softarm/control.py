@@ -32,7 +32,7 @@ from ._validate import count, format_value, real
 from .dispatch import warn_unstable, warn_verdict
 from .equilibrium import Equilibrium, Stability
 from .errors import ConvergenceError
-from .loads import as_loads
+from .loads import as_actuators, as_loads
 from .statics import Solver
 from .statics._bounded import regularised_step
 from .statics.displacement import displaced_columns, displacement_jacobians
@@ -225,7 +225,7 @@ class ForwardSolver:
     def __init__(self, arm, actuators, loads=(), *, tol=1e-6, s="tip", jacobians=True,
                  stability=True):
         self.arm = arm
-        self.actuators = _actuator_loads(actuators)
+        self.actuators = as_actuators(actuators)
         if any(load.displacement_controlled for load in self.actuators):
             raise ValueError("ForwardSolver takes tension-controlled tendons (a "
                              "displacement-controlled Tendon's tension is an unknown of the "
@@ -351,7 +351,7 @@ class InverseSolver:
     def __init__(self, arm, actuators, loads=(), *, bounds=None, scales=None, tol=1e-6,
                  max_iterations=10, starts=6, s=None, solver_tol=None):
         self.arm = arm
-        self.actuators = _actuator_loads(actuators)
+        self.actuators = as_actuators(actuators)
         self.loads = as_loads(loads)
         self.tol = real(tol, "tol")
         if not self.tol > 0.0:
@@ -879,19 +879,6 @@ class InverseSolver:
             first, **fields, loads=(*self.loads, *self._stacked_actuators(inputs)),
             stability=stability, residual=np.array([eq.residual for eq in equilibria]),
             error_estimate=np.array([eq.error_estimate for eq in equilibria]))
-
-
-def _actuator_loads(actuators) -> tuple:
-    """The actuators as loads, each checked: loads with actuation inputs, single (unbatched)."""
-    actuators = as_loads(actuators)
-    for load in actuators:
-        if not load.inputs:
-            raise TypeError(f"actuators must be loads with actuation inputs (Tendon, "
-                            f"Chamber, MagneticField), got {load!r}")
-        if load.batch_shape != ():
-            raise ValueError(f"actuators must be single (unbatched) loads, got "
-                             f"{type(load).__name__} of batch shape {load.batch_shape}")
-    return actuators
 
 
 def _size(e) -> float:

@@ -24,6 +24,8 @@ from . import __version__
 from ._files import write_atomic
 from ._schema import arm_to_dict, loads_to_dict
 from .case import Case, CaseError, _parse
+from .dynamics import Energy
+from .dynamics._results import Trajectories
 from .equilibrium import Equilibrium, Stability
 from .lie import se3, so3
 
@@ -248,6 +250,19 @@ def load_result(path: str | os.PathLike) -> Equilibrium:
     return load_saved(path).result
 
 
+def _existing(path, formats, what: str) -> tuple[Path, str]:
+    """(the path, its lower-case suffix) of an existing file of one of ``formats``, else a
+    CaseError naming the file."""
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix not in formats:
+        raise CaseError(f"{path}: unknown {what} format {path.suffix!r}; expected one of "
+                        f"{', '.join(formats)}")
+    if not path.exists():
+        raise CaseError(f"{path}: no such file")
+    return path, suffix
+
+
 def load_saved(path: str | os.PathLike) -> SavedResult:
     """Read a result file with its embedded case and metadata (see :class:`SavedResult`).
 
@@ -256,13 +271,7 @@ def load_saved(path: str | os.PathLike) -> SavedResult:
     CaseError
         If the file is missing, of an unknown format or not a softarm result.
     """
-    path = Path(path)
-    suffix = path.suffix.lower()
-    if suffix not in FORMATS:
-        raise CaseError(f"{path}: unknown result format {path.suffix!r}; expected one of "
-                        f"{', '.join(FORMATS)}")
-    if not path.exists():
-        raise CaseError(f"{path}: no such file")
+    path, suffix = _existing(path, FORMATS, "result")
     if path.is_dir():
         raise CaseError(f"{path}: is a folder, not a result file")
     try:
@@ -536,7 +545,7 @@ TRAJECTORY_COLUMNS = (
 
 
 @dataclass(frozen=True, eq=False)
-class SavedTrajectory:
+class SavedTrajectory(Trajectories):
     """A trajectory file read back (:func:`read_trajectory`): the arrays of a
     :class:`softarm.Trajectory` under the same names and shapes (without ``final``: a file
     keeps no solver state to continue from), the case and what the file says of the run.
@@ -582,15 +591,6 @@ class SavedTrajectory:
     sweep_label: str | None
     version: str
     path: Path
-
-    @property
-    def tip_position(self) -> np.ndarray:
-        """p(L, t), shape (B..., T, 3) (m, spatial)."""
-        return self.positions[..., -1, :]
-
-    @property
-    def batch_shape(self) -> tuple[int, ...]:
-        return self.positions.shape[:-3]
 
 
 def _trajectory_arrays(trajectory) -> dict:
@@ -761,15 +761,7 @@ def read_trajectory(path: str | os.PathLike) -> SavedTrajectory:
     CaseError
         If the file is missing, of an unknown format or not a softarm trajectory.
     """
-    from .dynamics import Energy
-
-    path = Path(path)
-    suffix = path.suffix.lower()
-    if suffix not in TRAJECTORY_FORMATS:
-        raise CaseError(f"{path}: unknown trajectory format {path.suffix!r}; expected one of "
-                        f"{', '.join(TRAJECTORY_FORMATS)}")
-    if not path.exists():
-        raise CaseError(f"{path}: no such file")
+    path, suffix = _existing(path, TRAJECTORY_FORMATS, "trajectory")
     try:
         if suffix == ".npz":
             with np.load(path, allow_pickle=False) as data:

@@ -941,6 +941,20 @@ class MagneticField(Load):
 _LOAD_TYPES: set[type] = set()
 
 
+def as_actuators(actuators) -> tuple[Load, ...]:
+    """The actuators as loads, each checked: loads with actuation inputs (Tendon, Chamber,
+    MagneticField), single (unbatched)."""
+    actuators = as_loads(actuators)
+    for load in actuators:
+        if not load.inputs:
+            raise TypeError(f"actuators must be loads with actuation inputs (Tendon, "
+                            f"Chamber, MagneticField), got {load!r}")
+        if load.batch_shape != ():
+            raise ValueError(f"actuators must be single (unbatched) loads, got "
+                             f"{type(load).__name__} of batch shape {load.batch_shape}")
+    return actuators
+
+
 def as_loads(loads) -> tuple[Load, ...]:
     """A single load or a sequence of loads as a tuple, TypeError for anything else."""
     if type(loads) in (tuple, list) and all(type(item) in _LOAD_TYPES for item in loads):

@@ -10,10 +10,15 @@ import numpy as np
 __all__ = ["Energy", "State", "Trajectory"]
 
 
-def _frozen(array) -> np.ndarray:
-    array = np.array(array, dtype=np.float64)
-    array.setflags(write=False)
-    return array
+class AlongTheArm:
+    """What a state, a trajectory and a saved trajectory share: ``positions`` (..., S, 3)."""
+
+    positions: np.ndarray
+
+    @property
+    def tip_position(self) -> np.ndarray:
+        """p(L), shape (B..., [T,] 3) (m, spatial)."""
+        return self.positions[..., -1, :]
 
 
 @dataclass(frozen=True, eq=False)
@@ -46,7 +51,7 @@ class Energy:
 
 
 @dataclass(frozen=True, eq=False)
-class State:
+class State(AlongTheArm):
     """The arm at one time: what :meth:`Simulator.step` returns and what a simulation may
     start from (``initial=state``: the same arm, stations, time step and scheme).
 
@@ -91,14 +96,17 @@ class State:
     _signature: tuple = ()  # what the state is valid for (arm, grid, Δt, scheme, batch)
     _fresh: bool = False  # at rest with no step taken yet (its first step: backward Euler)
 
+
+class Trajectories(AlongTheArm):
+    """What a trajectory and a saved one share: the batch shape of (B..., T, S, 3)."""
+
     @property
-    def tip_position(self) -> np.ndarray:
-        """p(L), shape (B..., 3) (m, spatial)."""
-        return self.positions[..., -1, :]
+    def batch_shape(self) -> tuple[int, ...]:
+        return self.positions.shape[:-3]
 
 
 @dataclass(frozen=True, eq=False)
-class Trajectory:
+class Trajectory(Trajectories):
     """An arm's motion: T times from the initial state on (T = steps + 1), S stations.
 
     Attributes (the batch axes B... of the loads first)
@@ -137,12 +145,3 @@ class Trajectory:
     iterations: np.ndarray
     tendon_lengths: np.ndarray | None
     final: State
-
-    @property
-    def tip_position(self) -> np.ndarray:
-        """p(L, t), shape (B..., T, 3) (m, spatial)."""
-        return self.positions[..., -1, :]
-
-    @property
-    def batch_shape(self) -> tuple[int, ...]:
-        return self.positions.shape[:-3]

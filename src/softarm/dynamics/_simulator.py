@@ -16,9 +16,9 @@ from .._validate import (
     real,
     rigid_transform,
 )
-from ..equilibrium import Equilibrium
+from ..equilibrium import Equilibrium, _frozen
 from ..errors import ConvergenceError
-from ..loads import as_loads
+from ..loads import as_actuators, as_loads
 from ..statics import Solver
 from ..statics.solver import _kernels, check_tol
 from ._results import Energy, State, Trajectory
@@ -93,19 +93,11 @@ def _bdf_alpha(dt: float, alpha: float) -> np.ndarray:
 
 
 def _actuator_loads(actuators) -> tuple:
-    """The actuators: single loads with actuation inputs (Tendon under tension control,
-    Chamber, MagneticField)."""
-    actuators = as_loads(actuators)
-    for load in actuators:
-        if not load.inputs:
-            raise TypeError(f"actuators must be loads with actuation inputs (Tendon, "
-                            f"Chamber, MagneticField), got {format_value(load)}")
-        if load.batch_shape != ():
-            raise ValueError(f"actuators must be single (unbatched) loads, got "
-                             f"{type(load).__name__} of batch shape {load.batch_shape}")
-        if getattr(load, "displacement_controlled", False):
-            raise ValueError("actuators: a tendon under displacement control is not modelled "
-                             "in dynamics yet (give its tension)")
+    """The actuators (:func:`~softarm.loads.as_actuators`), tendons under tension control."""
+    actuators = as_actuators(actuators)
+    if any(getattr(load, "displacement_controlled", False) for load in actuators):
+        raise ValueError("actuators: a tendon under displacement control is not modelled in "
+                         "dynamics yet (give its tension)")
     return actuators
 
 
@@ -747,12 +739,6 @@ class Simulator:
             errors=_frozen(errors.reshape(*shape, T)),
             iterations=iterations.astype(np.int64).reshape(*shape, T),
             tendon_lengths=lengths, final=self.state)
-
-
-def _frozen(array) -> np.ndarray:
-    array = np.array(array, dtype=np.float64)
-    array.setflags(write=False)
-    return array
 
 
 def simulate(arm, loads=(), *, duration, dt, actuators=(), inputs=None, damping=None,

@@ -798,26 +798,26 @@ def _station_rotation(y0, f0, y1, f1, u, h, out):
 @_inline
 def _rotated(y0, a0, a1, a2, out):
     """out's rotation = y0's R times exp(a~) (a material, by Rodrigues; the series below
-    1e-4 rad, to round-off); ``out`` must not be ``y0``."""
+    1e-4 rad, to round-off); ``out`` may be ``y0`` (a row is read before it is written)."""
     angle = math.sqrt(a0 * a0 + a1 * a1 + a2 * a2)
     if angle < 1e-4:
         sa, ca = 1.0 - angle * angle / 6.0, 0.5 - angle * angle / 24.0
     else:
         sa, ca = math.sin(angle) / angle, (1.0 - math.cos(angle)) / (angle * angle)
-    e = np.empty((3, 3))
-    e[0, 0] = 1.0 - ca * (a1 * a1 + a2 * a2)
-    e[1, 1] = 1.0 - ca * (a0 * a0 + a2 * a2)
-    e[2, 2] = 1.0 - ca * (a0 * a0 + a1 * a1)
-    e[0, 1] = -sa * a2 + ca * a0 * a1
-    e[1, 0] = sa * a2 + ca * a0 * a1
-    e[0, 2] = sa * a1 + ca * a0 * a2
-    e[2, 0] = -sa * a1 + ca * a0 * a2
-    e[1, 2] = -sa * a0 + ca * a1 * a2
-    e[2, 1] = sa * a0 + ca * a1 * a2
+    e00 = 1.0 - ca * (a1 * a1 + a2 * a2)
+    e11 = 1.0 - ca * (a0 * a0 + a2 * a2)
+    e22 = 1.0 - ca * (a0 * a0 + a1 * a1)
+    e01 = -sa * a2 + ca * a0 * a1
+    e10 = sa * a2 + ca * a0 * a1
+    e02 = sa * a1 + ca * a0 * a2
+    e20 = -sa * a1 + ca * a0 * a2
+    e12 = -sa * a0 + ca * a1 * a2
+    e21 = sa * a0 + ca * a1 * a2
     for a in range(3):
-        for b in range(3):
-            out[_R + 3 * a + b] = (y0[_R + 3 * a] * e[0, b] + y0[_R + 3 * a + 1] * e[1, b]
-                                   + y0[_R + 3 * a + 2] * e[2, b])
+        r0, r1, r2 = y0[_R + 3 * a], y0[_R + 3 * a + 1], y0[_R + 3 * a + 2]
+        out[_R + 3 * a] = r0 * e00 + r1 * e10 + r2 * e20
+        out[_R + 3 * a + 1] = r0 * e01 + r1 * e11 + r2 * e21
+        out[_R + 3 * a + 2] = r0 * e02 + r1 * e12 + r2 * e22
 
 
 @_inline
@@ -3991,7 +3991,8 @@ def _ms_verdict(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, N
 # One implicit time step of Cosserat rod dynamics is a boundary value problem in s (Till,
 # Aloi & Rucker 2019). Node state (DYN = 24): centreline p (spatial), frame R (row-major),
 # internal force n and moment m (material), velocity q and angular velocity ω (material).
-_DP, _DR, _DN, _DM, _DQ, _DW = 0, 3, 12, 15, 18, 21
+# p and R sit where the statics' state has them (_P, _R), so _rotated and _dipole apply.
+_DP, _DR, _DN, _DM, _DQ, _DW = _P, _R, 12, 15, 18, 21
 DYN = 24
 # Unknowns and rates per node (DUNK = 18): δp, δθ (material), δn, δm, δq, δω; a node's rate
 # vector holds p', u, n', m', q', ω' in the same order.
@@ -4019,33 +4020,6 @@ def _mat_t_vec(R, o, x0, x1, x2, out, k):
     out[k] = R[o] * x0 + R[o + 3] * x1 + R[o + 6] * x2
     out[k + 1] = R[o + 1] * x0 + R[o + 4] * x1 + R[o + 7] * x2
     out[k + 2] = R[o + 2] * x0 + R[o + 5] * x1 + R[o + 8] * x2
-
-
-@_jit
-def _rotate_by(z, a0, a1, a2):
-    """R ← R exp(a~) for the node state z (Rodrigues)."""
-    th2 = a0 * a0 + a1 * a1 + a2 * a2
-    if th2 < 1e-8:
-        A = 1.0 - th2 / 6.0
-        Bc = 0.5 - th2 / 24.0
-    else:
-        th = math.sqrt(th2)
-        A = math.sin(th) / th
-        Bc = (1.0 - math.cos(th)) / th2
-    e00 = 1.0 - Bc * (a1 * a1 + a2 * a2)
-    e11 = 1.0 - Bc * (a0 * a0 + a2 * a2)
-    e22 = 1.0 - Bc * (a0 * a0 + a1 * a1)
-    e01 = -A * a2 + Bc * a0 * a1
-    e10 = A * a2 + Bc * a0 * a1
-    e02 = A * a1 + Bc * a0 * a2
-    e20 = -A * a1 + Bc * a0 * a2
-    e12 = -A * a0 + Bc * a1 * a2
-    e21 = A * a0 + Bc * a1 * a2
-    for i in range(3):
-        r0, r1, r2 = z[_DR + 3 * i], z[_DR + 3 * i + 1], z[_DR + 3 * i + 2]
-        z[_DR + 3 * i] = r0 * e00 + r1 * e10 + r2 * e20
-        z[_DR + 3 * i + 1] = r0 * e01 + r1 * e11 + r2 * e21
-        z[_DR + 3 * i + 2] = r0 * e02 + r1 * e12 + r2 * e22
 
 
 @_jit
@@ -4314,7 +4288,7 @@ def _dyn_jacobian(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, rat
                 a0 = d if c == 3 else 0.0
                 a1 = d if c == 4 else 0.0
                 a2 = d if c == 5 else 0.0
-                _rotate_by(zp, a0, a1, a2)
+                _rotated(zp, a0, a1, a2, zp)
             else:
                 zp[_DN + c - 6] += d
             _node_rates(zp, node_s[k], node_piece[k], props, now, hh[k], coef, g1, e1, act,
@@ -4400,7 +4374,7 @@ def _dyn_apply(Z, dx, S):
                 Z[k, _DN + c - 6] -= v
         if k > 0:
             o = _dyn_column(k, 3)
-            _rotate_by(Z[k], -dx[o] * S[3], -dx[o + 1] * S[3], -dx[o + 2] * S[3])
+            _rotated(Z[k], -dx[o] * S[3], -dx[o + 1] * S[3], -dx[o + 2] * S[3], Z[k])
 
 
 @_jit
@@ -4512,7 +4486,7 @@ def _dyn_predict(Z, Z1, Z2):
         for i in range(DYN):
             if not (_DR <= i < _DR + 9):
                 Z[k, i] = 3.0 * Z[k, i] - 3.0 * Z1[k, i] + Z2[k, i]
-        _rotate_by(Z[k], 2.0 * a[0] - b[0], 2.0 * a[1] - b[1], 2.0 * a[2] - b[2])
+        _rotated(Z[k], 2.0 * a[0] - b[0], 2.0 * a[1] - b[1], 2.0 * a[2] - b[2], Z[k])
 
 
 def _dynamics(args):
