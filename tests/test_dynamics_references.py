@@ -113,6 +113,19 @@ def test_the_scheme_is_of_second_order_in_dt():
     assert 3.6 < first / second < 4.4  # measured 4.02 (and 4.01 from 1 to 0.5 ms)
 
 
+def _till_rucker(example: str):
+    """(their parameters, the rod in softarm's frame, its gravity) of one of Till, Aloi &
+    Rucker's examples (tests/data/till_rucker/params.json)."""
+    params = json.loads((DATA / "till_rucker" / "params.json").read_text())[example]
+    section = params["section"]
+    EA, GA, _ = section["Kse_softarm_order_EA_GA_GA"]
+    GJ, EI, _ = section["Kbt_softarm_order_GJ_EI_EI"]
+    rod = Arm.from_stiffness(params["length"], EA, GA, GA, GJ, EI, EI,
+                             mass_per_length=section["rhoA"],
+                             inertia_per_length=section["rhoJ_softarm_order"])
+    return params, rod, Gravity(params["gravity_softarm_frame"])
+
+
 def test_till_aloi_ruckers_cantilever():
     """Their example 02_Dynamics/00_Cosserat_Rod_PDE (tests/data/till_rucker/README.md): a
     steel rod under gravity released from its equilibrium with a 20 g tip weight, BDF-α
@@ -120,14 +133,7 @@ def test_till_aloi_ruckers_cantilever():
     Richardson-extrapolated: 3.6e-5 m of its own). Their first step takes the history of
     a start at rest (ẋ = 0) where softarm's takes backward Euler (test_dynamics.py): for
     this comparison softarm starts as they do (through a private switch)."""
-    params = json.loads((DATA / "till_rucker" / "params.json").read_text())["cantilever"]
-    section = params["section"]
-    EA, GA, _ = section["Kse_softarm_order_EA_GA_GA"]
-    GJ, EI, _ = section["Kbt_softarm_order_GJ_EI_EI"]
-    rod = Arm.from_stiffness(params["length"], EA, GA, GA, GJ, EI, EI,
-                             mass_per_length=section["rhoA"],
-                             inertia_per_length=section["rhoJ_softarm_order"])
-    gravity = Gravity(params["gravity_softarm_frame"])
+    params, rod, gravity = _till_rucker("cantilever")
     loaded = softarm.solve(rod, [gravity, TipLoad(params["initial_tip_force_softarm_frame"])])
     reference = np.genfromtxt(
         DATA / "till_rucker" / "cantilever_tip_dt2ms_fine_grid_first2s.csv", delimiter=",",
@@ -153,15 +159,8 @@ def test_till_aloi_ruckers_tendon_robot_converges_to_softarm():
     of their points (measured 12.0, 6.0, 3.0 mm of a 0.6 m swing): their code converges
     to softarm's answer. Their quadratic drag (1e-4 kg/m², below 1e-4 of the weight at
     these speeds) is not modelled."""
-    params = json.loads((DATA / "till_rucker" / "params.json").read_text())["tendon_robot"]
-    section = params["section"]
-    EA, GA, _ = section["Kse_softarm_order_EA_GA_GA"]
-    GJ, EI, _ = section["Kbt_softarm_order_GJ_EI_EI"]
-    rod = Arm.from_stiffness(params["length"], EA, GA, GA, GJ, EI, EI,
-                             mass_per_length=section["rhoA"],
-                             inertia_per_length=section["rhoJ_softarm_order"])
+    params, rod, gravity = _till_rucker("tendon_robot")
     offset = params["tendon"]["offset_softarm_frame"]
-    gravity = Gravity(params["gravity_softarm_frame"])
     bending = Damping(matrix=np.diag([0.0, 0.0, 0.0, *params["Bbt_their_order"]]))
     distances = []
     for name, header in (("tendon_tip_N400.csv", 3), ("tendon_tip_N800.csv", 3)):

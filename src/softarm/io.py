@@ -441,7 +441,10 @@ def _check_verdict(verdict, batch: tuple, fail) -> None:
             raise fail(f"'stability' {key!r} must be {kind} of shape {batch}")
 
 
-def _read_csv(path: Path):
+def _csv_rows(path: Path) -> tuple[dict, list[str] | None, list[list[float]]]:
+    """(meta, header, rows) of a softarm CSV file: the ``# meta:`` and ``# case:`` lines,
+    the first other line as the header, then rows of finite numbers, one per column
+    (CaseError naming the line otherwise)."""
     meta: dict = {}
     header = None
     rows = []
@@ -468,6 +471,11 @@ def _read_csv(path: Path):
                     column = header[next(i for i, v in enumerate(row) if not math.isfinite(v))]
                     raise CaseError(f"{path}: line {number}: column {column!r} is not finite")
                 rows.append(row)
+    return meta, header, rows
+
+
+def _read_csv(path: Path):
+    meta, header, rows = _csv_rows(path)
     if header is None or "method" not in meta:
         raise CaseError(f"{path}: not a softarm result file (no '# meta:' line or header)")
     missing = [c for c in COLUMNS if c not in header]
@@ -815,20 +823,7 @@ def read_trajectory(path: str | os.PathLike) -> SavedTrajectory:
 
 
 def _read_trajectory_csv(path: Path) -> tuple[dict, dict]:
-    meta: dict = {}
-    header, rows = None, []
-    with path.open(newline="", encoding="utf-8") as stream:
-        for line in stream:
-            if line.startswith("# meta: "):
-                meta.update(json.loads(line[len("# meta: "):]))
-            elif line.startswith("# case: "):
-                meta["case"] = json.loads(line[len("# case: "):])
-            elif line.startswith("#") or not line.strip():
-                continue
-            elif header is None:
-                header = next(csv.reader([line]))
-            else:
-                rows.append([float(v) for v in next(csv.reader([line]))])
+    meta, header, rows = _csv_rows(path)
     if header is None or meta.get("kind") != "trajectory":
         raise CaseError(f"{path}: not a softarm trajectory (no '# meta:' line or header)")
     batch = tuple(meta["batch_shape"])
