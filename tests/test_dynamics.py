@@ -244,3 +244,26 @@ def test_simulator_steps_take_the_inputs_given():
         sim.step([1.0, 2.0])
     with pytest.raises(ValueError, match="finite"):
         sim.step([np.nan])
+
+
+def test_a_batch_keeps_going_past_a_failed_case():
+    """failures="keep": a case whose step cannot be solved (here pushed inside out, v₁ <= 0,
+    by a compressive tip force of twice EA) stops where it failed, marked and blanked; the
+    others are the same as alone. failures="raise" (the default) raises instead."""
+    crush = np.zeros((3, 3))
+    crush[1, 0] = -2.0 * HEAVY.rigidities.EA
+    loads = [Gravity(), TipLoad(crush)]
+    sim = Simulator(HEAVY, loads=loads, dt=1e-3, stations=21)
+    with pytest.raises(softarm.ConvergenceError, match=r"for case \(1,\): .* inside out"):
+        sim.run(5)
+    assert sim.time == 0.0  # (unchanged)
+    path = sim.run(5, failures="keep")
+    assert path.failed.tolist() == [False, True, False]
+    assert [case for case, _, _ in sim.failures] == [(1,)]
+    assert sim.failures[0][1] == pytest.approx(1e-3)  # its first step
+    assert np.all(np.isnan(path.positions[1, 1:])) and np.all(np.isfinite(path.positions[0]))
+    alone = simulate(HEAVY, [Gravity()], duration=5e-3, dt=1e-3, stations=21)
+    np.testing.assert_array_equal(path.positions[0], alone.positions)
+    np.testing.assert_array_equal(path.positions[2], alone.positions)
+    later = sim.run(2, failures="keep")  # the failed case is skipped from now on
+    assert np.all(np.isnan(later.positions[1, 1:])) and len(sim.failures) == 1

@@ -246,11 +246,11 @@ def test_a_step_that_fails_keeps_the_steps_before(small, capsys, monkeypatch):
     original = softarm.Simulator.run
     calls = []
 
-    def failing(self, steps, inputs=None):
+    def failing(self, steps, inputs=None, **options):
         calls.append(steps)
         if len(calls) == 2:
             raise softarm.ConvergenceError("the time step could not be solved", 0.5)
-        return original(self, steps, inputs)
+        return original(self, steps, inputs, **options)
 
     monkeypatch.setattr(softarm.Simulator, "run", failing)
     out = folder / "failed.csv"
@@ -266,7 +266,7 @@ def test_a_step_that_fails_keeps_the_steps_before(small, capsys, monkeypatch):
 def test_an_interrupt_before_any_step_writes_nothing(small, capsys, monkeypatch):
     folder, path, _case, _ = small
 
-    def interrupt(self, steps, inputs=None):
+    def interrupt(self, steps, inputs=None, **options):
         raise KeyboardInterrupt
 
     monkeypatch.setattr(softarm.Simulator, "run", interrupt)
@@ -362,6 +362,22 @@ def test_a_sweep_gives_one_trajectory_per_case_as_if_run_one_by_one(tmp_path, ca
         data["load"][1]["force"] = [0.0, 0.0, value]
         alone = simulate_case(parse_case(data))
         np.testing.assert_allclose(positions[k], alone.positions, rtol=0, atol=1e-9)
+
+
+def test_a_sweep_goes_on_past_a_failed_case(tmp_path, capsys):
+    """The middle case is pushed inside out (a compressive tip force of twice EA): it fails
+    at its first step; the others are written whole, the failed one as NaN, and one line on
+    stderr names it."""
+    text = HANGING.replace('initial = "equilibrium"', 'initial = "rest"') + \
+        '[sweep]\nload = 2\ncomponent = "x"\nvalues = [0.0, -1e9, 0.0]\n'
+    path = write_case(tmp_path, text, "crushed")
+    out = tmp_path / "sweep.npz"
+    code, _stdout, stderr = run(capsys, "simulate", path, "-o", out)
+    assert code == 0, stderr
+    assert "1 of 3 cases failed" in stderr and "-1e+09" in stderr
+    back = read_trajectory(out)
+    assert np.all(np.isnan(back.positions[1, 1:])) and np.all(np.isfinite(back.positions[0]))
+    np.testing.assert_array_equal(back.positions[0], back.positions[2])
 
 
 # --------------------------------------------------------------------------------------------

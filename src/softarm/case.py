@@ -723,7 +723,9 @@ def simulation_parts(case: Case, *, seconds: float = 0.25) -> Iterator[Trajector
 
     The first chunk is one step (it shows the cost of a step, the compile excluded: a first
     use of the dynamics kernel compiles it); the next ones take about ``seconds`` each. The
-    first chunk includes the initial state (T = steps + 1); the others start after it.
+    first chunk includes the initial state (T = steps + 1); the others start after it. A
+    sweep's cases go on past a case that fails (its values NaN from its failed step,
+    ``Trajectory.failed``); a single case raises ConvergenceError.
     """
     simulator, inputs = _simulator(case)
     total = case.simulation.steps
@@ -731,7 +733,7 @@ def simulation_parts(case: Case, *, seconds: float = 0.25) -> Iterator[Trajector
     while done < total:
         steps = min(chunk, total - done)
         start = time.perf_counter()
-        part = simulator.run(steps, inputs)
+        part = simulator.run(steps, inputs, failures="keep" if case.sweep else "raise")
         elapsed = time.perf_counter() - start
         yield part if done == 0 else _from(part, 1)
         done += steps
@@ -771,7 +773,7 @@ def join_trajectories(parts, start: int = 0) -> Trajectory:
         strains=cat([p.strains for p in parts]), stresses=cat([p.stresses for p in parts]),
         energy=energy, errors=cat([p.errors for p in parts]),
         iterations=cat([p.iterations for p in parts]), tendon_lengths=lengths,
-        final=parts[-1].final)
+        final=parts[-1].final, failed=parts[-1].failed)
 
 
 def simulate_case(case: Case, *, progress: Callable[[int, int], None] | None = None

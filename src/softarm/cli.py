@@ -613,6 +613,14 @@ def _run_simulate(args) -> int:
         from . import plot
 
         plot.plot_trajectory(trajectory, name=case.name, sweep=case.sweep, path=picture)
+    failed = np.flatnonzero(np.ravel(trajectory.failed)) if trajectory.failed is not None \
+        else ()
+    if stopped is None and len(failed):
+        values = case.sweep.values if case.sweep is not None else range(len(failed))
+        print(f"softarm: {len(failed)} of {trajectory.failed.size} cases failed (their values "
+              f"are NaN in the outputs from their failed step on): sweep values "
+              f"{', '.join(f'{values[b]:g}' for b in failed[:10])}"
+              + (" ..." if len(failed) > 10 else ""), file=sys.stderr)
     if stopped is not None:
         kept = f"; wrote the {done} of {total} steps done (to t = {trajectory.times[-1]:.6g} " \
             f"s) to {', '.join(map(str, outputs + ([picture] if picture else [])))}" \

@@ -441,10 +441,12 @@ def _check_verdict(verdict, batch: tuple, fail) -> None:
             raise fail(f"'stability' {key!r} must be {kind} of shape {batch}")
 
 
-def _csv_rows(path: Path) -> tuple[dict, list[str] | None, list[list[float]]]:
+def _csv_rows(path: Path, finite: bool = True) -> tuple[dict, list[str] | None,
+                                                       list[list[float]]]:
     """(meta, header, rows) of a softarm CSV file: the ``# meta:`` and ``# case:`` lines,
-    the first other line as the header, then rows of finite numbers, one per column
-    (CaseError naming the line otherwise)."""
+    the first other line as the header, then rows of numbers, one per column, finite unless
+    ``finite`` is False (a trajectory's failed cases are NaN) (CaseError naming the line
+    otherwise)."""
     meta: dict = {}
     header = None
     rows = []
@@ -467,7 +469,7 @@ def _csv_rows(path: Path) -> tuple[dict, list[str] | None, list[list[float]]]:
                     row = [float(v) for v in fields]
                 except ValueError:
                     raise CaseError(f"{path}: line {number}: not a row of numbers") from None
-                if not all(math.isfinite(v) for v in row):
+                if finite and not all(math.isfinite(v) for v in row):
                     column = header[next(i for i, v in enumerate(row) if not math.isfinite(v))]
                     raise CaseError(f"{path}: line {number}: column {column!r} is not finite")
                 rows.append(row)
@@ -617,6 +619,8 @@ def _trajectory_meta(trajectory, case: Case, complete: bool, reason: str) -> dic
             "batch_shape": list(trajectory.batch_shape), "steps": int(trajectory.times.size - 1),
             "steps_requested": int(case.simulation.steps) if case.simulation else None,
             "complete": bool(complete), "reason": reason,
+            "failed_cases": ([] if getattr(trajectory, "failed", None) is None else
+                             np.flatnonzero(np.ravel(trajectory.failed)).tolist()),
             "sweep_column": sweep.column if sweep is not None else None,
             "sweep_label": sweep.label if sweep is not None else None,
             "sweep_values": list(sweep.values) if sweep is not None else None,
@@ -823,7 +827,7 @@ def read_trajectory(path: str | os.PathLike) -> SavedTrajectory:
 
 
 def _read_trajectory_csv(path: Path) -> tuple[dict, dict]:
-    meta, header, rows = _csv_rows(path)
+    meta, header, rows = _csv_rows(path, finite=False)
     if header is None or meta.get("kind") != "trajectory":
         raise CaseError(f"{path}: not a softarm trajectory (no '# meta:' line or header)")
     batch = tuple(meta["batch_shape"])

@@ -130,6 +130,9 @@ class Trajectory(Trajectories):
         Each tendon's length (m), in the order of the actuators.
     final : State
         The last state (to continue from: ``simulate(..., initial=trajectory.final)``).
+    failed : ndarray of bool, shape (B...)
+        The cases whose step could not be solved (``Simulator.run(..., failures="keep")``):
+        their values from the failed step on are NaN (``Simulator.failures`` says when).
     """
 
     times: np.ndarray
@@ -145,3 +148,4 @@ class Trajectory(Trajectories):
     iterations: np.ndarray
     tendon_lengths: np.ndarray | None
     final: State
+    failed: np.ndarray | None = None

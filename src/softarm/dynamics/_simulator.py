@@ -456,6 +456,10 @@ class Simulator:
         self._arrays = tuple(a.copy() for a in self._initial)
         self.time = self.t0
         self._q = self.inputs.copy() if self.actuators else None
+        #: (case index, time the failed step would have reached (s), residual) of every
+        #: case that failed in a run(failures="keep")
+        self.failures = []
+        self._failed = np.zeros(self.shape, dtype=bool)
         self._fresh = self._starts_at_rest
         self._factors = None
         self._state = None
@@ -486,6 +490,7 @@ class Simulator:
         times = self.time + self.dt * np.arange(1, steps + 1)
         first = 1 if self._fresh else 0
         parts = []
+        skip = self._failed.ravel().copy()
         for a, b, coef, props in ((0, first, self._coef_first, self._props_first),
                                   (first, steps, self._coef, self._props)):
             if b > a:
@@ -495,7 +500,8 @@ class Simulator:
                     factors[4] = coef
                 parts.append(self._kernel_run(arrays, times[a:b], coef, props,
                                               None if factors is None else tuple(factors[:4]),
-                                              threads, q))
+                                              threads, q, skip))
+                skip |= parts[-1][3] < b - a  # (a case failed in the first part: not after)
         if len(parts) == 1:
             return (times, *parts[0])
         (out1, e1, i1, d1), (out2, e2, i2, d2) = parts
@@ -503,7 +509,7 @@ class Simulator:
         done = np.where(d1 < 1, d1, 1 + d2)
         return (times, out, np.concatenate([e1, e2], 1), np.concatenate([i1, i2], 1), done)
 
-    def _kernel_run(self, arrays, times, coef, props, factors, threads, q):
+    def _kernel_run(self, arrays, times, coef, props, factors, threads, q, skip):
         """The kernel over ``times`` (advancing ``arrays`` in place where a case succeeds)."""
         k = _kernels()
         Z, Zold, H, aux = arrays
@@ -514,7 +520,7 @@ class Simulator:
                 ("strains", 6), ("stresses", 6))}
         energy = np.zeros((B, steps, 4))
         info = np.zeros((B, steps, 4))
-        done = np.zeros(B, dtype=np.int64)
+        done = np.where(skip, -1, 0).astype(np.int64)  # (-1: the kernel skips the case)
         tendons = None
         if self._act is not None:
             tendons = np.zeros((B, steps, max(1, self._act[0].shape[0])))
@@ -571,13 +577,21 @@ class Simulator:
                 self.shape))
         return self._state
 
-    def run(self, steps: int, inputs=None) -> Trajectory:
+    def run(self, steps: int, inputs=None, *, failures: str = "raise") -> Trajectory:
         """``steps`` steps from the current state, in one compiled call (the cases of a
         batch in threads); returns the trajectory, the current state first.
 
         ``inputs``: the actuators' inputs over time, a callable t -> (n,) or an array
         (steps + 1, n) at the trajectory's times (row 0, the current time, is not used);
-        None: constant (as the last step left them)."""
+        None: constant (as the last step left them).
+
+        ``failures``: "raise" (default): a case whose step cannot be solved raises a
+        ConvergenceError and the simulator's state is unchanged. "keep" (a long batch, a
+        sweep): the other cases go on; a failed case stays at its last solved step, its
+        values after it are NaN, ``Trajectory.failed`` marks it and :attr:`failures` says
+        when and with what residual (later runs skip it)."""
+        if failures not in ("raise", "keep"):
+            raise ValueError(f"failures must be 'raise' or 'keep', got {failures!r}")
         steps = count(steps, "steps", 1)
         B = int(np.prod(self.shape))
         first = self.state
@@ -593,7 +607,10 @@ class Simulator:
         arrays = tuple(a.copy() for a in self._arrays)
         times, out, energy, info, done = self._advance(steps, None, threads, arrays=arrays,
                                                        inputs=q)
-        self._check(done, info, steps, times)
+        if failures == "raise":
+            self._check(done, info, steps, times)
+        else:
+            self._mark_failures(done, info, steps, times, out, energy)
         if q is not None:
             self._q = np.array(q[-1])
         self._arrays = arrays
@@ -603,6 +620,26 @@ class Simulator:
         self._state = None  # (the final state is made from the new arrays)
         start = self._record_now(initial=first)
         return self._trajectory(first, times, out, energy, info, start)
+
+    def _case(self, b: int) -> tuple[int, ...]:
+        """The batch index of flat case ``b``."""
+        return tuple(int(i) for i in np.unravel_index(b, self.shape)) if self.shape else ()
+
+    def _mark_failures(self, done, info, steps, times, out, energy) -> None:
+        """Record the cases that failed in this run and blank their values from the failed
+        step on (NaN); cases that had failed before are blanked throughout."""
+        failed = self._failed.ravel()
+        for b in np.flatnonzero(done < steps):
+            first = max(int(done[b]), 0)
+            if done[b] >= 0:  # a new failure
+                self.failures.append((self._case(b), float(times[first]),
+                                      float(info[b, first, 0])))
+                failed[b] = True
+            for array in (*out.values(), energy):
+                array[b, first:] = np.nan
+            info[b, first:, 3] = np.nan  # (its errors; its iterations 0)
+            info[b, first:, 1] = 0.0
+        self._failed = failed.reshape(self.shape)
 
     def _checked_inputs(self, values, rows: int) -> np.ndarray:
         """``values`` as (rows, n) finite floats, else ValueError naming ``inputs``."""
@@ -635,15 +672,16 @@ class Simulator:
         return self._checked_inputs(inputs, times.size + 1)[1:]
 
     def _check(self, done, info, steps, times) -> None:
-        failed = np.flatnonzero(done < steps)
+        failed = np.flatnonzero((done < steps) & (done >= 0))
         if failed.size:
             b = int(failed[0])
             t = int(done[b])
             raise ConvergenceError(
                 f"the time step to t = {times[t]:.6g} s (step {t + 1}) could not be solved "
-                f"for case {np.unravel_index(b, self.shape) if self.shape else ()}: Newton "
-                f"did not converge to tol {self.tol:g} in {MAX_ITERATIONS} iterations (a "
-                "smaller dt, a looser tol or damping may help; the state is unchanged)",
+                f"for case {self._case(b)}: Newton "
+                f"did not converge to tol {self.tol:g} in {MAX_ITERATIONS} iterations, or "
+                "its answer left the model (an axial stretch v₁ <= 0: a section turned inside "
+                "out); a smaller dt, a looser tol or damping may help; the state is unchanged",
                 float(info[b, t, 0]), f"{MAX_ITERATIONS} Newton iterations")
 
     # ------------------------------------------------------------------ results
@@ -738,7 +776,7 @@ class Simulator:
             energy=Energy(*(_frozen(energies[..., i]) for i in range(4))),
             errors=_frozen(errors.reshape(*shape, T)),
             iterations=iterations.astype(np.int64).reshape(*shape, T),
-            tendon_lengths=lengths, final=self.state)
+            tendon_lengths=lengths, final=self.state, failed=self._failed.copy())
 
 
 def simulate(arm, loads=(), *, duration, dt, actuators=(), inputs=None, damping=None,

@@ -4007,7 +4007,7 @@ DPROPS = 118
 # BDF-α coefficients (DCOEF): c0, c1, c2, d1, Δt, α.
 DCOEF = 6
 # Statuses
-DYN_OK, DYN_NEWTON, DYN_NOT_FINITE = 0, 1, 2
+DYN_OK, DYN_NEWTON, DYN_NOT_FINITE, DYN_INADMISSIBLE = 0, 1, 2, 3
 # A step that took this many chord iterations asks for new factors at the next one: a
 # factorisation costs about ten iterations, an aged factor one more iteration a step for
 # tens of steps (measured: 3.0 -> 2.x iterations a step).
@@ -4517,7 +4517,8 @@ def dynamic_steps(Z, Zold, H, aux, props, loads, tip, grid, coef, S, options, ba
     (kinetic, elastic, gravity, dissipated), info (residual, iterations, factorisations,
     predictor - corrector distance / L); status (B,) is the number of steps done (= T on
     success): a failed step leaves Z, Zold, H and aux at the last solved step, and info's
-    row at the failed step holds (residual, -1, ...).
+    row at the failed step holds (residual, -1, ...); a case whose status is < 0 on entry
+    is skipped (it failed before).
 
     Optional (None: compiled without): ``act`` the actuators and magnets (the statics'
     ``act``), with ``actuation`` = (the constitutive law's arm (the statics' arm with
@@ -4547,6 +4548,8 @@ def dynamic_steps(Z, Zold, H, aux, props, loads, tip, grid, coef, S, options, ba
     tip_now = np.empty(tip.shape[1])
     Bm_all, Lm_all, piv_all, valid_all = factors
     for b in range(first, last):
+        if status[b] < 0:
+            continue  # a case that failed in an earlier call: left where it stopped
         f = b if Bm_all.shape[0] > 1 else 0
         if Bm_all.shape[0] == 1 and b > first:
             valid_all[0] = 0  # (one shared factor storage: another case's factors)
@@ -4592,6 +4595,9 @@ def dynamic_steps(Z, Zold, H, aux, props, loads, tip, grid, coef, S, options, ba
                                              actuation, tol, max_iter, fac, kl, work)
             info[b, t, 0] = res
             info[b, t, 2] = nf
+            for k in range(G):  # the model's limit: a section turned inside out (v₁ <= 0)
+                if code == DYN_OK and not eps[k, 0] > 0.0:
+                    code = DYN_INADMISSIBLE
             if code != DYN_OK:
                 info[b, t, 1] = -1.0
                 fac[3][0] = 0
