@@ -267,3 +267,23 @@ def test_a_batch_keeps_going_past_a_failed_case():
     np.testing.assert_array_equal(path.positions[2], alone.positions)
     later = sim.run(2, failures="keep")  # the failed case is skipped from now on
     assert np.all(np.isnan(later.positions[1, 1:])) and len(sim.failures) == 1
+
+
+def test_a_segmented_precurved_arm_with_point_and_follower_loads_settles():
+    """Two segments (joints in the stations' grid), a precurved one, a point load inside
+    (n and m jump at a joint) and a follower tip load: settled, as softarm.solve, at second
+    order in the spacing (measured 2.0e-4 L and 5.8e-5 L)."""
+    stiffer = Material(4e6, poisson_ratio=0.5, density=1500.0)
+    arm = softarm.SegmentedArm([Arm(0.15, Circle(0.012), stiffer),
+                                Arm(0.15, Circle(0.008), SOFT, curvature=(0.0, 0.0, 2.0))])
+    loads = [Gravity(), softarm.PointLoad(0.1, [0.0, 0.05, 0.1]),
+             TipLoad([0.0, 0.0, -0.05], follower=True)]
+    errors = []
+    for stations in (26, 51):
+        path = simulate(arm, loads, duration=3.0, dt=4e-3, stations=stations,
+                        damping=Damping(retardation=0.3), tol=1e-10)
+        eq = softarm.solve(arm, loads, s=stations, tol=1e-10)
+        assert np.abs(path.velocities[-1]).max() < 1e-5
+        errors.append(np.abs(path.positions[-1] - eq.positions).max() / arm.length)
+    assert errors[1] < 1e-4
+    assert 3.0 < errors[0] / errors[1] < 4.5
