@@ -287,3 +287,24 @@ def test_a_segmented_precurved_arm_with_point_and_follower_loads_settles():
         errors.append(np.abs(path.positions[-1] - eq.positions).max() / arm.length)
     assert errors[1] < 1e-4
     assert 3.0 < errors[0] / errors[1] < 4.5
+
+
+def test_each_case_of_a_batch_takes_its_own_inputs():
+    tendon = softarm.Tendon(0.0, softarm.routing.Straight(0.0, 0.008))
+    pulls = np.array([0.2, 0.6])
+    ramp = np.linspace(0.0, 1.0, 11)[:, None]
+    schedule = pulls[:, None, None] * ramp  # (cases, steps + 1, inputs)
+    loads = [Gravity([[0.0, 0.0, -9.81], [0.0, 0.0, -9.81]])]  # (a batch of two)
+    both = simulate(ROBOT, loads, actuators=[tendon], inputs=schedule, duration=0.01,
+                    dt=1e-3, stations=21, damping=Damping(retardation=0.05))
+    for k, pull in enumerate(pulls):
+        alone = simulate(ROBOT, [Gravity()], actuators=[tendon], inputs=pull * ramp,
+                         duration=0.01, dt=1e-3, stations=21,
+                         damping=Damping(retardation=0.05))
+        np.testing.assert_array_equal(both.positions[k], alone.positions)
+    assert not np.allclose(both.positions[0], both.positions[1])
+    sim = Simulator(ROBOT, [tendon], loads, dt=1e-3, stations=21)
+    state = sim.step(np.array([[0.1], [0.3]]))  # (cases, inputs)
+    assert state.positions.shape == (2, 21, 3)
+    with pytest.raises(ValueError, match="batch axes"):
+        sim.step(np.ones((3, 1)))

@@ -455,7 +455,7 @@ class Simulator:
         """Back to the initial state (and its time)."""
         self._arrays = tuple(a.copy() for a in self._initial)
         self.time = self.t0
-        self._q = self.inputs.copy() if self.actuators else None
+        self._q = self.inputs[None].copy() if self.actuators else None  # (C, n)
         #: (case index, time the failed step would have reached (s), residual) of every
         #: case that failed in a run(failures="keep")
         self.failures = []
@@ -494,7 +494,7 @@ class Simulator:
         for a, b, coef, props in ((0, first, self._coef_first, self._props_first),
                                   (first, steps, self._coef, self._props)):
             if b > a:
-                q = None if inputs is None else inputs[a:b]
+                q = None if inputs is None else inputs[:, a:b]
                 if factors is not None and factors[4] is not coef:
                     factors[3][:] = 0  # (the Jacobian changes with the scheme)
                     factors[4] = coef
@@ -527,7 +527,7 @@ class Simulator:
         loads, tip, schedule = self._loads, self._tip, None
         if q is not None:
             loads, tip = self._loads0
-            schedule = (np.ascontiguousarray(q, dtype=np.float64)[None], *self._unit)
+            schedule = (np.ascontiguousarray(q, dtype=np.float64), *self._unit)
         shared = factors is None
         count_ = max(1, threads or 1)
         local = [self._storage(False, 1) for _ in range(count_)] if shared else None
@@ -554,18 +554,18 @@ class Simulator:
     def step(self, inputs=None) -> State:
         """One implicit step of Δt from the current state; returns the new state.
 
-        ``inputs`` (n,): the actuators' inputs at the end of the step (tensions in N,
-        pressures in Pa, field components in T, in the order of the actuators' inputs, as
-        :class:`~softarm.ForwardSolver`'s), kept for the next steps; None: as before (at
-        first, the actuators' own values). Raises ConvergenceError (with the step's
-        residual) if a case's step cannot be solved: the simulator's state (and inputs)
-        are then unchanged."""
-        q = self._q if inputs is None else self._checked_inputs(inputs, 1)[0]
+        ``inputs`` (n,) or (B..., n): the actuators' inputs at the end of the step (tensions
+        in N, pressures in Pa, field components in T, in the order of the actuators' inputs,
+        as :class:`~softarm.ForwardSolver`'s; batch axes first to give each case its own),
+        kept for the next steps; None: as before (at first, the actuators' own values).
+        Raises ConvergenceError (with the step's residual) if a case's step cannot be
+        solved: the simulator's state (and inputs) are then unchanged."""
+        q = self._q if inputs is None else self._checked_inputs(inputs, 1)[:, 0]
         if self._factors is None:  # (kept between steps: the chord iteration's factors)
             self._factors = [*self._storage(True, int(np.prod(self.shape))), None]
         arrays = tuple(a.copy() for a in self._arrays)
         times, out, _, info, done = self._advance(
-            1, self._factors, arrays=arrays, inputs=None if q is None else q[None])
+            1, self._factors, arrays=arrays, inputs=None if q is None else q[:, None])
         self._check(done, info, 1, times)
         self._q = q
         self._arrays = arrays
@@ -582,7 +582,8 @@ class Simulator:
         batch in threads); returns the trajectory, the current state first.
 
         ``inputs``: the actuators' inputs over time, a callable t -> (n,) or an array
-        (steps + 1, n) at the trajectory's times (row 0, the current time, is not used);
+        (steps + 1, n) at the trajectory's times (row 0, the current time, is not used),
+        the batch axes first ((B..., n), (B..., steps + 1, n)) to give each case its own;
         None: constant (as the last step left them).
 
         ``failures``: "raise" (default): a case whose step cannot be solved raises a
@@ -599,8 +600,8 @@ class Simulator:
         times = self.time + self.dt * np.arange(1, steps + 1)
         q = None
         if self.actuators:
-            q = (np.broadcast_to(self._q, (steps, self._q.size)) if inputs is None else
-                 self._schedule(inputs, times))
+            q = (np.broadcast_to(self._q[:, None], (len(self._q), steps, self.inputs.size))
+                 if inputs is None else self._schedule(inputs, times))
         elif inputs is not None:
             raise ValueError("inputs: these loads have no actuators (give them as "
                              f"actuators=...), got {format_value(inputs)}")
@@ -612,7 +613,7 @@ class Simulator:
         else:
             self._mark_failures(done, info, steps, times, out, energy)
         if q is not None:
-            self._q = np.array(q[-1])
+            self._q = np.array(q[:, -1])
         self._arrays = arrays
         self._fresh = False
         self.time = float(times[-1])
@@ -642,7 +643,8 @@ class Simulator:
         self._failed = failed.reshape(self.shape)
 
     def _checked_inputs(self, values, rows: int) -> np.ndarray:
-        """``values`` as (rows, n) finite floats, else ValueError naming ``inputs``."""
+        """``values`` as (C, rows, n) finite floats, C = 1 (the same for every case) or the
+        batch's case count (batch axes first), else ValueError naming ``inputs``."""
         n = self.inputs.size
         if not n:
             raise ValueError("inputs: these loads have no actuators (give them as "
@@ -651,25 +653,34 @@ class Simulator:
             q = np.asarray(values, dtype=np.float64)
         except (TypeError, ValueError):
             q = None
-        if q is None or q.shape not in ((rows, n),) + (((n,),) if rows == 1 else ()):
-            raise ValueError(f"inputs must be {'an array (n,)' if rows == 1 else 'a callable'}"
-                             f" {'' if rows == 1 else 'or an array (steps + 1, n)'} of the "
-                             f"actuators' n = {n} inputs, got {format_value(values)}")
+        one = ((n,), (rows, n)) if rows == 1 else ((rows, n),)
+        batched = ((*self.shape, n), (*self.shape, rows, n)) if rows == 1 else \
+            ((*self.shape, rows, n),)
+        if q is None or (q.shape not in one and (not self.shape or q.shape not in batched)):
+            wanted = "(n,)" if rows == 1 else "(steps + 1, n)"
+            raise ValueError(f"inputs must be an array {wanted} of the actuators' n = {n} "
+                             + ("" if rows == 1 else "inputs (or a callable of t), ")
+                             + (f"with the batch axes {self.shape} first if they differ per "
+                                "case, " if self.shape else "")
+                             + f"got {format_value(values)}")
         if not np.all(np.isfinite(q)):
             raise ValueError(f"inputs must be finite, got {format_value(values)}")
-        return q.reshape(rows, n)
+        cases = 1 if q.shape in one else int(np.prod(self.shape))
+        return q.reshape(cases, rows, n)
 
     def _schedule(self, inputs, times) -> np.ndarray:
-        """The inputs (steps, n) at the new step ``times`` from a callable or an array."""
+        """The inputs (C, steps, n) at the new step ``times`` from a callable or an array."""
         if callable(inputs):
             rows = []
             for t in times:
                 try:
-                    rows.append(self._checked_inputs(inputs(float(t)), 1)[0])
+                    rows.append(self._checked_inputs(inputs(float(t)), 1))
                 except ValueError as error:
                     raise ValueError(f"inputs({float(t)!r}): {error}") from None
-            return np.array(rows)
-        return self._checked_inputs(inputs, times.size + 1)[1:]
+            widest = max(row.shape[0] for row in rows)
+            return np.concatenate([np.broadcast_to(row, (widest, 1, row.shape[2]))
+                                   for row in rows], axis=1)
+        return self._checked_inputs(inputs, times.size + 1)[:, 1:]
 
     def _check(self, done, info, steps, times) -> None:
         failed = np.flatnonzero((done < steps) & (done >= 0))
