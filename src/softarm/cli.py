@@ -31,7 +31,7 @@ import numpy as np
 from . import __version__
 from .case import Case, CaseError, load_case
 from .errors import ConvergenceError, InadmissibleStateError, StabilityWarning
-from .io import FORMATS, load_saved, save_result
+from .io import FORMATS, is_trajectory_file, load_saved, load_trajectory, save_result
 from .sweep import solve_case
 
 __all__ = ["main"]
@@ -190,8 +190,12 @@ def _parser() -> argparse.ArgumentParser:
         "view", help="write an interactive 3D view of a saved result (HTML)",
         description="Write a self-contained HTML file (opens offline in any browser) with an "
         "interactive 3D view of a result written by 'softarm solve -o': the arm as a tube, "
-        "hover read-outs, the loads; a sweep gets a slider. Needs pip install 'softarm[view]'.")
-    view.add_argument("result", metavar="RESULT", help="result file (.csv, .json or .npz)")
+        "hover read-outs, the loads; a sweep gets a slider. A trajectory (.npz with a times "
+        "array, softarm.io.TRAJECTORY_ARRAYS): the moving arm with a time slider, play at "
+        "real time or a chosen rate, the tip's path and the energy plot. Needs pip install "
+        "'softarm[view]'.")
+    view.add_argument("result", metavar="RESULT",
+                      help="result file (.csv, .json or .npz) or trajectory (.npz)")
     view.add_argument("-o", "--output", metavar="HTML",
                       help="HTML file to write (default: RESULT with suffix .html)")
     view.set_defaults(run=_run_view)
@@ -627,11 +631,16 @@ def _run_view(args) -> int:
     source = Path(args.result)
     page = _check_output(args.output or str(source.with_suffix(".html")), (".html", ".htm"),
                          "page", [source])
-    saved = load_saved(source)
+    trajectory = is_trajectory_file(source)  # a motion (softarm.io.load_trajectory)
+    saved = load_trajectory(source) if trajectory else load_saved(source)
     try:
         from . import view
 
-        view.view_result_file(saved, page)
+        if trajectory:
+            view.write_trajectory_html(saved, page, arm=saved.arm, radii=saved.radii,
+                                       name=saved.name)
+        else:
+            view.view_result_file(saved, page)
     except ImportError as error:  # plotly missing
         raise CaseError(f"{page}: {error}") from None
     print(f"wrote {page}")

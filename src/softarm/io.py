@@ -30,9 +30,13 @@ from .lie import se3, so3
 __all__ = [
     "COLUMNS",
     "FORMATS",
+    "TRAJECTORY_ARRAYS",
     "SavedResult",
+    "SavedTrajectory",
+    "is_trajectory_file",
     "load_result",
     "load_saved",
+    "load_trajectory",
     "save_result",
     "write_atomic",
 ]
@@ -479,3 +483,110 @@ def _read_csv(path: Path):
     residual = np.asarray(meta.get("residual", np.nan), dtype=float)
     estimate = np.asarray(meta.get("error_estimate", np.nan), dtype=float)
     return meta, columns, poses, residual, estimate, sweep
+
+
+# ------------------------------------------------------------------------- trajectories
+
+#: The arrays a trajectory's NPZ file holds (named after :class:`softarm.Trajectory`'s
+#: attributes; T times, S stations): times (T,) s; s (S,) m; positions (T, S, 3) m, spatial;
+#: rotations (T, S, 3, 3) (columns e1 e2 e3, spatial); energy_kinetic, energy_elastic,
+#: energy_gravity, energy_dissipated (T,) J. Optional: radii (S,) m, the tube's radius at
+#: each station (for drawing); name, the case's name (a string); meta, JSON text whose
+#: "case" entry is a case as :func:`save_result` embeds it (its arm is drawn). Further arrays
+#: (velocities, strains, ...) may be present and are not read.
+TRAJECTORY_ARRAYS = ("times", "s", "positions", "rotations", "energy_kinetic",
+                     "energy_elastic", "energy_gravity", "energy_dissipated")
+
+
+@dataclass(frozen=True)
+class TrajectoryEnergy:
+    """A saved trajectory's energies (J), each (T,): as :class:`softarm.Energy`'s."""
+
+    kinetic: np.ndarray
+    elastic: np.ndarray
+    gravity: np.ndarray
+    dissipated: np.ndarray
+
+    @property
+    def total(self) -> np.ndarray:
+        return self.kinetic + self.elastic + self.gravity + self.dissipated
+
+
+@dataclass(frozen=True)
+class SavedTrajectory:
+    """A motion read by :func:`load_trajectory`: the arrays of :data:`TRAJECTORY_ARRAYS`
+    under :class:`softarm.Trajectory`'s names (``energy`` with its ``kinetic``, ...), what
+    the viewer draws (``radii`` or the case's ``arm``, ``name``) and the file's ``path``."""
+
+    times: np.ndarray
+    s: np.ndarray
+    positions: np.ndarray
+    rotations: np.ndarray
+    energy: TrajectoryEnergy
+    radii: np.ndarray | None
+    name: str | None
+    arm: object | None
+    path: Path
+
+
+def is_trajectory_file(path: str | os.PathLike) -> bool:
+    """True if ``path`` is an NPZ archive holding a ``times`` array (a trajectory, not an
+    equilibrium written by :func:`save_result`)."""
+    path = Path(path)
+    if path.suffix.lower() != ".npz" or not zipfile.is_zipfile(path):
+        return False
+    with zipfile.ZipFile(path) as archive:
+        return "times.npy" in archive.namelist()
+
+
+def load_trajectory(path: str | os.PathLike) -> SavedTrajectory:
+    """Read a trajectory's NPZ file (the arrays of :data:`TRAJECTORY_ARRAYS`).
+
+    Raises
+    ------
+    CaseError
+        If the file is missing, not an NPZ archive, or lacks an array or has one of the
+        wrong shape or with values that are not finite, naming it.
+    """
+    path = Path(path)
+    if not path.exists():
+        raise CaseError(f"{path}: no such file")
+    if path.is_dir() or not zipfile.is_zipfile(path):
+        raise CaseError(f"{path}: not a softarm trajectory file (not an NPZ archive, or "
+                        "truncated)")
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            arrays = {name: np.asarray(data[name], dtype=float) for name in TRAJECTORY_ARRAYS}
+            radii = np.asarray(data["radii"], dtype=float) if "radii" in data.files else None
+            name = str(data["name"]) if "name" in data.files else None
+            meta = json.loads(str(data["meta"])) if "meta" in data.files else {}
+    except KeyError as error:
+        raise CaseError(f"{path}: not a softarm trajectory file (no {error} array)") from None
+    except Exception as error:  # truncated or garbage archives
+        raise CaseError(f"{path}: not a softarm trajectory file ({type(error).__name__}: "
+                        f"{_brief(error)})") from None
+    T, S = arrays["times"].size, arrays["s"].size
+    shapes = {"times": (T,), "s": (S,), "positions": (T, S, 3), "rotations": (T, S, 3, 3),
+              **{name: (T,) for name in TRAJECTORY_ARRAYS[4:]}}
+    for key, shape in shapes.items():
+        if arrays[key].shape != shape:
+            raise CaseError(f"{path}: {key} must have shape {shape} (T = {T} times, S = {S} "
+                            f"stations), got {arrays[key].shape}")
+        if not np.all(np.isfinite(arrays[key])):
+            raise CaseError(f"{path}: {key} holds values that are not finite")
+    if T < 1 or S < 2 or np.any(np.diff(arrays["times"]) <= 0):
+        raise CaseError(f"{path}: times must increase and there must be two stations or more")
+    if radii is not None and (radii.shape != (S,) or not np.all(radii > 0)):
+        raise CaseError(f"{path}: radii must be {S} positive radii in m, got shape "
+                        f"{radii.shape}")
+    arm = None
+    if meta.get("case"):
+        try:
+            case = _parse(meta["case"], path, batched=True)
+        except CaseError as error:
+            raise CaseError(f"{path}: embedded case: {error}") from None
+        arm, name = case.arm, name or case.name
+    energy = TrajectoryEnergy(*(arrays[f"energy_{k}"] for k in
+                                ("kinetic", "elastic", "gravity", "dissipated")))
+    return SavedTrajectory(arrays["times"], arrays["s"], arrays["positions"],
+                           arrays["rotations"], energy, radii, name, arm, path)
