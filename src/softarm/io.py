@@ -556,12 +556,16 @@ def load_trajectory(path: str | os.PathLike) -> SavedTrajectory:
                         "truncated)")
     try:
         with np.load(path, allow_pickle=False) as data:
+            missing = [name for name in TRAJECTORY_ARRAYS if name not in data.files]
+            if missing:
+                raise CaseError(f"{path}: not a softarm trajectory file (no "
+                                f"{', '.join(missing)} array{'s' if len(missing) > 1 else ''})")
             arrays = {name: np.asarray(data[name], dtype=float) for name in TRAJECTORY_ARRAYS}
             radii = np.asarray(data["radii"], dtype=float) if "radii" in data.files else None
             name = str(data["name"]) if "name" in data.files else None
             meta = json.loads(str(data["meta"])) if "meta" in data.files else {}
-    except KeyError as error:
-        raise CaseError(f"{path}: not a softarm trajectory file (no {error} array)") from None
+    except CaseError:
+        raise
     except Exception as error:  # truncated or garbage archives
         raise CaseError(f"{path}: not a softarm trajectory file ({type(error).__name__}: "
                         f"{_brief(error)})") from None
