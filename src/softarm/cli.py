@@ -210,6 +210,15 @@ def _parser() -> argparse.ArgumentParser:
                      help="TCP port on 127.0.0.1 (default 8050; 0: any free port)")
     app.add_argument("--no-browser", action="store_true",
                      help="do not open a browser tab, only print the address")
+    app.add_argument("--dynamic", action="store_true",
+                     help="the arm in motion: the sliders drive a simulation stepped in real "
+                     "time (softarm.Simulator) and the page shows the arm swinging")
+    app.add_argument("--dt", type=_seconds, metavar="DT",
+                     help="the dynamic mode's time step in s (default 0.002; implies "
+                     "--dynamic)")
+    app.add_argument("--damping", type=_seconds, metavar="TAU",
+                     help="the dynamic mode's Kelvin-Voigt retardation time in s (default: "
+                     "undamped; implies --dynamic)")
     app.set_defaults(run=_run_app)
 
     inverse = commands.add_parser(
@@ -657,12 +666,28 @@ def _port(text: str) -> int:
     return value
 
 
+def _seconds(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a time in s, got {text!r}") from None
+    if not (np.isfinite(value) and value >= 0):
+        raise argparse.ArgumentTypeError(f"must be a time >= 0 s, got {text!r}")
+    return value
+
+
 def _run_app(args) -> int:
     case = load_case(args.case)
     from . import app
 
+    dynamics = None
+    if args.dynamic or args.dt is not None or args.damping is not None:
+        if args.dt == 0:
+            raise CaseError("--dt must be a positive time step in s, got 0")
+        dynamics = app.Dynamics(dt=args.dt or app.Dynamics.dt, damping=args.damping)
     try:
-        return app.serve(case, port=args.port, browser=not args.no_browser)
+        return app.serve(case, port=args.port, browser=not args.no_browser,
+                         dynamics=dynamics)
     except ImportError as error:  # plotly missing
         raise CaseError(str(error)) from None
 
