@@ -1,0 +1,118 @@
+"""The live app's dynamic mode over HTTP (no browser): the states it serves against
+softarm.Simulator.step replayed with the same inputs, its bad requests and its settings."""
+
+from __future__ import annotations
+
+import json
+import threading
+import time
+import urllib.error
+import urllib.request
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import softarm
+
+pytest.importorskip("plotly", reason="the app needs plotly: pip install 'softarm[view]'")
+
+from softarm import app
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+DYNAMICS = app.Dynamics(dt=2e-3, stations=21, damping=0.01)
+
+
+def get(url):
+    try:
+        with urllib.request.urlopen(url, timeout=60) as reply:
+            return reply.status, json.loads(reply.read())
+    except urllib.error.HTTPError as error:
+        return error.code, json.loads(error.read())
+
+
+@pytest.fixture(scope="module")
+def motion():
+    live = app.LiveMotion(softarm.load_case(EXAMPLES / "tendon_robot.toml"), DYNAMICS)
+    httpd = app.make_server(live, port=0)
+    thread = threading.Thread(target=httpd.serve_forever, kwargs={"poll_interval": 0.05},
+                              daemon=True)
+    thread.start()
+    live.start()
+    yield f"http://127.0.0.1:{httpd.server_address[1]}", live
+    live.stop()
+    httpd.shutdown()
+    httpd.server_close()
+
+
+def test_served_states_are_the_simulators(motion):
+    url, live = motion
+    status, first = get(url + "/state?after=-1")
+    assert status == 200
+    # change a tension and switch another tendon off, then take a state 40 steps later
+    status, body = get(url + f"/state?after={first['index']}&l2.tension=5.5&l3.on=0")
+    assert status == 200
+    index = body["index"]
+    while index < body["index"] + 40:
+        status, later = get(url + f"/state?after={index}")
+        index = later["index"]
+    status, history = get(url + "/history")
+    assert history["replayable"] and history["history"][0] == [0, [3.0, 1.0, 0.0]]
+    assert history["history"][-1][1] == [5.5, 0.0, 0.0]  # (tendon 2 switched off: 0 N)
+    # the second method: a Simulator of the same case stepped one step at a time
+    case = live.case
+    simulator = softarm.Simulator(case.arm, case.loads[1:], case.loads[:1], dt=DYNAMICS.dt,
+                                  stations=DYNAMICS.stations,
+                                  damping=softarm.Damping(retardation=DYNAMICS.damping),
+                                  initial=softarm.solve(case.arm, case.loads))
+    changes = dict((k, q) for k, q in history["history"])
+    q = None
+    for step in range(index):
+        q = changes.get(step, q)
+        state = simulator.step(q)
+    assert simulator.time == pytest.approx(later["time"], abs=1e-12)
+    # to the step's tolerance (1e-6 L): the server runs the steps in chunks (Simulator.run)
+    np.testing.assert_allclose(later["positions"], state.positions, rtol=0, atol=1e-6 * 0.25)
+    np.testing.assert_allclose(later["rotations"], state.rotations[-1], rtol=0, atol=1e-5)
+    # and the arm has moved: the new tension curls it
+    assert np.linalg.norm(np.subtract(later["positions"][-1], first["positions"][-1])) > 1e-3
+
+
+def test_bad_requests(motion):
+    url, _ = motion
+    status, body = get(url + "/state?after=x")
+    assert (status, body) == (400, {"error": "after must be a state index, got 'x'"})
+    status, body = get(url + "/state?after=0&l2.tension=99")
+    assert (status, body) == (400, {"error": "l2.tension must be in [0.0, 10.0] N, got 99.0"})
+    status, body = get(url + "/state?after=0&nothing=1")
+    assert status == 400 and body["error"].startswith("unknown input 'nothing'")
+
+
+def test_a_state_waits_for_a_newer_one(motion):
+    url, _ = motion
+    _, a = get(url + "/state?after=-1")
+    start = time.perf_counter()
+    _, b = get(url + f"/state?after={a['index']}")
+    assert b["index"] > a["index"] and b["time"] > a["time"]
+    assert time.perf_counter() - start < 1.0
+
+
+def test_passive_load_change_continues_from_the_state():
+    live = app.LiveMotion(softarm.load_case(EXAMPLES / "demo.toml"),
+                          app.Dynamics(dt=2e-3, stations=21))
+    with live._lock:
+        before = live._state
+        live.update({"l2.force.z": "0.5"})
+        assert live.simulator is not None and not live.replayable
+        # the new Simulator starts from the state it had (positions and time)
+        np.testing.assert_array_equal(live.simulator.state.positions, before.positions)
+        assert live.simulator.time == before.time
+        assert any(load.kind == "tip" and load.force[2] == 0.5 for load in live.simulator.loads
+                   if hasattr(load, "kind"))
+
+
+def test_dynamics_settings_are_checked():
+    with pytest.raises(ValueError, match=r"Dynamics\.dt must be a positive number, got 0"):
+        app.Dynamics(dt=0)
+    with pytest.raises(ValueError, match=r"Dynamics\.damping must be a retardation time"):
+        app.Dynamics(damping=-1.0)
