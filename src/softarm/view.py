@@ -505,7 +505,8 @@ _DRAW = """(function () {
   // A motion's player: the last frame whose time has come at the chosen rate (real time:
   // the trajectory's own seconds), redrawn as soon as the previous redraw is done; frames
   // that come faster than the browser redraws are skipped, the motion keeps its pace.
-  // gd.softarmPlayed lists [frame, wall-clock ms] of each frame drawn while playing.
+  // gd.softarmPlayed lists [frame, the playback's clock (s of the trajectory), the wall
+  // clock (ms)] when each frame drawn while playing was chosen.
   function motion(gd, tips) {
     var times = fig.player.times, rates = fig.player.rates, n = times.length;
     var names = fig.frames.map(function (frame) { return frame.name; });
@@ -528,8 +529,9 @@ _DRAW = """(function () {
             setTimeout(tick, Math.max(0, (times[k + 1] - t) / rate * 1000));
             return;
           }
+          var chosen = performance.now();
           show(j).then(function () {
-            gd.softarmPlayed.push([j, performance.now()]);
+            gd.softarmPlayed.push([j, t, chosen]);
             if (j >= n - 1) playing = null; else requestAnimationFrame(tick);
           });
         })();
