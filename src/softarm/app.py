@@ -17,6 +17,9 @@ words); ``GET /reset`` the same after returning to the unloaded arm. A bad reque
 unknown name, a value that is not a finite number or is out of its slider's range) gets
 HTTP 400 with ``{"error": message}``; a load the solver cannot follow (a fold, a load too large
 for the arm) gets HTTP 422 with the message, and the arm stays where it was.
+
+``softarm app CASE.toml --dynamic``: the arm in motion (:class:`LiveMotion`, see "dynamic
+mode" below; endpoints ``/state``, ``/reset``, ``/history``: docs/cli.md).
 """
 
 from __future__ import annotations
@@ -759,8 +762,9 @@ class LiveMotion:
 
     def update(self, query: dict[str, str]) -> None:
         """Set inputs from a request's query (BadRequest naming a bad one): the actuators'
-        from the next step on; a change of another load continues from the current state
-        with a new Simulator (:class:`ConvergenceError` or ValueError if it cannot)."""
+        from the thread's next chunk of steps on; a change of another load continues from
+        the current state with a new Simulator (:class:`ConvergenceError` or ValueError if
+        it cannot)."""
         old = self.values
         self.values = _updated(self.by_name, old, query)
         passive = [name for name in query if self.by_name[name].load not in self._actuated]

@@ -1,5 +1,8 @@
 """Interactive 3D views of equilibria in a browser: ``softarm view RESULT -o view.html``,
-:meth:`softarm.Equilibrium.show` and the figures of the live app (``softarm app``).
+:meth:`softarm.Equilibrium.show` and the figures of the live app (``softarm app``); and of
+motions (:func:`trajectory_figure`, :func:`write_trajectory_html`, ``softarm view
+TRAJECTORY.npz``): the moving arm with a time slider, a player at real time or a chosen rate,
+the tip's path and the energy plot (see "trajectories" below).
 
 The figures are built here as plain dicts in plotly's figure schema (``data``, ``layout``,
 ``frames``; a sweep's tip plot as a second figure under ``"tips"``) from
