@@ -47,14 +47,20 @@ def motion():
 
 def test_served_states_are_the_simulators(motion):
     url, live = motion
-    status, first = get(url + "/state?after=-1")
+    status, reply = get(url + "/state?after=-1")
     assert status == 200
+    first = reply["states"][0]
     # change a tension and switch another tendon off, then take a state 40 steps later
-    status, body = get(url + f"/state?after={first['index']}&l2.tension=5.5&l3.on=0")
+    status, reply = get(url + f"/state?after={first['index']}&l2.tension=5.5&l3.on=0")
     assert status == 200
-    index = body["index"]
-    while index < body["index"] + 40:
-        status, later = get(url + f"/state?after={index}")
+    index = start = reply["states"][-1]["index"]
+    while index < start + 40:
+        status, reply = get(url + f"/state?after={index}")
+        later = reply["states"][-1]
+        # the states after the index asked for, in order
+        assert [s["index"] for s in reply["states"]] == sorted({s["index"] for s in
+                                                                 reply["states"]})
+        assert reply["states"][0]["index"] > index
         index = later["index"]
     status, history = get(url + "/history")
     assert history["replayable"] and history["history"][0] == [0, [3.0, 1.0, 0.0]]
@@ -91,8 +97,10 @@ def test_bad_requests(motion):
 def test_a_state_waits_for_a_newer_one(motion):
     url, _ = motion
     _, a = get(url + "/state?after=-1")
+    a = a["states"][-1]
     start = time.perf_counter()
     _, b = get(url + f"/state?after={a['index']}")
+    b = b["states"][0]
     assert b["index"] > a["index"] and b["time"] > a["time"]
     assert time.perf_counter() - start < 1.0
 

@@ -24,6 +24,7 @@ mode" below; endpoints ``/state``, ``/reset``, ``/history``: docs/cli.md).
 
 from __future__ import annotations
 
+import collections
 import contextlib
 import errno
 import html
@@ -534,7 +535,7 @@ class _Handler(BaseHTTPRequestHandler):
                         body = None
                         failure = _one_line(f"cannot continue with these inputs: {error}")
                     else:
-                        body, failure = live.state_after(after), None
+                        body, failure = live.states_after(after), None
                 if failure is not None:
                     self._json(422, {"error": failure})
                 else:
@@ -679,13 +680,15 @@ class Dynamics:
 
 #: The longest a request for a newer state waits, s.
 _WAIT = 1.0
-#: A thread step advances at most this much wall-clock time's worth of steps, s: beyond, the
-#: simulation falls behind real time (and the page says so) instead of catching up in bursts.
+#: A chunk of steps covers at most this much time, s (wall clock times the rate).
 _CHUNK = 0.05
 #: The compute time of a chunk of steps at most (when there is that much to do), s: a new
 #: state at least this often (a chunk's cost is mostly per call for a few steps: about 5 ms
 #: with three tendons, 0.6 ms per step at 41 stations on a 2-core machine).
 _FRAME = 0.02
+#: How far the simulation runs ahead of the wall clock, s (the states of a chunk are shown as
+#: their time comes; an input takes effect about this much later).
+_AHEAD = 0.06
 #: With no request for this long (no page open), the simulation pauses, s.
 _IDLE = 5.0
 
@@ -694,7 +697,7 @@ class LiveMotion:
     """A case in motion: its controls (:func:`inputs`), a :class:`softarm.Simulator` stepped
     in a thread on the wall clock, and the newest state for the page.
 
-    ``start()`` runs the thread, ``stop()`` ends it; :meth:`state_after` waits for a state
+    ``start()`` runs the thread, ``stop()`` ends it; :meth:`states_after` waits for states
     newer than an index. ``history`` lists (step index, inputs) of each change of the
     actuators' inputs: the steps after the index use them (the simulation reproduces with
     :meth:`softarm.Simulator.step`)."""
@@ -742,6 +745,8 @@ class LiveMotion:
 
     def _build(self, initial) -> None:
         """A Simulator for the current values of the passive loads, from ``initial``."""
+        if hasattr(self, "simulator"):  # a new start, after the states already served
+            self.index += 1
         d = self.dynamics
         actuators = [self.case.loads[i] for i in self._actuated]
         self.simulator = self._Simulator(self.case.arm, actuators, self._passive(), dt=d.dt,
@@ -754,11 +759,48 @@ class LiveMotion:
         self._publish(self.simulator.state)
 
     def _publish(self, state) -> None:
+        """A new start (the first state, a reset, a load change): the buffer holds ``state``
+        alone, shown at once."""
         self._state = state
-        self.newest = {"index": self.index, "time": float(state.time),
-                       "positions": np.asarray(state.positions).tolist(),
-                       "rotations": np.asarray(state.rotations[..., -1, :, :]).tolist()}
+        self._buffer = collections.deque([self._entry(self.index, state.time,
+                                                      state.positions, state.rotations[-1])])
+        self._anchor()
         self._lock.notify_all()
+
+    @staticmethod
+    def _entry(index, t, positions, tip_rotation) -> dict:
+        return {"index": int(index), "time": float(t),
+                "positions": np.asarray(positions).tolist(),
+                "rotations": np.asarray(tip_rotation).tolist()}
+
+    def _extend(self, trajectory, steps: int) -> None:
+        """The states of a chunk of ``steps`` steps, into the buffer (shown as their time
+        comes, :meth:`_shown`)."""
+        first = self.index
+        self.index += steps
+        self._state = trajectory.final
+        for k in range(1, steps + 1):
+            self._buffer.append(self._entry(first + k, trajectory.times[k],
+                                            trajectory.positions[k],
+                                            trajectory.rotations[k, -1]))
+        self._lock.notify_all()
+
+    def _clock(self) -> float:
+        """The simulation time the wall clock says now (s)."""
+        return self._time0 + (time.perf_counter() - self._wall0) * self.dynamics.rate
+
+    def _shown(self) -> dict:
+        """The state to show now: the last buffered one whose time has come (the older ones
+        leave the buffer), else the first."""
+        now = self._clock()
+        while len(self._buffer) > 1 and self._buffer[1]["time"] <= now:
+            self._buffer.popleft()
+        return self._buffer[0]
+
+    @property
+    def newest(self) -> dict:
+        """The state shown now (callers hold the lock)."""
+        return self._shown()
 
     def update(self, query: dict[str, str]) -> None:
         """Set inputs from a request's query (BadRequest naming a bad one): the actuators'
@@ -788,7 +830,6 @@ class LiveMotion:
 
     def _anchor(self) -> None:
         self._wall0, self._time0 = time.perf_counter(), self._state.time
-        self._rates = []
 
     def start(self) -> None:
         with self._lock:
@@ -807,10 +848,12 @@ class LiveMotion:
             self._thread.join()
 
     def _run(self) -> None:
-        """The thread: steps up to the wall clock's time, in chunks run outside the lock
-        (the compiled steps release the GIL: requests are answered meanwhile); a chunk of a
-        Simulator replaced meanwhile (a load changed, a reset) is dropped."""
-        dt = self.dynamics.dt
+        """The thread: keeps the buffer of states _AHEAD s ahead of the wall clock, in chunks
+        run outside the lock (the compiled steps release the GIL: requests are answered
+        meanwhile); a chunk of a Simulator replaced meanwhile (a load changed, a reset) is
+        dropped. A simulation slower than real time shows each chunk's last state as soon as
+        it is computed (the clock is set back to it)."""
+        dt, rate = self.dynamics.dt, self.dynamics.rate
         while True:
             with self._lock:
                 if not self._running:
@@ -820,22 +863,24 @@ class LiveMotion:
                     self._lock.wait(0.2)
                     self._anchor()
                     continue
-                target = self._time0 + (now - self._wall0) * self.dynamics.rate
-                due = int((target - self._state.time) / dt)
-                if due < 1:
-                    self._lock.wait(max(1e-3, (self._state.time + dt - target)
-                                        / self.dynamics.rate))
+                clock, end = self._clock(), self._state.time
+                if clock > end:  # behind: the buffer ran out, the clock waits for the steps
+                    self._time0, self._wall0 = end, now
+                    clock = end
+                if end - clock > 0.5 * _AHEAD * rate:  # ahead enough: wait
+                    self._lock.wait((end - clock - 0.5 * _AHEAD * rate) / rate)
                     continue
-                most = max(1, int(_CHUNK * self.dynamics.rate / dt))
+                due = int((clock + _AHEAD * rate - end) / dt)
+                most = max(1, int(_CHUNK * rate / dt))
                 if self.step_ms is not None:  # and a chunk computed in about _FRAME
                     most = min(most, max(1, int(1e3 * _FRAME / self.step_ms)))
-                steps, simulator, q = min(due, most), self.simulator, self._q
+                steps, simulator, q = max(1, min(due, most)), self.simulator, self._q
                 if q is not None and q.tolist() != self.history[-1][1]:
                     self.history.append((self.index, q.tolist()))
             start = time.perf_counter()
             try:
                 inputs = None if q is None else np.broadcast_to(q, (steps + 1, q.size))
-                final = simulator.run(steps, inputs).final
+                trajectory = simulator.run(steps, inputs)
             except Exception as error:  # a step that cannot be solved: stop there
                 with self._lock:
                     self.failure = _one_line(f"the simulation stopped: {error}")
@@ -845,32 +890,38 @@ class LiveMotion:
             with self._lock:
                 if simulator is not self.simulator:
                     continue
-                self.index += steps
-                self._publish(final)
+                self._extend(trajectory, steps)
                 self.step_ms = 1e3 * (time.perf_counter() - start) / steps
                 self.published += 1
-                if due > most:  # behind: the simulation runs slower than real time
-                    self._time0, self._wall0 = final.time, time.perf_counter()
 
-    def state_after(self, index: int, timeout: float = _WAIT) -> dict:
-        """The newest state once its index exceeds ``index`` (or after ``timeout`` s), with
+    def states_after(self, index: int, timeout: float = _WAIT) -> dict:
+        """The states computed after step ``index`` (waiting up to ``timeout`` s for one),
+        from the one shown now on, including those whose time has not come yet (the page
+        shows each at its time, on the clock sent along), at most one per 1/120 s; with
         the page's read-outs (callers hold the lock)."""
         self._seen = time.perf_counter()
         end = self._seen + timeout
-        while self.newest["index"] <= index and self._running:
+        self._shown()
+        while self._buffer[-1]["index"] <= index and self._running:
             left = end - time.perf_counter()
             if left <= 0:
                 break
             self._lock.wait(left)
-        body = dict(self.newest)
-        body["headings"] = _headings(self.case, self.values)
-        body["step_ms"] = self.step_ms
-        body["stopped"] = self.failure
+            self._shown()
+        spacing = self.dynamics.rate / 120.0
+        states, last = [], -math.inf
+        for k, entry in enumerate(self._buffer):
+            final = k == len(self._buffer) - 1
+            if entry["index"] > index and (entry["time"] >= last + spacing or final):
+                states.append(entry)
+                last = entry["time"]
         slow = self.step_ms is not None and self.step_ms > 1e3 * self.dynamics.dt / \
             self.dynamics.rate
-        body["behind"] = (f"a step of {1e3 * self.dynamics.dt:g} ms takes "
-                          f"{self.step_ms:.2f} ms") if slow else None
-        return body
+        return {"states": states, "clock": self._clock(), "rate": self.dynamics.rate,
+                "headings": _headings(self.case, self.values), "step_ms": self.step_ms,
+                "stopped": self.failure,
+                "behind": (f"a step of {1e3 * self.dynamics.dt:g} ms takes "
+                           f"{self.step_ms:.2f} ms") if slow else None}
 
     def page(self) -> bytes:
         """The dynamic mode's page."""
@@ -879,10 +930,10 @@ class LiveMotion:
                  for i in self.inputs]
         case, d = self.case, self.dynamics
         with self._lock:
-            first = self.state_after(-1)
+            first = self.states_after(-1)
         scene = {"length": float(case.arm.length), "s": self.simulator.s.tolist(),
                  "radii": None if self.radii is None else self.radii.tolist(),
-                 "base": first["positions"][0], "dt": d.dt, "rate": d.rate}
+                 "base": first["states"][0]["positions"][0], "dt": d.dt, "rate": d.rate}
         settings = (f"dynamic: Δt = {d.dt:g} s, {d.stations} stations, "
                     + ("undamped" if d.damping is None else f"damping τ = {d.damping:g} s")
                     + ("" if d.rate == 1 else f", {d.rate:g} × real time"))
@@ -895,10 +946,11 @@ class LiveMotion:
 
 
 # The dynamic mode's page: the controls, and the arm drawn on a canvas (see the note at
-# "dynamic mode" above). The loop: the next state is asked for as soon as one arrives
-# (GET /state?after=INDEX, with the inputs if a control changed), and each arrived one is
-# drawn at the next animation frame; window.softarmFrames lists [state index, time ms] of each
-# drawn frame (the browser tests count them).
+# "dynamic mode" above). The states are asked for as soon as the last ones arrived (GET
+# /state?after=INDEX, with the inputs if a control changed: the server's states after INDEX,
+# some of them ahead of its clock); each animation frame draws the last one whose time has
+# come on the server's clock. window.softarmFrames lists [state index, time, round trip,
+# drawing] (ms) of each drawn frame (the browser tests count them).
 _MOTION_PAGE = """<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>softarm app: {name} (dynamic)</title>
 <link rel="icon" href="data:,">
@@ -999,15 +1051,17 @@ canvas.addEventListener("pointermove", e => {{
 canvas.addEventListener("wheel", e => {{ e.preventDefault();
   zoom *= Math.exp(-0.001 * e.deltaY); if (shown) draw(shown); }}, {{passive: false}});
 window.addEventListener("resize", size);
-let index = -1, resetting = false, last = performance.now();
+let index = -1, resetting = false, offset = null, drawn = -1;
+const queue = [];  // states received and not drawn yet, in order
 async function fetchState(after) {{
   const parts = resetting ? [] : ["after=" + after];
   if (changed) parts.push(changed);
   const path = (resetting ? "/reset?" : "/state?") + parts.join("&");
+  if (resetting) {{ queue.length = 0; drawn = -1; }}
   changed = null; resetting = false;
   const sent = performance.now(), reply = await fetch(path), body = await reply.json();
   if (!reply.ok) throw new Error(body.error);
-  body.fetched = performance.now(); body.wait = body.fetched - sent;
+  body.wait = performance.now() - sent;
   return body;
 }}
 document.getElementById("reset").addEventListener("click", () => {{
@@ -1016,42 +1070,56 @@ document.getElementById("reset").addEventListener("click", () => {{
     const out = document.getElementById(item.name + ".out");
     if (out) out.textContent = Number(item.value).toPrecision(4); }});
   changed = null; resetting = true; trail.length = 0; }});
-async function loop() {{
-  let pending = fetchState(index);
+let info = null;
+function receive(body) {{
+  for (const state of body.states) {{
+    if (state.index > index) {{ queue.push(state); index = state.index; }}
+  }}
+  // the simulation's clock: its time now is (performance.now() / 1000) * rate + offset
+  offset = body.clock - performance.now() / 1000 * body.rate;
+  info = body;
+}}
+async function poll() {{  // the states, as soon as the server has new ones
   for (;;) {{
-    let body;
-    try {{ body = await pending; error.textContent = ""; }}
+    try {{ receive(await fetchState(index)); error.textContent = ""; }}
     catch (e) {{
       error.textContent = String(e.message || e);
       await new Promise(done => setTimeout(done, 300));
-      pending = fetchState(index); continue;
     }}
-    index = Math.max(index, body.index);
-    pending = fetchState(index);  // in flight while this one is drawn
-    await new Promise(done => requestAnimationFrame(done));
-    const tip = body.positions[body.positions.length - 1], drawing = performance.now();
-    trail.push(tip); if (trail.length > 120) trail.shift();
-    draw(body);
-    const now = performance.now();
-    // [state index, drawn at, the request's round trip, waiting for the frame, drawing] ms
-    window.softarmFrames.push([body.index, now, body.wait, drawing - body.fetched,
-                               now - drawing]);
-    for (const [name, text] of Object.entries(body.headings)) {{
-      const check = document.getElementById(name);
-      if (check) check.parentElement.lastChild.textContent = " " + text;
-    }}
-    const frames = window.softarmFrames;
-    const back = frames.length > 30 ? frames[frames.length - 31] : null;
-    status.textContent = "t  " + body.time.toFixed(3) + " s (step " + body.index + ")\\ntip  (" +
-      tip.map(v => v.toPrecision(4)).join(", ") + ") m" +
-      (body.step_ms === null ? "" : "\\nstep  " + body.step_ms.toFixed(2) + " ms") +
-      (back ? "\\nframes  " + (30000 / (now - back[1])).toFixed(0) + " per second" : "") +
-      (body.behind ? "\\nslower than real time: " + body.behind : "");
-    if (body.stopped) error.textContent = body.stopped;
   }}
 }}
+function frame() {{  // each animation frame: the last received state whose time has come
+  requestAnimationFrame(frame);
+  if (offset === null || !queue.length) return;
+  const clock = performance.now() / 1000 * info.rate + offset;
+  let state = null;
+  while (queue.length && (queue[0].time <= clock || state === null && queue.length > 40))
+    state = queue.shift();
+  if (state === null || state.index <= drawn) return;
+  const start = performance.now(), tip = state.positions[state.positions.length - 1];
+  trail.push(tip); if (trail.length > 120) trail.shift();
+  draw(state);
+  drawn = state.index;
+  const now = performance.now();
+  // [state index, drawn at, the last request's round trip, drawing] ms
+  window.softarmFrames.push([state.index, now, info.wait, now - start]);
+  for (const [name, text] of Object.entries(info.headings)) {{
+    const check = document.getElementById(name);
+    if (check) check.parentElement.lastChild.textContent = " " + text;
+  }}
+  const frames = window.softarmFrames;
+  const back = frames.length > 30 ? frames[frames.length - 31] : null;
+  status.textContent = "t  " + state.time.toFixed(3) + " s (step " + state.index +
+    ")\\ntip  (" + tip.map(v => v.toPrecision(4)).join(", ") + ") m" +
+    (info.step_ms === null ? "" : "\\nstep  " + info.step_ms.toFixed(2) + " ms") +
+    (back ? "\\nframes  " + (30000 / (now - back[1])).toFixed(0) + " per second" : "") +
+    (info.behind ? "\\nslower than real time: " + info.behind : "");
+  if (info.stopped) error.textContent = info.stopped;
+}}
 size();
-draw({first});
-loop();
+receive({first});
+draw(queue[0]);
+poll();
+requestAnimationFrame(frame);
 </script></body></html>
 """
