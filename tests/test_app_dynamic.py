@@ -124,3 +124,16 @@ def test_dynamics_settings_are_checked():
         app.Dynamics(dt=0)
     with pytest.raises(ValueError, match=r"Dynamics\.damping must be a retardation time"):
         app.Dynamics(damping=-1.0)
+
+
+@pytest.mark.parametrize(("argv", "message"), [
+    (["--dt", "0"], "softarm: error: --dt must be a positive time step in s, got 0\n"),
+    (["--dt", "x"], "argument --dt: must be a time in s, got 'x'"),
+    (["--damping", "-1"], "argument --damping: must be a time >= 0 s, got '-1'"),
+])
+def test_cli_dynamic_options(argv, message, capsys):
+    from softarm import cli
+
+    assert cli.main(["app", str(EXAMPLES / "demo.toml"), "--no-browser", *argv]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and message in err and err.strip().count("\n") <= 1
