@@ -5,8 +5,9 @@ Usage: ``python benchmarks/dynamics_pyelastica.py`` (needs ``pip install ".[benc
 For each n_elem in (10, 20, 40, 80, 160) and each clamp placement, PyElastica's
 ``PositionVerlet`` runs the 1.5-s swing at the time step ``cfl * 2 / omega_max`` (the explicit
 stability limit of the fastest element mode, rounded down to divide 0.01 s) and the tip is
-compared with the method-of-lines reference ``tests/data/swinging_arm_mol.csv`` at t = 0,
-0.01, ..., 1.5 s. The table prints the max tip error (in L), wall and CPU seconds
+compared with the method-of-lines reference
+``src/softarm/validation/data/swinging_arm_mol.csv`` at t = 0, 0.01, ..., 1.5 s. The table
+prints the max tip error (in L), wall and CPU seconds
 (``time.process_time``); the coarsest setting with error <= 1e-3 L is reported by
 :func:`coarsest_passing`, whose result (a :class:`Run`) is the cost to set softarm's own run
 beside (see :func:`main`).

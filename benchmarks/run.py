@@ -713,9 +713,18 @@ def main(argv=None) -> int:
         if route == "softarm auto" and name.startswith("hose L = 3 m"):
             verdict.append(f"a 3 m hanging hose ≤ 5 ms (issue 31): "
                            f"{'met' if wall <= 5e-3 else 'NOT met'}: {1e3 * wall:.1f} ms")
+    import dynamics  # (benchmarks/dynamics.py, beside this script)
+
+    if quick:
+        dynamics_lines = ["## Dynamics", "",
+                          "Skipped with --quick: `python benchmarks/dynamics.py`."]
+    else:
+        dynamics_lines = dynamics.measure(False, with_pyelastica=not args.no_pyelastica)
+        dynamics_lines = dynamics_lines.rstrip("\n").split("\n")
     elapsed = time.perf_counter() - t_start
     text = report(env, comp, rows, ref_notes, pyel_note, (closed, closed_principal, closed_serial),
-                  batch, verdict, quick, elapsed, stiff.markdown(stiff_rows, stiff_repeats))
+                  batch, verdict, quick, elapsed,
+                  [*stiff.markdown(stiff_rows, stiff_repeats), "", *dynamics_lines])
     print()
     print(table(rows))
     print()

@@ -1,8 +1,10 @@
 """Method-of-lines reference for planar Reissner rod dynamics (the swinging arm).
 
-Written from the equations alone for softarm's rod dynamics; it imports nothing from softarm.
-Run it as a script (``python tests/_mol_rod.py``) to regenerate
-``tests/data/swinging_arm_mol.csv`` (see :func:`main`; add ``--cache DIR`` to reuse runs).
+Written from the equations alone for softarm's rod dynamics; its model imports nothing from
+softarm (only :func:`load_reference` reads the stored file with the package's reader). Run it
+as a script (``python tests/_mol_rod.py``) to regenerate
+``src/softarm/validation/data/swinging_arm_mol.csv`` (shipped: ``softarm reproduce`` reads
+it; see :func:`main`; add ``--cache DIR`` to reuse runs).
 
 The continuum. A planar Cosserat rod in the x-z plane, clamped at the origin with its axis
 along +x, free at s = L; arc length s, position r(s, t) = (x, z), section angle θ(s, t) from
@@ -61,7 +63,8 @@ __all__ = [
     "swinging_arm",
 ]
 
-_DATA = Path(__file__).resolve().parent / "data" / "swinging_arm_mol.csv"
+_DATA = (Path(__file__).resolve().parents[1] / "src" / "softarm" / "validation" / "data"
+         / "swinging_arm_mol.csv")
 
 
 @dataclass(frozen=True)
@@ -338,7 +341,7 @@ def _study(case, cells, rtol, rtol_check, cache, length):
 
 
 def main(argv=None) -> None:
-    """Convergence study in n_cells and rtol, then write tests/data/swinging_arm_mol.csv."""
+    """Convergence study in n_cells and rtol, then write the reference file (_DATA)."""
     import argparse
 
     parser = argparse.ArgumentParser(description=main.__doc__)
@@ -379,14 +382,13 @@ def main(argv=None) -> None:
 
 
 def load_reference(case: str = "undamped"):
-    """(t, tip_xz) of ``case`` ('undamped' or 'damped') from tests/data/swinging_arm_mol.csv."""
+    """(t, tip_xz) of ``case`` ('undamped' or 'damped') from the reference file (read by the
+    package's reader: softarm reproduce uses it too)."""
+    from softarm.validation._motion import swinging_arm_reference
+
     if case not in CASES:
         raise ValueError(f"case must be one of {sorted(CASES)}, got {case!r}")
-    lines = [ln for ln in _DATA.read_text().splitlines() if not ln.startswith("#")]
-    names = lines[0].split(",")
-    data = np.array([[float(v) for v in ln.split(",")] for ln in lines[1:]])
-    cols = [names.index(f"x_{case}_m"), names.index(f"z_{case}_m")]
-    return data[:, names.index("t_s")], data[:, cols]
+    return swinging_arm_reference(case)
 
 
 if __name__ == "__main__":

@@ -34,7 +34,8 @@ print(repr(eq.tip_position.tolist()))
 #: kernels of other capabilities: a passive solve from the unloaded arm compiles none
 _NOT_PASSIVE = ("_law", "_dipole", "_actuator_rates", "_ldl_substitute", "_implicit_function",
                 "inverse_newton", "box_least_squares", "shoot", "sweep_point",
-                "solve_stiff_cases", "_band_factor", "_ms_evaluate")
+                "solve_stiff_cases", "_band_factor", "_ms_evaluate", "dynamic_steps",
+                "_node_rates", "_dyn_newton")
 
 
 def _python(code: str, *args: str, cache: Path, notice: bool = True, prefetch: bool = False):

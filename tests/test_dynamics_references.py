@@ -2,9 +2,10 @@
 
 - The natural frequencies of a cantilever from a simulated free vibration against
   Timoshenko's beam (first two bending modes, shear factor and rotary inertia included), the
-  first torsional and first axial frequency (tests/_timoshenko.py), to 0.2 % at Δt = T/200.
+  first torsional and first axial frequency (softarm/validation/_timoshenko.py), to 0.2 % at
+  Δt = T/200 (softarm reproduce runs the same checks: softarm/validation/_motion.py).
 - The heavy soft arm released horizontal, swinging down under gravity, against the
-  method-of-lines solution of tests/_mol_rod.py (tests/data/swinging_arm_mol.csv).
+  method-of-lines solution of tests/_mol_rod.py (softarm/validation/data/swinging_arm_mol.csv).
 - Till, Aloi & Rucker's steel cantilever (their C++ example at a stated commit,
   tests/data/till_rucker/).
 - The order of the scheme in Δt.
@@ -13,49 +14,24 @@
 from __future__ import annotations
 
 import json
-import math
 from pathlib import Path
 
 import numpy as np
 import pytest
 from _mol_rod import load_reference
-from _timoshenko import cantilever_axial, cantilever_bending, cantilever_torsion
-from scipy.optimize import minimize_scalar
 
 import softarm
 from softarm import Arm, Circle, Damping, Gravity, Material, Simulator, TipLoad, simulate
+from softarm.validation._motion import dominant_frequency as _frequency
+from softarm.validation._motion import free_vibration as _released
+from softarm.validation._timoshenko import (
+    cantilever_axial,
+    cantilever_bending,
+    cantilever_torsion,
+)
 
 DATA = Path(__file__).parent / "data"
 THICK = Arm(0.2, Circle(0.01), Material(1e7, poisson_ratio=0.5, density=1100.0))  # L/r = 20
-
-
-def _frequency(signal, dt, near) -> float:
-    """The angular frequency of the strongest oscillation near ``near`` (rad/s) in a
-    uniformly sampled signal: the maximum of its Hann-windowed periodogram, found by a
-    bounded search between the neighbouring FFT bins (for a pure sinusoid this is its
-    frequency to far better than a bin)."""
-    x = np.asarray(signal) - np.mean(signal)
-    t = np.arange(x.size) * dt
-    window = np.hanning(x.size)
-
-    def power(omega):
-        return -abs(np.sum(window * x * np.exp(-1j * omega * t)))
-
-    bin_ = 2 * math.pi / (x.size * dt)
-    grid = near + bin_ * np.linspace(-3, 3, 61)
-    start = grid[np.argmin([power(w) for w in grid])]
-    found = minimize_scalar(power, bounds=(start - bin_ / 10, start + bin_ / 10),
-                            method="bounded", options={"xatol": 1e-10 * near})
-    return float(found.x)
-
-
-def _released(arm, loads, mode_omega, stations=51, periods=20):
-    """A free vibration from the equilibrium under ``loads`` (no load after): the
-    trajectory at Δt = T/200 of the mode of angular frequency ``mode_omega``."""
-    dt = 2 * math.pi / mode_omega / 200
-    bent = softarm.solve(arm, loads, s=stations, tol=1e-12)
-    return simulate(arm, [], duration=200 * periods * dt, dt=dt, stations=stations,
-                    initial=bent, tol=1e-11), dt
 
 
 def _section(arm):
@@ -165,3 +141,40 @@ def test_till_aloi_ruckers_cantilever():
     # measured 3.9e-5 m (1.2e-4 m at 101 stations: the trapezoidal rule's O(h²))
     assert np.abs(tip[:, 1] - reference["x_extrap"]).max() < 8e-5
     assert np.abs(tip[:, 0] - reference["z_extrap"]).max() < 8e-5
+
+
+def test_till_aloi_ruckers_tendon_robot_converges_to_softarm():
+    """Their example 02_Dynamics/03_Tendon_Robot: a spring-steel rod with one tendon,
+    displacement-controlled by a motor that pulls the arm up, holds it and lets it fall
+    (25 s, BDF2, Δt = 50 ms, bending damping), run on 200 (their default), 400 and 800
+    points (tests/data/till_rucker/). softarm is driven by each run's tension history (its
+    tendons are tension-controlled in dynamics) and its tip compared with theirs: their
+    s-integrator is explicit Euler, first order, so the distance halves with each doubling
+    of their points (measured 12.0, 6.0, 3.0 mm of a 0.6 m swing): their code converges
+    to softarm's answer. Their quadratic drag (1e-4 kg/m², below 1e-4 of the weight at
+    these speeds) is not modelled."""
+    params = json.loads((DATA / "till_rucker" / "params.json").read_text())["tendon_robot"]
+    section = params["section"]
+    EA, GA, _ = section["Kse_softarm_order_EA_GA_GA"]
+    GJ, EI, _ = section["Kbt_softarm_order_GJ_EI_EI"]
+    rod = Arm.from_stiffness(params["length"], EA, GA, GA, GJ, EI, EI,
+                             mass_per_length=section["rhoA"],
+                             inertia_per_length=section["rhoJ_softarm_order"])
+    offset = params["tendon"]["offset_softarm_frame"]
+    gravity = Gravity(params["gravity_softarm_frame"])
+    bending = Damping(matrix=np.diag([0.0, 0.0, 0.0, *params["Bbt_their_order"]]))
+    distances = []
+    for name, header in (("tendon_tip_N400.csv", 3), ("tendon_tip_N800.csv", 3)):
+        theirs = np.genfromtxt(DATA / "till_rucker" / name, delimiter=",", comments="#",
+                               skip_header=header, names=True)
+        tendon = softarm.Tendon(float(theirs["tension"][0]),
+                                softarm.routing.Straight(offset[1], offset[2]))
+        start = softarm.solve(rod, [gravity, tendon], s=201)
+        path = simulate(rod, [gravity], actuators=[tendon], inputs=theirs["tension"][:, None],
+                        duration=0.05 * (theirs.size - 1), dt=0.05, stations=201,
+                        initial=start, alpha=0.0, damping=bending)
+        tip = path.tip_position  # theirs: x = softarm's y, z = softarm's x
+        assert np.ptp(theirs["x"]) > 0.5  # the arm swings up by 0.6 m and back
+        distances.append(np.hypot(tip[:, 0] - theirs["z"], tip[:, 1] - theirs["x"]).max())
+    assert distances[1] < 4e-3
+    assert 1.8 < distances[0] / distances[1] < 2.2

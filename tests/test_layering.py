@@ -107,7 +107,7 @@ LAYERS = (
     ("analytic", "statics"),  # two independent routes (see the tests above)
     ("dispatch",),
     ("stability", "control", "dynamics"),
-    ("_sweep_table",),  # the plain data of a [sweep] table
+    ("_sweep_table", "_simulate_table"),  # the plain data of a [sweep], [simulate] table
     ("_schema",),
     ("_keypath",),
     ("case",),

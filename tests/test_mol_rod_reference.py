@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 from _mol_rod import energy, linear_frequencies, load_reference, simulate, swinging_arm
-from _timoshenko import cantilever_bending
+
+from softarm.validation._timoshenko import cantilever_bending
 
 
 def test_small_amplitude_limit_is_the_timoshenko_cantilever():

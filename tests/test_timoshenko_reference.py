@@ -1,10 +1,12 @@
-"""The cantilever frequency references of tests/_timoshenko.py against independent values."""
+"""The cantilever frequency references of softarm/validation/_timoshenko.py against independent
+values."""
 
 import math
 
 import numpy as np
 import pytest
-from _timoshenko import (
+
+from softarm.validation._timoshenko import (
     cantilever_axial,
     cantilever_bending,
     cantilever_bending_fem,

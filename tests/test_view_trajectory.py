@@ -30,14 +30,26 @@ def swing():
                             damping=softarm.Damping(retardation=0.005))
 
 
-def write_npz(trajectory, path, **extra):
-    """The trajectory's arrays under the names of softarm.io.TRAJECTORY_ARRAYS."""
-    arrays = {name: getattr(trajectory, name) for name in ("times", "s", "positions",
-                                                           "rotations")}
-    arrays |= {f"energy_{k}": getattr(trajectory.energy, k)
-               for k in ("kinetic", "elastic", "gravity", "dissipated")}
-    np.savez(path, **arrays, **extra)
-    return path
+CASE = """
+name = "swing"
+[arm]
+length = 0.5
+section = { kind = "circle", radius = 0.02 }
+material = { E = 1.0e6, nu = 0.5, density = 1100.0 }
+[[load]]
+kind = "gravity"
+[simulate]
+duration = 0.3
+dt = 0.002
+stations = 21
+damping = { retardation = 0.005 }
+"""
+
+
+def saved_case(tmp_path, text=CASE):
+    path = tmp_path / "swing.toml"
+    path.write_text(text, encoding="utf-8")
+    return softarm.load_case(path)
 
 
 def test_frame_indices_spread_evenly_in_time():
@@ -57,7 +69,7 @@ def test_frames_hold_the_trajectory_at_the_shown_times(swing):
     assert len(fig["frames"]) == shown.size == 40
     names = [t["name"] for t in fig["data"]]
     moving = [names[i] for i in fig["frames"][0]["traces"]]
-    assert moving == ["arm", "centreline", "e1", "e2", "e3"]
+    assert moving == ["arm", "centreline", "e1", "e2", "e3", "base"]
     for frame, k in zip(fig["frames"], shown, strict=True):
         line = frame["data"][1]
         drawn = np.stack([decode(line[a]) for a in "xyz"], -1)
@@ -129,61 +141,74 @@ def test_batched_trajectory_is_refused(swing):
         view.trajectory_figure(Batched())
 
 
-def test_trajectory_file_round_trip(swing, tmp_path):
-    path = write_npz(swing, tmp_path / "swing.npz", radii=np.full(21, 0.02), name="swing",
-                     velocities=swing.velocities)
-    assert io.is_trajectory_file(path)
-    saved = io.load_trajectory(path)
-    np.testing.assert_array_equal(saved.positions, swing.positions)
-    np.testing.assert_array_equal(saved.energy.total, swing.energy.total)
-    assert saved.name == "swing" and saved.arm is None
-    np.testing.assert_array_equal(saved.radii, 0.02)
-
-
 def test_cli_view_trajectory(swing, tmp_path, capsys):
-    source = write_npz(swing, tmp_path / "swing.npz", radii=np.full(21, 0.02), name="swing")
+    # the file of softarm simulate (softarm.io.save_trajectory) of the same motion
+    source = io.save_trajectory(swing, tmp_path / "swing.npz", saved_case(tmp_path))
     assert cli.main(["view", str(source)]) == 0
     out, err = capsys.readouterr()
     page = tmp_path / "swing.html"
     assert out.strip() == f"wrote {page}" and err == ""
-    text = page.read_text(encoding="utf-8")
-    fig = json.loads(re.search(r"var id = \"softarm-view\", fig = (\{.*?\}), config", text,
-                               re.S).group(1)
-                     .replace("<\\/", "</"))
+    fig = page_figure(page)
     shown = view.frame_indices(swing.times)
     line = fig["frames"][-1]["data"][1]
     np.testing.assert_allclose(np.stack([decode(line[a]) for a in "xyz"], -1),
                                swing.positions[shown[-1]], rtol=1e-6, atol=1e-7)
+    assert fig["layout"]["title"]["text"].startswith("swing: motion, t = 0 s")
+    # the tube of the case's arm: 20 mm from the axis
+    tube = np.stack([decode(fig["data"][0][a]) for a in "xyz"], -1).reshape(-1, 16, 3)
+    np.testing.assert_allclose(np.linalg.norm(tube[0] - swing.positions[0, 0], axis=-1), 0.02,
+                               rtol=1e-5)
 
 
-@pytest.mark.parametrize(("change", "message"), [
-    ("garbage", "not a softarm trajectory file (not an NPZ archive, or truncated)"),
-    ("no energy", "not a softarm trajectory file (no energy_gravity array)"),
-    ("short", "positions must have shape (151, 21, 3) (T = 151 times, S = 21 stations), "
-              "got (151, 5, 3)"),
-    ("nan", "rotations holds values that are not finite"),
-])
-def test_cli_view_bad_trajectory(swing, tmp_path, capsys, change, message):
+def page_figure(page):
+    text = page.read_text(encoding="utf-8")
+    return json.loads(re.search(r"var id = \"softarm-view\", fig = (\{.*?\}), config", text,
+                                re.S).group(1).replace("<\\/", "</"))
+
+
+def test_cli_view_a_sweep_of_simulations(tmp_path, capsys):
+    text = CASE.replace("duration = 0.3", "duration = 0.02") + (
+        '[[load]]\nkind = "tip"\nforce = [0.0, 0.0, 0.0]\n'
+        '[sweep]\nload = 2\nfield = "force"\ncomponent = "z"\nstart = 0.0\nstop = 0.2\n'
+        'steps = 3\n')
+    case = saved_case(tmp_path, text)
+    assert cli.main(["simulate", str(case.source), "-o", str(tmp_path / "s.npz")]) == 0
+    saved = io.read_trajectory(tmp_path / "s.npz")
+    assert saved.batch_shape == (3,)
+    capsys.readouterr()
+    assert cli.main(["view", str(tmp_path / "s.npz"), "--case", "3"]) == 0
+    fig = page_figure(tmp_path / "s.html")
+    line = fig["frames"][-1]["data"][1]
+    np.testing.assert_allclose(np.stack([decode(line[a]) for a in "xyz"], -1),
+                               saved.positions[2, -1], rtol=1e-6, atol=1e-7)
+    assert saved.sweep_values[2] == 0.2
+    assert fig["layout"]["title"]["text"].startswith(
+        f"swing ({saved.sweep_label} = 0.2): motion, t = 0 s")
+    assert cli.main(["view", str(tmp_path / "s.npz"), "--case", "4", "-o",
+                     str(tmp_path / "x.html")]) == 2
+    _, err = capsys.readouterr()
+    assert err == (f"softarm: error: {tmp_path / 's.npz'}: case must be 1 ... 3 (the file "
+                   "holds 3 simulations), got 4\n")
+    assert not (tmp_path / "x.html").exists()
+
+
+@pytest.mark.parametrize("change", ["garbage", "short"])
+def test_cli_view_bad_trajectory(swing, tmp_path, capsys, change):
     source = tmp_path / "bad.npz"
     if change == "garbage":
         source.write_bytes(b"PK\x03\x04 not really")
-        source = tmp_path / "bad.npz"
     else:
-        arrays = dict(np.load(write_npz(swing, tmp_path / "good.npz")))
-        if change == "no energy":
-            del arrays["energy_gravity"]
-        elif change == "short":
-            arrays["positions"] = arrays["positions"][:, :5]
-        else:
-            arrays["rotations"][3, 2, 0, 0] = np.nan
+        good = io.save_trajectory(swing, tmp_path / "good.npz", saved_case(tmp_path))
+        arrays = dict(np.load(good))
+        arrays["positions"] = arrays["positions"][:, :5]
         np.savez(source, **arrays)
     page = tmp_path / "bad.html"
-    # (garbage is no NPZ archive: read as a result file, which says the same)
     assert cli.main(["view", str(source), "-o", str(page)]) == 2
     out, err = capsys.readouterr()
     assert out == "" and err.count("\n") == 1
-    if change == "garbage":
+    if change == "garbage":  # (no trajectory: read as a result file, which says so)
         assert err.startswith(f"softarm: error: {source}: not a softarm result file")
     else:
-        assert err == f"softarm: error: {source}: {message}\n"
+        assert err == (f"softarm: error: {source}: not a valid softarm trajectory: "
+                       "'positions' has shape (151, 5, 3), expected (151, 21, 3)\n")
     assert not page.exists()

@@ -53,6 +53,7 @@ __all__ = [
     "MATERIAL",
     "ROUTING",
     "SECTIONS",
+    "SIMULATE",
     "SOLVE",
     "STIFFNESS",
     "SWEEP",
@@ -190,6 +191,26 @@ INVERSE = (Key("target", "vector", "m", required=True),
            Field("tol", "number", "units of the arm length"),
            Field("lower", "numbers"), Field("upper", "numbers"),
            Field("max_iterations", "integer", minimum=1), Field("starts", "integer", minimum=1))
+
+#: ``[simulate]`` (:class:`softarm.case.Simulation`), by name; its sub-tables ``damping``,
+#: ``[[simulate.input]]`` and ``base`` are :data:`DAMPING`, :data:`SCHEDULE` and :data:`BASE`.
+SIMULATE = {key.name: key for key in (
+    Field("duration", "number", "s", required=True), Field("dt", "number", "s", required=True),
+    Field("stations", "integer", minimum=3), Field("tol", "number", "units of the arm length"),
+    Field("alpha", "number", finite=True),
+    Field("initial", "text", choices=("rest", "equilibrium")))}
+
+#: ``[simulate.damping]`` (:class:`softarm.Damping`): ``retardation`` or a 6 × 6 ``matrix``.
+DAMPING = (Key("retardation", "number", "s"), Field("matrix", "rows", "N s, N m² s"))
+
+#: One ``[[simulate.input]]`` (:class:`softarm.case.Schedule`): ``load`` counts from 1.
+SCHEDULE = (Field("load", "integer", minimum=1, required=True),
+            Field("times", "numbers", "s", required=True),
+            Field("values", "rows", "the input's unit", required=True))
+
+#: ``[simulate.base]`` (:class:`softarm.case.BaseMotion`).
+BASE = (Field("times", "numbers", "s", required=True),
+        Field("positions", "rows", "m", required=True), Field("rotations", "rows", "rad"))
 
 #: ``[sweep]`` (:class:`softarm.sweep.Sweep`), by name: ``load`` counts from 1 in the file,
 #: from 0 in the model; ``field`` is one of the swept load's vectors; either ``values`` or
@@ -340,6 +361,14 @@ class Table:
             schema = ROUTING[table.string("kind", tuple(ROUTING))]
             values = schema.read(table)
             return table.build(schema.keys, lambda: schema.cls(**values))
+        if kind == "rows":  # a list of numbers or of lists of numbers: the model checks shapes
+            raw = self.raw(key.name)
+            if not (isinstance(raw, list) and raw and not _has_bool(raw) and all(
+                    isinstance(v, Real) or (isinstance(v, list) and v and all(
+                        isinstance(x, Real) for x in v)) for v in raw)):
+                raise self.type_error(key.name, f"must be a list of numbers or of lists of "
+                                      f"numbers in {key.unit}, got {format_value(raw)}")
+            return raw
         if kind == "span":  # two numbers in m
             raw = self.raw(key.name)
             if not (isinstance(raw, list) and len(raw) == 2 and not _has_bool(raw)

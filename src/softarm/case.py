@@ -26,7 +26,7 @@ import math
 import os
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field, replace
 from numbers import Real
 from pathlib import Path
@@ -35,9 +35,11 @@ import numpy as np
 
 from . import _schema, dispatch
 from ._keypath import resolve
-from ._schema import Table, arm_to_dict, loads_to_dict
+from ._schema import Schema, Table, arm_to_dict, loads_to_dict
+from ._simulate_table import BaseMotion, Schedule, Simulation
 from ._sweep_table import DESIGNS, Design, Parameter, Sweep
 from ._validate import check_allocation, count, format_value
+from .dynamics import Damping, Simulator, Trajectory
 from .equilibrium import Equilibrium, Stability
 from .errors import CaseError, CaseTypeError
 from .loads import LOAD_KINDS
@@ -54,12 +56,17 @@ __all__ = [
     "Case",
     "CaseError",
     "CaseTypeError",
+    "Schedule",
+    "Simulation",
     "SolveOptions",
     "Sweep",
     "arm_to_dict",
+    "join_trajectories",
     "load_case",
     "loads_to_dict",
     "parse_case",
+    "simulate_case",
+    "simulation_parts",
     "solve_case",
 ]
 
@@ -172,6 +179,8 @@ class Case:
     description : str
     inverse : InverseTask or None
         The ``[inverse]`` table, if any.
+    simulation : Simulation or None
+        The ``[simulate]`` table, if any (:func:`simulate_case`).
     """
 
     name: str
@@ -184,6 +193,7 @@ class Case:
     description: str = ""
     design: Design | None = None
     inverse: InverseTask | None = None
+    simulation: Simulation | None = None
 
     @property
     def batched_loads(self) -> tuple:
@@ -288,6 +298,50 @@ def _design(table: Table, data: dict) -> Design:
             if text.startswith(f"{parameter.path}: "):
                 raise row.error(None, text) from None
         raise table.error(None, text) from None
+
+
+def _input_count(load) -> int:
+    """The number of actuation inputs of a load (a magnetic field's are 3)."""
+    return sum(int(np.size(getattr(load, name))) for name in load.inputs)
+
+
+def _simulation(table: Table, loads: tuple) -> Simulation:
+    """The ``[simulate]`` table with its ``damping``, ``[[simulate.input]]`` and ``base``."""
+    keys = _schema.SIMULATE
+    values = {name: table.read(key) for name, key in keys.items() if table.wants(key)}
+    if table.has("damping"):
+        values["damping"] = _build(table.table("damping"),
+                                   Schema("", Damping, _schema.DAMPING))
+    schedules = []
+    for row in table.tables("input"):
+        read = {key.name: row.read(key) for key in _schema.SCHEDULE if row.wants(key)}
+        index = read.get("load")
+        if index is not None:
+            if index > len(loads):
+                raise row.error("load", f"there are {len(loads)} [[load]] tables, got load = "
+                                f"{index} (counted from 1)")
+            load = loads[index - 1]
+            if not load.inputs:
+                raise row.error("load", f"load {index} ({load.kind}) has no actuation input; "
+                                "give a tendon, chamber or magnetic load")
+        schedule = row.build(_schema.SCHEDULE, lambda read=read: Schedule(
+            read["load"] - 1, read["times"], read["values"]))
+        width = _input_count(loads[schedule.load])
+        if schedule.width != width:
+            raise row.error("values", f"load {schedule.load + 1} ({loads[schedule.load].kind}) "
+                            f"has {width} input{'s' if width > 1 else ''} "
+                            f"({', '.join(loads[schedule.load].inputs)}); give "
+                            f"{'one number' if width == 1 else f'a list of {width} numbers'} "
+                            f"per time, got {schedule.width}")
+        for j, other in enumerate(schedules):
+            if other.load == schedule.load:
+                raise row.error("load", f"load {schedule.load + 1} has a schedule already "
+                                f"({table.key('input')}[{j + 1}])")
+        schedules.append(schedule)
+    values["inputs"] = tuple(schedules)
+    if table.has("base"):
+        values["base"] = _build(table.table("base"), Schema("", BaseMotion, _schema.BASE))
+    return table.build(tuple(keys.values()), lambda: Simulation(**values))
 
 
 def _sweep(table: Table, loads: tuple, stations: int) -> Sweep:
@@ -421,12 +475,13 @@ def _parse(data, source, *, name=None, batched=False) -> Case:
             sweep = _sweep(table, loads, options.stations)
     inverse = _build(top.table("inverse"), _schema.Schema("", InverseTask, _schema.INVERSE)) \
         if top.has("inverse") else None
+    simulation = _simulation(top.table("simulate"), loads) if top.has("simulate") else None
     top.done()
     clean = dict(data)
     clean.setdefault("name", case_name)
     return Case(case_name, arm, loads, options, sweep,
                 Path(source) if source is not None else None, copy.deepcopy(clean), description,
-                design, inverse)
+                design, inverse, simulation)
 
 
 def load_case(path: str | os.PathLike) -> Case:
@@ -607,3 +662,148 @@ def _concatenate(parts: list[Equilibrium], loads: tuple) -> Equilibrium:
         arm=first.arm, loads=loads, method="+".join(methods),
         exact=all(bool(p.exact) for p in parts),
         residual=cat("residual"), error_estimate=cat("error_estimate"), stability=stability)
+
+
+# --------------------------------------------------------------------------------------------
+# Simulating a case
+# --------------------------------------------------------------------------------------------
+
+
+def _simulator(case: Case) -> tuple[Simulator, Callable | None]:
+    """The case's :class:`~softarm.Simulator` and its inputs over time (None: constant).
+
+    The loads with actuation inputs (tendons, chambers, magnetic fields) are the actuators,
+    in file order; a scheduled one starts from its schedule's first value. With
+    ``initial = "equilibrium"`` the arm starts at rest in the equilibrium of all the loads
+    at t = 0 (``softarm.solve`` with the ``[solve]`` options; the Simulator balances it again
+    on its own stations)."""
+    options = case.simulation
+    if options is None:
+        raise ValueError(f"{case.source or case.name}: simulate: missing (the case has no "
+                         "[simulate] table; docs/case-files.md)")
+    scheduled = {schedule.load: schedule for schedule in options.inputs}
+    loads = list(case.batched_loads)
+    for index, schedule in scheduled.items():
+        first, load, start = schedule(0.0), loads[index], 0
+        changes = {}
+        for name in load.inputs:
+            shape = np.shape(getattr(load, name))
+            size = int(np.prod(shape))
+            changes[name] = first[start:start + size].reshape(shape) if shape else \
+                float(first[start])
+            start += size
+        loads[index] = load.replace(**changes)
+    actuators = [load for load in loads if load.inputs]
+    passive = [load for load in loads if not load.inputs]
+    inputs = None
+    if scheduled:
+        parts = [(scheduled.get(index), np.concatenate(
+            [np.ravel(np.asarray(getattr(load, name), dtype=float)) for name in load.inputs]))
+            for index, load in enumerate(loads) if load.inputs]
+
+        def inputs(t: float) -> np.ndarray:
+            return np.concatenate([values if schedule is None else schedule(t)
+                                   for schedule, values in parts])
+
+    initial = None
+    if options.initial == "equilibrium":
+        initial = dispatch.solve(case.arm, loads, method=case.solve.method,
+                                 s=options.stations, tol=case.solve.tol,
+                                 base=None if options.base is None else options.base(0.0))
+    simulator = Simulator(case.arm, actuators, passive, dt=options.dt, damping=options.damping,
+                          initial=initial, base=options.base, stations=options.stations,
+                          tol=options.tol, alpha=options.alpha)
+    return simulator, inputs
+
+
+def simulation_parts(case: Case, *, seconds: float = 0.25) -> Iterator[Trajectory]:
+    """The case's ``[simulate]`` run in consecutive chunks of steps, each yielded as it is
+    done (:func:`join_trajectories` makes them one trajectory; a caller that stops early, on
+    Ctrl-C or a ConvergenceError, keeps the chunks it has).
+
+    The first chunk is one step (it shows the cost of a step, the compile excluded: a first
+    use of the dynamics kernel compiles it); the next ones take about ``seconds`` each. The
+    first chunk includes the initial state (T = steps + 1); the others start after it.
+    """
+    simulator, inputs = _simulator(case)
+    total = case.simulation.steps
+    done, chunk = 0, 1
+    while done < total:
+        steps = min(chunk, total - done)
+        start = time.perf_counter()
+        part = simulator.run(steps, inputs)
+        elapsed = time.perf_counter() - start
+        yield part if done == 0 else _from(part, 1)
+        done += steps
+        chunk = max(1, min(total, int(seconds * steps / max(elapsed, 1e-9))))
+
+
+def _from(trajectory: Trajectory, start: int) -> Trajectory:
+    """``trajectory`` from its time index ``start`` on."""
+    return join_trajectories([trajectory], start)
+
+
+def join_trajectories(parts, start: int = 0) -> Trajectory:
+    """Consecutive trajectories (each starting where the last ended, without repeating its
+    time) as one, from time index ``start`` of the first on; the final state is the last's."""
+    parts = list(parts)
+    if not parts:
+        raise ValueError("join_trajectories: no trajectory given")
+    axis = len(parts[0].batch_shape)
+
+    def cat(arrays, axis=axis):
+        array = np.concatenate([np.asarray(a) for a in arrays], axis=axis)
+        array = array[(slice(None),) * axis + (slice(start, None),)]
+        array.setflags(write=False)
+        return array
+
+    energy = type(parts[0].energy)(*(cat([getattr(p.energy, name) for p in parts])
+                                     for name in ("kinetic", "elastic", "gravity",
+                                                  "dissipated")))
+    lengths = None if parts[0].tendon_lengths is None else \
+        cat([p.tendon_lengths for p in parts])
+    return Trajectory(
+        times=cat([p.times for p in parts], 0), s=parts[0].s,
+        positions=cat([p.positions for p in parts]),
+        rotations=cat([p.rotations for p in parts]),
+        velocities=cat([p.velocities for p in parts]),
+        angular_velocities=cat([p.angular_velocities for p in parts]),
+        strains=cat([p.strains for p in parts]), stresses=cat([p.stresses for p in parts]),
+        energy=energy, errors=cat([p.errors for p in parts]),
+        iterations=cat([p.iterations for p in parts]), tendon_lengths=lengths,
+        final=parts[-1].final)
+
+
+def simulate_case(case: Case, *, progress: Callable[[int, int], None] | None = None
+                  ) -> Trajectory:
+    """Run a case's ``[simulate]`` table: its arm under its loads (a ``[sweep]`` of a load
+    gives one trajectory per step: batch shape (steps,)), the actuators following their
+    ``[[simulate.input]]`` schedules, the base its ``[simulate.base]`` motion.
+
+    Parameters
+    ----------
+    case : Case
+        With a ``[simulate]`` table.
+    progress : callable, optional
+        ``progress(steps_done, steps_total)`` after each chunk of steps
+        (:func:`simulation_parts`).
+
+    Returns
+    -------
+    Trajectory
+        ``duration / dt + 1`` times, the initial state first.
+
+    Raises
+    ------
+    ValueError
+        The case has no ``[simulate]`` table, or the simulation rejects its data.
+    ConvergenceError
+        A time step could not be solved.
+    """
+    parts, done = [], 0
+    for part in simulation_parts(case):
+        parts.append(part)
+        done += part.times.size - (1 if done == 0 else 0)
+        if progress is not None:
+            progress(done, case.simulation.steps)
+    return join_trajectories(parts)

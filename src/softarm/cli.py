@@ -31,7 +31,7 @@ import numpy as np
 from . import __version__
 from .case import Case, CaseError, load_case
 from .errors import ConvergenceError, InadmissibleStateError, StabilityWarning
-from .io import FORMATS, is_trajectory_file, load_saved, load_trajectory, save_result
+from .io import FORMATS, load_saved, read_trajectory, save_result
 from .sweep import solve_case
 
 __all__ = ["main"]
@@ -166,6 +166,22 @@ def _parser() -> argparse.ArgumentParser:
                        help="tip position tolerance relative to the arm length (default 1e-8)")
     solve.set_defaults(run=_run_solve)
 
+    simulate = commands.add_parser(
+        "simulate", help="simulate a case's [simulate] table over time, export the trajectory",
+        description="Run the case file's [simulate] table (the arm's motion under its loads, "
+        "actuator schedules and base motion; every step of a one-parameter [sweep] at once) "
+        "with a progress bar, print a summary and write the trajectory. Ctrl-C or a step "
+        "that cannot be solved keeps the steps done so far: they are written, marked "
+        "incomplete.")
+    simulate.add_argument("case", metavar="CASE.toml", help="case file with a [simulate] table")
+    simulate.add_argument("-o", "--output", action="append", default=[], metavar="OUT",
+                          help="write the trajectory to OUT (.npz, .zarr or .csv; may be "
+                          "repeated)")
+    simulate.add_argument("--plot", metavar="PICTURE",
+                          help="draw snapshots, the tip's path and the energies (.png, .pdf, "
+                          ".svg)")
+    simulate.set_defaults(run=_run_simulate)
+
     critical = commands.add_parser(
         "critical", help="the critical load factor of a case and its buckling mode",
         description="Scale the case's loads (or those given with --vary) by a load factor λ "
@@ -190,12 +206,16 @@ def _parser() -> argparse.ArgumentParser:
         "view", help="write an interactive 3D view of a saved result (HTML)",
         description="Write a self-contained HTML file (opens offline in any browser) with an "
         "interactive 3D view of a result written by 'softarm solve -o': the arm as a tube, "
-        "hover read-outs, the loads; a sweep gets a slider. A trajectory (.npz with a times "
-        "array, softarm.io.TRAJECTORY_ARRAYS): the moving arm with a time slider, play at "
+        "hover read-outs, the loads; a sweep gets a slider. A trajectory (written by softarm "
+        "simulate): the moving arm with a time slider, play at "
         "real time or a chosen rate, the tip's path and the energy plot. Needs pip install "
         "'softarm[view]'.")
     view.add_argument("result", metavar="RESULT",
-                      help="result file (.csv, .json or .npz) or trajectory (.npz)")
+                      help="result file (.csv, .json or .npz) or trajectory file (softarm "
+                      "simulate's .npz, .zarr or .csv)")
+    view.add_argument("--case", type=_positive, metavar="K",
+                      help="of a trajectory file of a sweep of simulations, the case to view "
+                      "(counted from 1; default 1)")
     view.add_argument("-o", "--output", metavar="HTML",
                       help="HTML file to write (default: RESULT with suffix .html)")
     view.set_defaults(run=_run_view)
@@ -212,13 +232,16 @@ def _parser() -> argparse.ArgumentParser:
                      help="do not open a browser tab, only print the address")
     app.add_argument("--dynamic", action="store_true",
                      help="the arm in motion: the sliders drive a simulation stepped in real "
-                     "time (softarm.Simulator) and the page shows the arm swinging")
+                     "time (softarm.Simulator) and the page shows the arm swinging; the "
+                     "default for a case with a [simulate] table (its dt, stations, damping)")
+    app.add_argument("--static", action="store_true",
+                     help="the static app even for a case with a [simulate] table")
     app.add_argument("--dt", type=_seconds, metavar="DT",
-                     help="the dynamic mode's time step in s (default 0.002; implies "
-                     "--dynamic)")
+                     help="the dynamic mode's time step in s (default: the [simulate] "
+                     "table's, else 0.002; implies --dynamic)")
     app.add_argument("--damping", type=_seconds, metavar="TAU",
                      help="the dynamic mode's Kelvin-Voigt retardation time in s (default: "
-                     "undamped; implies --dynamic)")
+                     "the [simulate] table's, else undamped; implies --dynamic)")
     app.set_defaults(run=_run_app)
 
     inverse = commands.add_parser(
@@ -537,6 +560,117 @@ def _run_solve(args) -> int:
     return 0
 
 
+def _trajectory_outputs(args) -> tuple[list[Path], Path | None]:
+    """The trajectory files (-o) and picture (--plot) of ``softarm simulate``, checked
+    before any step: a known suffix, an existing folder, not the input, not given twice; a
+    ``.zarr`` (a folder) may exist (it is replaced) and needs xarray and zarr."""
+    from .io import TRAJECTORY_FORMATS
+
+    outputs: list[Path] = []
+    for name in args.output:
+        out = Path(name)
+        if out.suffix.lower() == ".zarr":
+            if importlib.util.find_spec("xarray") is None or \
+                    importlib.util.find_spec("zarr") is None:
+                raise CaseError(f"{out}: a .zarr output needs xarray and zarr: pip install "
+                                "'softarm[sweep]'")
+            if not Path(os.path.realpath(out)).parent.is_dir():
+                raise CaseError(f"{out}: folder {Path(os.path.realpath(out)).parent} does not "
+                                "exist")
+            if out.exists() and not out.is_dir():
+                raise CaseError(f"{out}: exists and is not a folder (a Zarr store is a folder)")
+            if any(_same_file(out, other) for other in outputs):
+                raise CaseError(f"{out}: given twice as an output")
+            outputs.append(out)
+        else:
+            outputs.append(_check_output(name, TRAJECTORY_FORMATS, "trajectory", [args.case],
+                                         outputs))
+    picture = _check_picture(args.plot, [args.case], outputs) if args.plot else None
+    return outputs, picture
+
+
+def _run_simulate(args) -> int:
+    from .case import join_trajectories, simulation_parts
+    from .io import save_trajectory
+
+    outputs, picture = _trajectory_outputs(args)
+    case = load_case(args.case)
+    where = case.source or case.name
+    if case.simulation is None:
+        raise CaseError(f"{where}: simulate: missing (softarm simulate needs a [simulate] "
+                        "table; docs/case-files.md)")
+    if case.design is not None:
+        raise CaseError(f"{where}: sweep: a design ([[sweep.parameter]]) of simulations is not "
+                        "supported yet; a one-parameter load [sweep] is")
+    total = case.simulation.steps
+    progress = _Progress(label="simulating", unit="steps")
+    parts, done, stopped = [], 0, None
+    start = time.perf_counter()
+    try:
+        try:
+            for part in simulation_parts(case):
+                parts.append(part)
+                done += part.times.size - (1 if len(parts) == 1 else 0)
+                progress(done, total)
+        except (ValueError, TypeError) as error:  # the simulation rejected the case's data
+            raise CaseError(_named(error, where)) from None
+    except KeyboardInterrupt:
+        with contextlib.suppress(ValueError, OSError):  # (no second Ctrl-C while writing)
+            signal.signal(signal.SIGINT, signal.SIG_IGN)
+        stopped = ("interrupted", 130)
+    except ConvergenceError as error:
+        stopped = (f"the solver did not converge: {error}", 1)
+    finally:
+        progress.close()
+    seconds = time.perf_counter() - start
+    if stopped is not None and not parts:
+        return _fail(stopped[1], f"softarm: {stopped[0]} (no step done; nothing written)")
+    trajectory = join_trajectories(parts)
+    reason = "" if stopped is None else _line(stopped[0], 300)
+    for out in outputs:
+        save_trajectory(trajectory, out, case, complete=stopped is None, reason=reason)
+    if picture is not None:
+        from . import plot
+
+        plot.plot_trajectory(trajectory, name=case.name, sweep=case.sweep, path=picture)
+    if stopped is not None:
+        kept = f"; wrote the {done} of {total} steps done (to t = {trajectory.times[-1]:.6g} " \
+            f"s) to {', '.join(map(str, outputs + ([picture] if picture else [])))}" \
+            if outputs or picture else f"; {done} of {total} steps were done (no output asked)"
+        return _fail(stopped[1], f"softarm: {stopped[0]}{kept}")
+    print(_simulation_summary(case, trajectory, seconds))
+    for out in [*outputs, *([picture] if picture else [])]:
+        print(f"wrote {out}")
+    return 0
+
+
+def _simulation_summary(case: Case, trajectory, seconds: float) -> str:
+    from .plot import describe_loads
+
+    options = case.simulation
+    steps = trajectory.times.size - 1
+    tip = trajectory.tip_position
+    energy = trajectory.energy
+    drift = np.max(np.abs(energy.total[..., -1] - energy.total[..., 0]))
+    lines = [f"case      {case.name}" + (f"  ({case.source})" if case.source else ""),
+             f"loads     {describe_loads(case.loads, case.sweep)}",
+             f"simulated {steps} steps of {options.dt:g} s to t = {trajectory.times[-1]:.6g} s,"
+             f" {trajectory.s.size} stations"
+             + (f", {int(np.prod(trajectory.batch_shape))} cases" if trajectory.batch_shape
+                else ""),
+             f"Newton    {np.mean(trajectory.iterations[..., 1:]):.3g} iterations a step on "
+             f"average, at most {int(np.max(trajectory.iterations))}; largest step correction "
+             f"{np.max(trajectory.errors):.2e} L"]
+    if not trajectory.batch_shape:
+        lines.append(f"tip       at t = {trajectory.times[-1]:.6g} s: {_vector(tip[-1])} m; "
+                     f"farthest from its start {np.max(np.linalg.norm(tip - tip[0], axis=-1)):.4g}"
+                     " m")
+    lines += [f"energy    kinetic + elastic + gravity + dissipated changed by up to {drift:.3g} J"
+              " (the work of the base and actuators, and the time steps' error)",
+              f"time      {seconds:.3g} s"]
+    return "\n".join(lines)
+
+
 def _run_inverse(args) -> int:
     import dataclasses
 
@@ -640,20 +774,46 @@ def _run_view(args) -> int:
     source = Path(args.result)
     page = _check_output(args.output or str(source.with_suffix(".html")), (".html", ".htm"),
                          "page", [source])
-    trajectory = is_trajectory_file(source)  # a motion (softarm.io.load_trajectory)
-    saved = load_trajectory(source) if trajectory else load_saved(source)
+    trajectory = _is_trajectory(source)  # written by softarm simulate
+    saved = read_trajectory(source) if trajectory else load_saved(source)
     try:
         from . import view
 
         if trajectory:
-            view.write_trajectory_html(saved, page, arm=saved.arm, radii=saved.radii,
-                                       name=saved.name)
+            view.view_trajectory_file(saved, page, case=args.case)
         else:
+            if args.case is not None:
+                raise CaseError(f"{source}: --case is for a trajectory file of a sweep of "
+                                "simulations; this is a result file")
             view.view_result_file(saved, page)
     except ImportError as error:  # plotly missing
         raise CaseError(f"{page}: {error}") from None
     print(f"wrote {page}")
     return 0
+
+
+def _is_trajectory(path: Path) -> bool:
+    """True if ``path`` is a trajectory file (softarm.io.save_trajectory's: a ``.zarr``
+    folder, or ``.npz`` or ``.csv`` whose metadata say ``"kind": "trajectory"``)."""
+    import json
+    import zipfile
+
+    suffix = path.suffix.lower()
+    try:
+        if suffix == ".zarr":
+            return path.is_dir()
+        if suffix == ".npz" and zipfile.is_zipfile(path):
+            with np.load(path, allow_pickle=False) as data:
+                return "meta" in data.files and \
+                    json.loads(str(data["meta"])).get("kind") == "trajectory"
+        if suffix == ".csv" and path.is_file():
+            with path.open(encoding="utf-8") as stream:
+                for line, _ in zip(stream, range(50), strict=False):
+                    if line.startswith("# meta: "):
+                        return json.loads(line[len("# meta: "):]).get("kind") == "trajectory"
+    except (OSError, ValueError, UnicodeDecodeError):
+        return False  # (then read as a result file, which says what is wrong)
+    return False
 
 
 def _port(text: str) -> int:
@@ -681,10 +841,13 @@ def _run_app(args) -> int:
     from . import app
 
     dynamics = None
-    if args.dynamic or args.dt is not None or args.damping is not None:
+    asked = args.dynamic or args.dt is not None or args.damping is not None
+    if args.static and asked:
+        raise CaseError("--static cannot go with --dynamic, --dt or --damping")
+    if asked or (case.simulation is not None and not args.static):
         if args.dt == 0:
             raise CaseError("--dt must be a positive time step in s, got 0")
-        dynamics = app.Dynamics(dt=args.dt or app.Dynamics.dt, damping=args.damping)
+        dynamics = app.Dynamics.of(case, dt=args.dt, damping=args.damping)
     try:
         return app.serve(case, port=args.port, browser=not args.no_browser,
                          dynamics=dynamics)

@@ -31,13 +31,15 @@ __all__ = [
     "COLUMNS",
     "FORMATS",
     "TRAJECTORY_ARRAYS",
+    "TRAJECTORY_COLUMNS",
+    "TRAJECTORY_FORMATS",
     "SavedResult",
     "SavedTrajectory",
-    "is_trajectory_file",
     "load_result",
     "load_saved",
-    "load_trajectory",
+    "read_trajectory",
     "save_result",
+    "save_trajectory",
     "write_atomic",
 ]
 
@@ -485,112 +487,382 @@ def _read_csv(path: Path):
     return meta, columns, poses, residual, estimate, sweep
 
 
-# ------------------------------------------------------------------------- trajectories
+# --------------------------------------------------------------------------------------------
+# Trajectories (softarm simulate)
+# --------------------------------------------------------------------------------------------
 
-#: The arrays a trajectory's NPZ file holds (named after :class:`softarm.Trajectory`'s
-#: attributes; T times, S stations): times (T,) s; s (S,) m; positions (T, S, 3) m, spatial;
-#: rotations (T, S, 3, 3) (columns e1 e2 e3, spatial); energy_kinetic, energy_elastic,
-#: energy_gravity, energy_dissipated (T,) J. Optional: radii (S,) m, the tube's radius at
-#: each station (for drawing); name, the case's name (a string); meta, JSON text whose
-#: "case" entry is a case as :func:`save_result` embeds it (its arm is drawn). Further arrays
-#: (velocities, strains, ...) may be present and are not read.
-TRAJECTORY_ARRAYS = ("times", "s", "positions", "rotations", "energy_kinetic",
-                     "energy_elastic", "energy_gravity", "energy_dissipated")
+#: File suffixes that :func:`save_trajectory` writes and :func:`read_trajectory` reads.
+TRAJECTORY_FORMATS = (".npz", ".zarr", ".csv")
+
+#: A trajectory file's arrays: name -> (dimensions after the batch axes, unit, meaning).
+#: ``.npz`` and ``.zarr`` hold them as they are (``.zarr``: the batch axis of a sweep is the
+#: dimension ``case``); ``.csv`` holds them in long form (:data:`TRAJECTORY_COLUMNS`).
+TRAJECTORY_ARRAYS = {
+    "times": (("time",), "s", "time t"),
+    "s": (("station",), "m", "arc length of the stations"),
+    "positions": (("time", "station", "axis"), "m", "centreline position, spatial frame"),
+    "rotations": (("time", "station", "row", "column"), "1",
+                  "material frame R (columns e1 e2 e3 in the spatial frame)"),
+    "velocities": (("time", "station", "axis"), "m/s", "centreline velocity, spatial frame"),
+    "angular_velocities": (("time", "station", "axis"), "rad/s",
+                           "angular velocity of the sections, spatial frame"),
+    "strains": (("time", "station", "component"), "1 (gamma), 1/m (kappa)",
+                "strains eps - eps0 (gamma1..3, kappa1..3), material frame"),
+    "stresses": (("time", "station", "component"), "N (n), N m (m)",
+                 "internal force and moment (n1..3, m1..3), material frame, viscous included"),
+    "energy_kinetic": (("time",), "J", "kinetic energy"),
+    "energy_elastic": (("time",), "J", "strain energy"),
+    "energy_gravity": (("time",), "J", "potential energy of gravity"),
+    "energy_dissipated": (("time",), "J", "work of the damping since t = 0 (cumulative)"),
+    "errors": (("time",), "1", "each step's predictor-corrector distance relative to L"),
+    "iterations": (("time",), "1", "Newton iterations of each step"),
+    "tendon_lengths": (("time", "tendon"), "m", "each tendon's length along its path"),
+}
+_UNBATCHED = ("times", "s")
+_ENERGIES = ("kinetic", "elastic", "gravity", "dissipated")
+
+#: The ``.csv`` columns of a trajectory, one row per (case, time, station), case-major: a first
+#: column for the swept parameter (or ``batch_index``) in a sweep, then these; the columns of
+#: one time (energies, error, iterations, tendon lengths ``tendon_K_length_m``) repeat on each
+#: of its stations' rows.
+TRAJECTORY_COLUMNS = (
+    "t_s", "s_m", "x_m", "y_m", "z_m", "quat_w", "quat_x", "quat_y", "quat_z",
+    "v_x_m_per_s", "v_y_m_per_s", "v_z_m_per_s",
+    "omega_x_rad_per_s", "omega_y_rad_per_s", "omega_z_rad_per_s",
+    "gamma_1", "gamma_2", "gamma_3", "kappa_1_per_m", "kappa_2_per_m", "kappa_3_per_m",
+    "n_1_N", "n_2_N", "n_3_N", "m_1_Nm", "m_2_Nm", "m_3_Nm",
+    "kinetic_J", "elastic_J", "gravity_J", "dissipated_J", "step_error", "iterations",
+)
 
 
-@dataclass(frozen=True)
-class TrajectoryEnergy:
-    """A saved trajectory's energies (J), each (T,): as :class:`softarm.Energy`'s."""
-
-    kinetic: np.ndarray
-    elastic: np.ndarray
-    gravity: np.ndarray
-    dissipated: np.ndarray
-
-    @property
-    def total(self) -> np.ndarray:
-        return self.kinetic + self.elastic + self.gravity + self.dissipated
-
-
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class SavedTrajectory:
-    """A motion read by :func:`load_trajectory`: the arrays of :data:`TRAJECTORY_ARRAYS`
-    under :class:`softarm.Trajectory`'s names (``energy`` with its ``kinetic``, ...), what
-    the viewer draws (``radii`` or the case's ``arm``, ``name``) and the file's ``path``."""
+    """A trajectory file read back (:func:`read_trajectory`): the arrays of a
+    :class:`softarm.Trajectory` under the same names and shapes (without ``final``: a file
+    keeps no solver state to continue from), the case and what the file says of the run.
+
+    Attributes
+    ----------
+    times, s, positions, rotations, velocities, angular_velocities, strains, stresses,
+    energy, errors, iterations, tendon_lengths
+        As :class:`softarm.Trajectory`'s (batch axes first).
+    case : Case
+        The case embedded in the file.
+    complete : bool
+        False if the run stopped early (Ctrl-C, a step that could not be solved): the file
+        holds the steps done before.
+    steps_requested : int
+        ``duration / dt`` of the case's ``[simulate]`` table.
+    reason : str
+        Why the run stopped early ("" when complete).
+    sweep_values : ndarray or None
+        The swept parameter per case (batch shape (cases,)), with its ``sweep_label``.
+    version : str
+        softarm version that wrote the file.
+    path : pathlib.Path
+    """
 
     times: np.ndarray
     s: np.ndarray
     positions: np.ndarray
     rotations: np.ndarray
-    energy: TrajectoryEnergy
-    radii: np.ndarray | None
-    name: str | None
-    arm: object | None
+    velocities: np.ndarray
+    angular_velocities: np.ndarray
+    strains: np.ndarray
+    stresses: np.ndarray
+    energy: object
+    errors: np.ndarray
+    iterations: np.ndarray
+    tendon_lengths: np.ndarray | None
+    case: Case
+    complete: bool
+    steps_requested: int
+    reason: str
+    sweep_values: np.ndarray | None
+    sweep_label: str | None
+    version: str
     path: Path
 
+    @property
+    def tip_position(self) -> np.ndarray:
+        """p(L, t), shape (B..., T, 3) (m, spatial)."""
+        return self.positions[..., -1, :]
 
-def is_trajectory_file(path: str | os.PathLike) -> bool:
-    """True if ``path`` is an NPZ archive holding a ``times`` array (a trajectory, not an
-    equilibrium written by :func:`save_result`)."""
+    @property
+    def batch_shape(self) -> tuple[int, ...]:
+        return self.positions.shape[:-3]
+
+
+def _trajectory_arrays(trajectory) -> dict:
+    arrays = {name: np.asarray(getattr(trajectory, name)) for name in TRAJECTORY_ARRAYS
+              if not name.startswith("energy_") and name != "tendon_lengths"}
+    for name in _ENERGIES:
+        arrays[f"energy_{name}"] = np.asarray(getattr(trajectory.energy, name))
+    if trajectory.tendon_lengths is not None:
+        arrays["tendon_lengths"] = np.asarray(trajectory.tendon_lengths)
+    return arrays
+
+
+def _trajectory_meta(trajectory, case: Case, complete: bool, reason: str) -> dict:
+    sweep = case.sweep
+    return {"softarm_version": __version__, "kind": "trajectory", "name": case.name,
+            "batch_shape": list(trajectory.batch_shape), "steps": int(trajectory.times.size - 1),
+            "steps_requested": int(case.simulation.steps) if case.simulation else None,
+            "complete": bool(complete), "reason": reason,
+            "sweep_column": sweep.column if sweep is not None else None,
+            "sweep_label": sweep.label if sweep is not None else None,
+            "sweep_values": list(sweep.values) if sweep is not None else None,
+            "rotation": _ROTATION_NOTE.replace("rotation vector rotvec_* in rad and ", ""),
+            "case": case.to_dict()}
+
+
+def save_trajectory(trajectory, path: str | os.PathLike, case: Case, *, complete: bool = True,
+                    reason: str = "") -> Path:
+    """Write a :class:`softarm.Trajectory` of ``case`` to ``path``; the suffix chooses the
+    format (``.npz``, ``.zarr`` (a folder; needs ``softarm[sweep]``) or ``.csv``).
+
+    ``.npz``: the arrays of :data:`TRAJECTORY_ARRAYS` and ``meta`` (one JSON string: the
+    softarm version, ``complete``, ``steps`` and ``steps_requested``, ``reason``, the sweep,
+    the case). ``.zarr``: the same arrays as an xarray Dataset (``zarr_format=2``), dims as
+    in :data:`TRAJECTORY_ARRAYS` after ``case`` for a sweep, the metadata in the attribute
+    ``meta``. ``.csv``: ``#`` comment lines (the title, the conventions, ``# meta:`` and
+    ``# case:`` JSON lines), a header and one row per (case, time, station)
+    (:data:`TRAJECTORY_COLUMNS`). Every format is written to a temporary name beside
+    ``path`` and renamed: no half-written output. ``complete=False`` (with a ``reason``)
+    marks a run that stopped early.
+    """
     path = Path(path)
-    if path.suffix.lower() != ".npz" or not zipfile.is_zipfile(path):
-        return False
-    with zipfile.ZipFile(path) as archive:
-        return "times.npy" in archive.namelist()
+    suffix = path.suffix.lower()
+    if suffix not in TRAJECTORY_FORMATS:
+        raise ValueError(f"{path}: unknown trajectory format {path.suffix!r}; use one of "
+                         f"{', '.join(TRAJECTORY_FORMATS)}")
+    arrays = _trajectory_arrays(trajectory)
+    meta = _trajectory_meta(trajectory, case, complete, reason)
+    if suffix == ".npz":
+        with write_atomic(path, "wb") as stream:
+            np.savez(stream, **arrays, meta=np.array(json.dumps(meta)))
+    elif suffix == ".zarr":
+        _save_zarr(arrays, meta, path)
+    else:
+        with write_atomic(path, "w") as stream:
+            _write_trajectory_csv(stream, arrays, meta)
+    return path
 
 
-def load_trajectory(path: str | os.PathLike) -> SavedTrajectory:
-    """Read a trajectory's NPZ file (the arrays of :data:`TRAJECTORY_ARRAYS`).
+def _dataset(arrays: dict, meta: dict):
+    import xarray
+
+    batch = tuple(meta["batch_shape"])
+    names = ("case",) if len(batch) == 1 else tuple(f"batch_{i}" for i in range(len(batch)))
+    variables = {}
+    for name, array in arrays.items():
+        dims, unit, meaning = TRAJECTORY_ARRAYS[name]
+        if name in _UNBATCHED:
+            continue
+        variables[name] = ((*names, *dims), array, {"units": unit, "long_name": meaning})
+    coords = {"time": ("time", arrays["times"], {"units": "s"}),
+              "station": ("station", arrays["s"], {"units": "m", "long_name": "arc length s"})}
+    if meta["sweep_values"] is not None:
+        coords[meta["sweep_column"]] = ("case", np.asarray(meta["sweep_values"]),
+                                        {"long_name": meta["sweep_label"]})
+    return xarray.Dataset(variables, coords=coords,
+                          attrs={"softarm_version": meta["softarm_version"],
+                                 "complete": int(meta["complete"]),
+                                 "meta": json.dumps(meta)})
+
+
+def _save_zarr(arrays: dict, meta: dict, path: Path) -> None:
+    """The Dataset written to a temporary folder beside ``path``, then renamed onto it (an
+    old store at ``path`` is removed only after the new one is whole)."""
+    import shutil
+    import tempfile
+
+    try:
+        import xarray  # noqa: F401
+        import zarr  # noqa: F401
+    except ImportError as error:
+        raise CaseError(f"{path}: a .zarr output needs xarray and zarr ({error.name} is "
+                        "missing): pip install 'softarm[sweep]'") from None
+    if path.exists() and not path.is_dir():
+        raise CaseError(f"{path}: exists and is not a folder (a Zarr store is a folder)")
+    parent = path.parent if str(path.parent) else Path(".")
+    tmp = Path(tempfile.mkdtemp(prefix=f".{path.name}.", suffix=".part", dir=parent))
+    old = None
+    try:
+        _dataset(arrays, meta).to_zarr(tmp / "store", mode="w", zarr_format=2,
+                                       consolidated=True)
+        if path.exists():
+            old = tmp / "old"
+            os.replace(path, old)
+        os.replace(tmp / "store", path)
+    except BaseException:
+        if old is not None and not path.exists():
+            os.replace(old, path)
+        raise
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+def _write_trajectory_csv(stream, arrays: dict, meta: dict) -> None:
+    stream.write(f"# softarm {meta['softarm_version']} trajectory: {meta['name']}"
+                 + ("" if meta["complete"] else f" (INCOMPLETE: {meta['reason']})") + "\n")
+    stream.write(f"# {meta['rotation']}; velocities in the spatial frame\n")
+    stream.write("# meta: " + json.dumps({k: v for k, v in meta.items()
+                                          if k not in ("rotation", "case")}) + "\n")
+    stream.write("# case: " + json.dumps(meta["case"]) + "\n")
+    batch = tuple(meta["batch_shape"])
+    cases = int(np.prod(batch))
+    times, s = arrays["times"], arrays["s"]
+    T, S = times.size, s.size
+
+    def per_station(name, width):
+        return np.asarray(arrays[name]).reshape(cases, T, S, width)
+
+    def per_time(name):  # repeated on each station
+        value = np.asarray(arrays[name], dtype=float).reshape(cases, T, -1)
+        return np.broadcast_to(value[:, :, None, :], (cases, T, S, value.shape[-1]))
+
+    quat = so3.to_quaternion(np.asarray(arrays["rotations"])).reshape(cases, T, S, 4)
+    blocks = [np.broadcast_to(times[None, :, None, None], (cases, T, S, 1)),
+              np.broadcast_to(s[None, None, :, None], (cases, T, S, 1)),
+              per_station("positions", 3), quat, per_station("velocities", 3),
+              per_station("angular_velocities", 3), per_station("strains", 6),
+              per_station("stresses", 6)]
+    blocks += [per_time(f"energy_{name}") for name in _ENERGIES]
+    blocks += [per_time("errors"), per_time("iterations")]
+    header = list(TRAJECTORY_COLUMNS)
+    if "tendon_lengths" in arrays:
+        lengths = per_time("tendon_lengths")
+        blocks.append(lengths)
+        header += [f"tendon_{k + 1}_length_m" for k in range(lengths.shape[-1])]
+    if batch:
+        lead = np.asarray(meta["sweep_values"], dtype=float) if meta["sweep_values"] \
+            is not None else np.arange(cases, dtype=float)
+        blocks.insert(0, np.broadcast_to(lead[:, None, None, None], (cases, T, S, 1)))
+        header.insert(0, meta["sweep_column"] or "batch_index")
+    table = np.concatenate(blocks, axis=-1).reshape(-1, len(header))
+    writer = csv.writer(stream, lineterminator="\n")
+    writer.writerow(header)
+    for row in table:
+        writer.writerow([repr(float(v)) for v in row])
+
+
+def read_trajectory(path: str | os.PathLike) -> SavedTrajectory:
+    """Read a trajectory written by :func:`save_trajectory` (``softarm simulate -o``).
+
+    Returns
+    -------
+    SavedTrajectory
+        The arrays as :class:`softarm.Trajectory` names them, the case, and whether the run
+        was complete.
 
     Raises
     ------
     CaseError
-        If the file is missing, not an NPZ archive, or lacks an array or has one of the
-        wrong shape or with values that are not finite, naming it.
+        If the file is missing, of an unknown format or not a softarm trajectory.
     """
+    from .dynamics import Energy
+
     path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix not in TRAJECTORY_FORMATS:
+        raise CaseError(f"{path}: unknown trajectory format {path.suffix!r}; expected one of "
+                        f"{', '.join(TRAJECTORY_FORMATS)}")
     if not path.exists():
         raise CaseError(f"{path}: no such file")
-    if path.is_dir() or not zipfile.is_zipfile(path):
-        raise CaseError(f"{path}: not a softarm trajectory file (not an NPZ archive, or "
-                        "truncated)")
     try:
-        with np.load(path, allow_pickle=False) as data:
-            missing = [name for name in TRAJECTORY_ARRAYS if name not in data.files]
-            if missing:
-                raise CaseError(f"{path}: not a softarm trajectory file (no "
-                                f"{', '.join(missing)} array{'s' if len(missing) > 1 else ''})")
-            arrays = {name: np.asarray(data[name], dtype=float) for name in TRAJECTORY_ARRAYS}
-            radii = np.asarray(data["radii"], dtype=float) if "radii" in data.files else None
-            name = str(data["name"]) if "name" in data.files else None
-            meta = json.loads(str(data["meta"])) if "meta" in data.files else {}
+        if suffix == ".npz":
+            with np.load(path, allow_pickle=False) as data:
+                meta = json.loads(str(data["meta"]))
+                arrays = {name: data[name] for name in data.files if name != "meta"}
+        elif suffix == ".zarr":
+            import xarray
+
+            with xarray.open_dataset(path, engine="zarr", consolidated=True) as data:
+                meta = json.loads(data.attrs["meta"])
+                arrays = {name: np.asarray(data[name].values) for name in data.data_vars}
+                arrays["times"] = np.asarray(data["time"].values)
+                arrays["s"] = np.asarray(data["station"].values)
+        else:
+            meta, arrays = _read_trajectory_csv(path)
+        if meta.get("kind") != "trajectory":
+            raise CaseError(f"{path}: not a softarm trajectory (kind {meta.get('kind')!r})")
+        batch = tuple(meta["batch_shape"])
+        T, S = arrays["times"].size, arrays["s"].size
+        for name, array in arrays.items():
+            dims = TRAJECTORY_ARRAYS[name][0]
+            sizes = {"time": T, "station": S, "axis": 3, "row": 3, "column": 3,
+                     "component": 6}
+            shape = (*(() if name in _UNBATCHED else batch),
+                     *(sizes.get(d, array.shape[-1]) for d in dims))
+            if array.shape != shape:
+                raise CaseError(f"{path}: not a valid softarm trajectory: {name!r} has shape "
+                                f"{array.shape}, expected {shape}")
+        case = _parse(meta["case"], path)
     except CaseError:
         raise
-    except Exception as error:  # truncated or garbage archives
-        raise CaseError(f"{path}: not a softarm trajectory file ({type(error).__name__}: "
+    except KeyError as error:
+        raise CaseError(f"{path}: not a softarm trajectory (no {error} entry)") from None
+    except Exception as error:  # truncated or garbage files included
+        raise CaseError(f"{path}: not a softarm trajectory ({type(error).__name__}: "
                         f"{_brief(error)})") from None
-    T, S = arrays["times"].size, arrays["s"].size
-    shapes = {"times": (T,), "s": (S,), "positions": (T, S, 3), "rotations": (T, S, 3, 3),
-              **{name: (T,) for name in TRAJECTORY_ARRAYS[4:]}}
-    for key, shape in shapes.items():
-        if arrays[key].shape != shape:
-            raise CaseError(f"{path}: {key} must have shape {shape} (T = {T} times, S = {S} "
-                            f"stations), got {arrays[key].shape}")
-        if not np.all(np.isfinite(arrays[key])):
-            raise CaseError(f"{path}: {key} holds values that are not finite")
-    if T < 1 or S < 2 or np.any(np.diff(arrays["times"]) <= 0):
-        raise CaseError(f"{path}: times must increase and there must be two stations or more")
-    if radii is not None and (radii.shape != (S,) or not np.all(radii > 0)):
-        raise CaseError(f"{path}: radii must be {S} positive radii in m, got shape "
-                        f"{radii.shape}")
-    arm = None
-    if meta.get("case"):
-        try:
-            case = _parse(meta["case"], path, batched=True)
-        except CaseError as error:
-            raise CaseError(f"{path}: embedded case: {error}") from None
-        arm, name = case.arm, name or case.name
-    energy = TrajectoryEnergy(*(arrays[f"energy_{k}"] for k in
-                                ("kinetic", "elastic", "gravity", "dissipated")))
-    return SavedTrajectory(arrays["times"], arrays["s"], arrays["positions"],
-                           arrays["rotations"], energy, radii, name, arm, path)
+    sweep = meta.get("sweep_values")
+    return SavedTrajectory(
+        times=arrays["times"], s=arrays["s"], positions=arrays["positions"],
+        rotations=arrays["rotations"], velocities=arrays["velocities"],
+        angular_velocities=arrays["angular_velocities"], strains=arrays["strains"],
+        stresses=arrays["stresses"],
+        energy=Energy(*(arrays[f"energy_{name}"] for name in _ENERGIES)),
+        errors=arrays["errors"], iterations=arrays["iterations"].astype(np.int64),
+        tendon_lengths=arrays.get("tendon_lengths"), case=case,
+        complete=bool(meta["complete"]), steps_requested=meta.get("steps_requested"),
+        reason=str(meta.get("reason", "")),
+        sweep_values=None if sweep is None else np.asarray(sweep, dtype=float),
+        sweep_label=meta.get("sweep_label"), version=str(meta.get("softarm_version", "")),
+        path=path)
+
+
+def _read_trajectory_csv(path: Path) -> tuple[dict, dict]:
+    meta: dict = {}
+    header, rows = None, []
+    with path.open(newline="", encoding="utf-8") as stream:
+        for line in stream:
+            if line.startswith("# meta: "):
+                meta.update(json.loads(line[len("# meta: "):]))
+            elif line.startswith("# case: "):
+                meta["case"] = json.loads(line[len("# case: "):])
+            elif line.startswith("#") or not line.strip():
+                continue
+            elif header is None:
+                header = next(csv.reader([line]))
+            else:
+                rows.append([float(v) for v in next(csv.reader([line]))])
+    if header is None or meta.get("kind") != "trajectory":
+        raise CaseError(f"{path}: not a softarm trajectory (no '# meta:' line or header)")
+    batch = tuple(meta["batch_shape"])
+    table = np.asarray(rows, dtype=float)
+    column = {name: table[:, k] for k, name in enumerate(header)}
+    cases = int(np.prod(batch))
+    times = np.unique(column["t_s"])
+    s = np.unique(column["s_m"])
+    T, S = times.size, s.size
+    if table.shape[0] != cases * T * S:
+        raise CaseError(f"{path}: {table.shape[0]} rows, expected {cases * T * S} (batch "
+                        f"{batch}, {T} times, {S} stations)")
+
+    def get(names):
+        return np.stack([column[n] for n in names], -1).reshape(*batch, T, S, len(names))
+
+    n = TRAJECTORY_COLUMNS
+    arrays = {"times": times, "s": s, "positions": get(n[2:5]),
+              "rotations": so3.from_quaternion(get(n[5:9])),
+              "velocities": get(n[9:12]), "angular_velocities": get(n[12:15]),
+              "strains": get(n[15:21]), "stresses": get(n[21:27])}
+    for name, key in zip(_ENERGIES, n[27:31], strict=True):
+        arrays[f"energy_{name}"] = get((key,))[..., 0, 0]
+    arrays["errors"] = get(("step_error",))[..., 0, 0]
+    arrays["iterations"] = get(("iterations",))[..., 0, 0]
+    tendons = [h for h in header if h.startswith("tendon_") and h.endswith("_length_m")]
+    if tendons:
+        arrays["tendon_lengths"] = get(tendons)[..., 0, :]
+    return meta, arrays

@@ -27,7 +27,8 @@ from .geometry import (
     tube_surface,
 )
 
-__all__ = ["describe_loads", "plot_equilibrium", "plot_result_file", "plot_sweep"]
+__all__ = ["describe_loads", "plot_equilibrium", "plot_result_file", "plot_sweep",
+           "plot_trajectory"]
 
 #: Figure size in inches and resolution of saved pictures (pixels = size × dpi).
 FIGSIZE = (11.0, 5.5)
@@ -280,3 +281,102 @@ def plot_result_file(source, path: str | os.PathLike | None = None, *, fig=None)
         return plot_sweep(result, saved.sweep_values, label=saved.sweep_label,
                           sweep=saved.case.sweep, fig=fig, path=path, name=name)
     return plot_equilibrium(result, fig=fig, path=path, name=name)
+
+
+def _motion_plane(points: np.ndarray) -> tuple[int, int]:
+    """The two spatial axes (indices) along which ``points`` (..., 3) spread the most, in
+    increasing order: the plane a side view of a motion shows best."""
+    spread = np.ptp(points.reshape(-1, 3), axis=0)
+    first, second = sorted(int(i) for i in np.argsort(spread)[-2:])
+    return first, second
+
+
+def plot_trajectory(trajectory, *, name: str = "", sweep=None, snapshots: int = 9, fig=None,
+                    path: str | os.PathLike | None = None):
+    """A picture of a motion (a :class:`softarm.Trajectory` or a trajectory file read back
+    with :func:`softarm.io.read_trajectory`): snapshots of the arm at ``snapshots`` evenly
+    spaced times coloured by time, with the tip's path, in the side view of the two spatial
+    axes it moves along most; the tip's coordinates over time; and the change of each
+    energy since t = 0 (kinetic, elastic, gravity, dissipated and their total, which the
+    base's and actuators' work changes).
+
+    A batch (a sweep) shows the tip paths and final shapes of every case, coloured by case
+    (``sweep``: the case's :class:`softarm.sweep.Sweep`, for the colour bar's label), the
+    distance of each tip from its start and each case's total energy change.
+    """
+    matplotlib, Figure = _matplotlib()
+    fig = Figure(figsize=FIGSIZE) if fig is None else fig
+    grid = fig.add_gridspec(2, 2, width_ratios=(1.2, 1.0), left=0.08, right=0.97,
+                            bottom=0.1, top=0.88, wspace=0.25, hspace=0.4)
+    ax = fig.add_subplot(grid[:, 0])
+    ax_tip, ax_energy = fig.add_subplot(grid[0, 1]), fig.add_subplot(grid[1, 1])
+    times = np.asarray(trajectory.times)
+    positions = np.asarray(trajectory.positions)
+    batch = positions.shape[:-3]
+    positions = positions.reshape(-1, *positions.shape[-3:])  # (cases, T, S, 3)
+    a, b = _motion_plane(positions)
+    names = "xyz"
+    cmap = matplotlib.colormaps["viridis"]
+    energy = trajectory.energy
+    change = {key: np.asarray(getattr(energy, key)).reshape(-1, times.size)
+              for key in ("kinetic", "elastic", "gravity", "dissipated", "total")}
+    change = {key: value - value[:, :1] for key, value in change.items()}
+    if not batch:
+        picks = np.unique(np.linspace(0, times.size - 1, max(2, snapshots)).round().astype(int))
+        duration = times[-1] - times[0]
+        for k in picks:
+            colour = cmap((times[k] - times[0]) / duration if duration > 0 else 0.0)
+            ax.plot(positions[0, k, :, a], positions[0, k, :, b], color=colour, linewidth=2.0)
+        ax.plot(positions[0, :, -1, a], positions[0, :, -1, b], color="0.4", linewidth=0.8,
+                linestyle="--", label="tip path")
+        ax.plot(positions[0, :, 0, a], positions[0, :, 0, b], color="k", linewidth=2.5,
+                marker="s", markersize=4, label="base")
+        mappable = matplotlib.cm.ScalarMappable(
+            norm=matplotlib.colors.Normalize(times[0], times[-1]), cmap=cmap)
+        fig.colorbar(mappable, ax=ax, label=f"t (s) of the {picks.size} snapshots",
+                     shrink=0.8)
+        tip = positions[0, :, -1] - positions[0, :1, -1]
+        for i, colour in zip(range(3), ("tab:red", "tab:green", "tab:blue"), strict=True):
+            ax_tip.plot(times, tip[:, i], color=colour, label=names[i])
+        ax_tip.set_ylabel("tip displacement (m)")
+        styles = {"kinetic": "tab:orange", "elastic": "tab:blue", "gravity": "tab:green",
+                  "dissipated": "tab:purple", "total": "k"}
+        for key, colour in styles.items():
+            ax_energy.plot(times, change[key][0], color=colour, label=key,
+                           linewidth=2.0 if key == "total" else 1.2)
+        ax.legend(fontsize=8, loc="best")
+    else:
+        cases = positions.shape[0]
+        values = np.asarray(sweep.values, dtype=float) if sweep is not None else \
+            np.arange(cases, dtype=float)
+        span = (values.min(), values.max()) if values.max() > values.min() else (0.0, 1.0)
+        for c in range(cases):
+            colour = cmap((values[c] - span[0]) / (span[1] - span[0]))
+            ax.plot(positions[c, :, -1, a], positions[c, :, -1, b], color=colour,
+                    linewidth=0.8, linestyle="--")
+            ax.plot(positions[c, -1, :, a], positions[c, -1, :, b], color=colour, linewidth=2.0)
+            ax_tip.plot(times, np.linalg.norm(positions[c, :, -1] - positions[c, :1, -1],
+                                              axis=-1), color=colour)
+            ax_energy.plot(times, change["total"][c], color=colour)
+        mappable = matplotlib.cm.ScalarMappable(
+            norm=matplotlib.colors.Normalize(*span), cmap=cmap)
+        fig.colorbar(mappable, ax=ax, label=sweep.label if sweep is not None else "case",
+                     shrink=0.8)
+        ax_tip.set_ylabel("tip distance from start (m)")
+        ax.set_title("tip paths (dashed) and shapes at the end", fontsize=10)
+    ax.set_xlabel(f"{names[a]} (m)")
+    ax.set_ylabel(f"{names[b]} (m)")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.grid(True, linewidth=0.4, alpha=0.5)
+    if not batch:
+        ax.set_title(f"snapshots, side view {names[a]}–{names[b]}", fontsize=10)
+    for axis in (ax_tip, ax_energy):
+        axis.grid(True, linewidth=0.4, alpha=0.5)
+        axis.set_xlabel("t (s)")
+    ax_energy.set_ylabel("energy change since t = 0 (J)")
+    if not batch:
+        ax_tip.legend(fontsize=7, loc="best")
+        ax_energy.legend(fontsize=7, loc="best", ncol=3)
+    fig.suptitle(_wrapped(f"{name or 'trajectory'}: {times.size - 1} steps to "
+                          f"t = {times[-1]:.4g} s"), fontsize=11)
+    return _finish(fig, path)

@@ -1,8 +1,9 @@
 """Interactive 3D views of equilibria in a browser: ``softarm view RESULT -o view.html``,
 :meth:`softarm.Equilibrium.show` and the figures of the live app (``softarm app``); and of
 motions (:func:`trajectory_figure`, :func:`write_trajectory_html`, ``softarm view
-TRAJECTORY.npz``): the moving arm with a time slider, a player at real time or a chosen rate,
-the tip's path and the energy plot (see "trajectories" below).
+TRAJECTORY.npz`` of a ``softarm simulate`` output): the moving arm with a time slider, a
+player at real time or a chosen rate, the tip's path and the energy plot (see "trajectories"
+below).
 
 The figures are built here as plain dicts in plotly's figure schema (``data``, ``layout``,
 ``frames``; a sweep's tip plot as a second figure under ``"tips"``) from
@@ -49,7 +50,7 @@ from .geometry import (
 __all__ = ["NOTEBOOK_PLOTLYJS", "PLAYBACK_RATES", "PLOTLY_MISSING", "TRAJECTORY_FRAMES",
            "axis_ticks", "figure", "frame_indices", "notebook_html", "plotly_js_path",
            "scene_traces", "to_html", "to_json", "trajectory_figure", "view_result_file",
-           "write_html", "write_trajectory_html"]
+           "view_trajectory_file", "write_html", "write_trajectory_html"]
 
 #: The message when plotly is not installed.
 PLOTLY_MISSING = "the browser views need plotly: pip install 'softarm[view]'"
@@ -777,7 +778,7 @@ def _ring_stations(s, radii, arm):
 
 
 def _pose_traces(poses, s, rings, length: float) -> list[dict]:
-    """The traces that move: tube, centreline, tip frame e1 e2 e3 (always this order)."""
+    """The traces that move: tube, centreline, tip frame e1 e2 e3, base (this order)."""
     p = poses[:, :3, 3]
     traces = []
     if rings is not None:
@@ -800,6 +801,12 @@ def _pose_traces(poses, s, rings, length: float) -> list[dict]:
                        "line": {"color": _AXES[k], "width": 6}, "name": axis,
                        "legendgroup": "tip frame", "legendgrouptitle": {"text": "tip frame"},
                        "showlegend": True, "hovertemplate": f"tip frame {axis}<extra></extra>"})
+    # the base moves too where the simulation moved it
+    traces.append({"type": "scatter3d", "mode": "markers", "x": p[:1, 0], "y": p[:1, 1],
+                   "z": p[:1, 2], "marker": {"symbol": "square", "size": 5,
+                                             "color": "rgb(80,80,80)"},
+                   "name": "base", "hovertemplate": "base<extra></extra>",
+                   "showlegend": False})
     return traces
 
 
@@ -814,7 +821,7 @@ def trajectory_figure(trajectory, *, arm=None, radii=None, name: str | None = No
     ----------
     trajectory : softarm.Trajectory
         Unbatched (or anything with its ``times``, ``s``, ``positions``, ``rotations`` and
-        ``energy``, such as :func:`softarm.io.load_trajectory`'s answer).
+        ``energy``, such as :func:`softarm.io.read_trajectory`'s answer).
     arm : Arm, optional
         Draws the tube of its real radius (with a step at a joint).
     radii : array_like, shape (S,), optional
@@ -856,10 +863,6 @@ def trajectory_figure(trajectory, *, arm=None, radii=None, name: str | None = No
                  "line": {"color": "rgb(120,120,120)", "width": 3, "dash": "solid"},
                  "hovertemplate": "tip at t = %{customdata:.4g} s<br>(%{x:.4g}, %{y:.4g}, "
                                   "%{z:.4g}) m<extra></extra>"})
-    data.append({"type": "scatter3d", "mode": "markers", "x": poses[0, :1, 0, 3],
-                 "y": poses[0, :1, 1, 3], "z": poses[0, :1, 2, 3],
-                 "marker": {"symbol": "square", "size": 5, "color": "rgb(80,80,80)"},
-                 "name": "base", "hovertemplate": "base<extra></extra>", "showlegend": False})
     data.append(_cube_anchor(centre, half))
     head = name or "softarm"
     duration = times[-1] - times[0]
@@ -937,3 +940,35 @@ def write_trajectory_html(trajectory, path: str | os.PathLike, **options) -> Pat
     with write_atomic(path, "wb") as stream:
         stream.write(text.encode("utf-8"))
     return path
+
+
+def view_trajectory_file(saved, path: str | os.PathLike, *, case: int | None = None) -> Path:
+    """:func:`write_trajectory_html` for a trajectory file read by
+    :func:`softarm.io.read_trajectory` (``saved``, a :class:`softarm.io.SavedTrajectory`):
+    the tube of its case's arm, titled with the case's name; of a sweep of simulations, case
+    number ``case`` (counted from 1; default 1), with its parameter in the title."""
+    import dataclasses
+
+    if isinstance(saved, (str, os.PathLike)):
+        raise TypeError(f"saved must be a softarm.io.SavedTrajectory (softarm.io."
+                        f"read_trajectory(path)), got the path {str(saved)!r}")
+    batch = tuple(saved.batch_shape)
+    name = saved.case.name
+    if len(batch) > 1:
+        raise ValueError(f"{saved.path}: cannot view a batch of shape {batch}")
+    if batch:
+        k = 1 if case is None else case
+        if isinstance(k, bool) or not isinstance(k, int) or not 1 <= k <= batch[0]:
+            raise ValueError(f"{saved.path}: case must be 1 ... {batch[0]} (the file holds "
+                             f"{batch[0]} simulations), got {case!r}")
+        energy = saved.energy
+        saved = dataclasses.replace(
+            saved, positions=saved.positions[k - 1], rotations=saved.rotations[k - 1],
+            energy=type(energy)(*(getattr(energy, n)[k - 1] for n, _ in _ENERGIES[:4])))
+        label = saved.sweep_label or "case"
+        value = saved.sweep_values[k - 1] if saved.sweep_values is not None else k
+        name = f"{name} ({label} = {value:.6g})"
+    elif case not in (None, 1):
+        raise ValueError(f"{saved.path}: case must be 1 (the file holds one simulation), got "
+                         f"{case!r}")
+    return write_trajectory_html(saved, path, arm=saved.case.arm, name=name)

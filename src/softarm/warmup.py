@@ -25,6 +25,7 @@ import numpy as np
 from . import analytic
 from .control import ForwardSolver, inverse
 from .dispatch import solve
+from .dynamics import simulate
 from .loads import Chamber, DistributedForce, Gravity, Tendon, TipLoad
 from .model import Arm, Circle, Material
 from .routing import Straight
@@ -106,6 +107,18 @@ def _stiff():
     solve(arm, [TipLoad(force=[1e3, 0.0, 1.0]), DistributedForce([0.0, 0.0, 0.0])])
 
 
+def _dynamics():
+    arm = Arm.from_stiffness(1.0, EA=1e3, GAy=1e3, GAz=1e3, GJ=1.0, EIy=1.0, EIz=1.0,
+                             mass_per_length=1.0, inertia_per_length=(1e-4, 5e-5, 5e-5))
+    simulate(arm, [Gravity()], duration=2e-3, dt=1e-3, stations=5)
+
+
+def _dynamics_actuated():
+    arm = Arm(0.2, Circle(0.01), Material(1e6, poisson_ratio=0.5, density=1100.0))
+    simulate(arm, actuators=[Tendon(tension=0.1, routing=Straight(0.0, 0.005))],
+             duration=2e-3, dt=1e-3, stations=5)
+
+
 @dataclass(frozen=True)
 class Step:
     """One capability to compile: ``name`` (its keys in the compile record, see
@@ -140,6 +153,10 @@ STEPS: tuple[Step, ...] = (
     Step("critical", "critical loads and continuation", ("shoot", "branch"), _critical),
     Step("stiff", "multiple shooting (arms in strong tension: kL >= 15)", ("stiff+verdict",),
          _stiff),
+    Step("dynamics", "dynamics of passive arms (softarm.simulate, Simulator)", ("dynamics",),
+         _dynamics),
+    Step("actuated dynamics", "dynamics of actuated and magnetic arms",
+         ("dynamics+actuated",), _dynamics_actuated),
 )
 
 

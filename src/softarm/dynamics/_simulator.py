@@ -186,8 +186,8 @@ class Simulator:
     >>> arm = Arm(0.5, Circle(0.02), Material(1e6, poisson_ratio=0.5, density=1100.0))
     >>> sim = Simulator(arm, loads=[Gravity()], dt=1e-3, stations=21)
     >>> state = sim.step()
-    >>> round(float(state.tip_position[2]) * 1e6, 1)  # ≈ -g Δt²/2 (a free fall, at first)
-    -4.9
+    >>> round(float(state.tip_position[2]) * 1e6, 1)  # -g Δt²: a free fall's backward-Euler step
+    -9.8
     """
 
     def __init__(self, arm, actuators=(), loads=(), *, dt, damping=None, initial=None,
@@ -246,7 +246,15 @@ class Simulator:
         self._grid = (self._h, self._node_piece, np.ascontiguousarray(s))
         self._gravity = self._gravity_of(self.loads, shape)
         data = self._solver._data
-        self._scales = np.array([self.length] * 3 + [1.0] * 3 + [data.force_scale] * 3
+        # The scales of the unknowns and of the equations' rows (the tolerance is relative
+        # to them): positions by L, forces by the bending scale EI/L² (a transverse force
+        # error δV bends the arm by δV L²/EI), except the axial force, by EA (its error
+        # stretches the arm by δN/EA only; at EI/L² the fast axial waves, which the
+        # predictor cannot follow and which move no point by tol, cost two iterations a
+        # step), moments by EI/L, velocities by L/Δt and 1/Δt.
+        axial = float(np.min(pieces[8][:, 0, 0]))
+        self._scales = np.array([self.length] * 3 + [1.0] * 3
+                                + [axial, data.force_scale, data.force_scale]
                                 + [data.force_scale * self.length] * 3
                                 + [self.length / self.dt] * 3 + [1.0 / self.dt] * 3)
         self._options = np.array([self.tol, MAX_ITERATIONS], dtype=np.float64)
@@ -384,7 +392,7 @@ class Simulator:
             self._settle(initial, Z, H, base0)
         H[..., 12:24] = H[..., 0:12]
         H[..., 24:36] = 0.0
-        return Z, Z.copy(), H, np.zeros((B, 2))
+        return Z, np.stack([Z, Z], axis=1), H, np.zeros((B, 2))
 
     def _settle(self, initial, Z, H, base0) -> None:
         """Z, H ← the equilibrium of ``initial``'s loads at rest on this grid: the equations
@@ -416,7 +424,7 @@ class Simulator:
                  (("p", 3), ("R", 9), ("v", 3), ("w", 3), ("e", 6), ("s", 6))}
         info, done = np.zeros((B, 1, 4)), np.zeros(B, dtype=np.int64)
         options = np.array([min(self.tol, 1e-9), 4 * MAX_ITERATIONS])
-        k.dynamic_steps(Z, Z.copy(), H, np.zeros((B, 2)), props,
+        k.dynamic_steps(Z, np.stack([Z, Z], axis=1), H, np.zeros((B, 2)), props,
                         np.ascontiguousarray(piece.reshape(B, P, -1)),
                         np.ascontiguousarray(tip.reshape(B, -1)), self._grid, coef,
                         self._scales, options, base, self._gravity, self._at, 0, B,
@@ -490,10 +498,12 @@ class Simulator:
                                   (first, steps, self._coef, self._props)):
             if b > a:
                 q = None if inputs is None else inputs[a:b]
-                parts.append(self._kernel_run(arrays, times[a:b], coef, props, factors,
-                                              threads, q))
-                if factors is not None:
+                if factors is not None and factors[4] is not coef:
                     factors[3][:] = 0  # (the Jacobian changes with the scheme)
+                    factors[4] = coef
+                parts.append(self._kernel_run(arrays, times[a:b], coef, props,
+                                              None if factors is None else tuple(factors[:4]),
+                                              threads, q))
         if len(parts) == 1:
             return (times, *parts[0])
         (out1, e1, i1, d1), (out2, e2, i2, d2) = parts
@@ -553,8 +563,8 @@ class Simulator:
         residual) if a case's step cannot be solved: the simulator's state (and inputs)
         are then unchanged."""
         q = self._q if inputs is None else self._checked_inputs(inputs, 1)[0]
-        if self._factors is None:
-            self._factors = self._storage(True, int(np.prod(self.shape)))
+        if self._factors is None:  # (kept between steps: the chord iteration's factors)
+            self._factors = [*self._storage(True, int(np.prod(self.shape))), None]
         arrays = tuple(a.copy() for a in self._arrays)
         times, out, _, info, done = self._advance(
             1, self._factors, arrays=arrays, inputs=None if q is None else q[None])

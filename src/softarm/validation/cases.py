@@ -23,6 +23,7 @@ from ..model import Arm, SegmentedArm
 from ..routing import Helix, Straight
 from . import references as ref
 from ._checks import CaseResult, DataTables, finding, gate, skipped
+from ._motion import dynamics
 from ._routes import (
     NUMERIC,
     attempt,
@@ -930,4 +931,13 @@ CASES: tuple[ValidationCase, ...] = (
         "tip load, Airy functions) and Prandtl's lateral-torsional buckling of a narrow "
         "strip; solve(branch='stable') past the Euler load against the post-buckling "
         "elastica table (Timoshenko & Gere §2.7, elliptic integrals).", stability),
+    ValidationCase(
+        "dynamics", "Dynamics: frequencies, energy, a large swing (issue 32)",
+        "softarm.simulate against Timoshenko's cantilever (the first two bending frequencies "
+        "with shear and rotary inertia, L/r = 20; the first torsional and axial ones) from a "
+        "simulated free vibration at Δt = T/200; the energy of a released undamped arm over "
+        "20 periods; a heavy soft arm (L = 0.5 m, r = 20 mm, E = 1 MPa) released horizontal "
+        "and swinging under gravity for a period, against an independent method-of-lines "
+        "solution (tests/_mol_rod.py, Richardson-extrapolated). Till & Rucker's C++ "
+        "examples are compared in tests/test_dynamics_references.py.", dynamics),
 )
