@@ -31,6 +31,18 @@ def get(url):
         return error.code, json.loads(error.read())
 
 
+def states(url, after, query=""):
+    """The states after step ``after`` (asking again while the server has none: a first step
+    compiles the dynamics kernel, which may take longer than a request waits)."""
+    end = time.monotonic() + 300
+    while True:
+        status, reply = get(url + f"/state?after={after}{query}")
+        assert status == 200, reply
+        if reply["states"] or time.monotonic() > end:
+            return reply["states"]
+        query = ""
+
+
 @pytest.fixture(scope="module")
 def motion():
     live = app.LiveMotion(softarm.load_case(EXAMPLES / "tendon_robot.toml"), DYNAMICS)
@@ -47,22 +59,18 @@ def motion():
 
 def test_served_states_are_the_simulators(motion):
     url, live = motion
-    status, reply = get(url + "/state?after=-1")
-    assert status == 200
-    first = reply["states"][0]
+    first = states(url, -1)[0]
     # change a tension and switch another tendon off, then take a state 40 steps later
-    status, reply = get(url + f"/state?after={first['index']}&l2.tension=5.5&l3.on=0")
-    assert status == 200
-    index = start = reply["states"][-1]["index"]
+    index = start = states(url, first["index"], "&l2.tension=5.5&l3.on=0")[-1]["index"]
     while index < start + 40:
-        status, reply = get(url + f"/state?after={index}")
-        later = reply["states"][-1]
+        reply = states(url, index)
+        later = reply[-1]
         # the states after the index asked for, in order
-        assert [s["index"] for s in reply["states"]] == sorted({s["index"] for s in
-                                                                 reply["states"]})
-        assert reply["states"][0]["index"] > index
+        assert [s["index"] for s in reply] == sorted({s["index"] for s in reply})
+        assert reply[0]["index"] > index
         index = later["index"]
     status, history = get(url + "/history")
+    assert status == 200
     assert history["replayable"] and history["history"][0] == [0, [3.0, 1.0, 0.0]]
     assert history["history"][-1][1] == [5.5, 0.0, 0.0]  # (tendon 2 switched off: 0 N)
     # the second method: a Simulator of the same case stepped one step at a time
@@ -96,8 +104,9 @@ def test_bad_requests(motion):
 
 def test_a_state_waits_for_a_newer_one(motion):
     url, _ = motion
-    _, a = get(url + "/state?after=-1")
-    a = a["states"][-1]
+    a = states(url, -1)[-1]
+    states(url, a["index"])  # (the first steps compiled)
+    a = states(url, -1)[-1]
     start = time.perf_counter()
     _, b = get(url + f"/state?after={a['index']}")
     b = b["states"][0]
@@ -137,3 +146,22 @@ def test_cli_dynamic_options(argv, message, capsys):
     assert cli.main(["app", str(EXAMPLES / "demo.toml"), "--no-browser", *argv]) == 2
     out, err = capsys.readouterr()
     assert out == "" and message in err and err.strip().count("\n") <= 1
+
+
+def test_settings_from_the_simulate_table():
+    case = softarm.load_case(EXAMPLES / "whip.toml")  # dt 1 ms, 41 stations, τ = 2 ms
+    settings = app.Dynamics.of(case)
+    assert (settings.dt, settings.stations, settings.initial) == (0.001, 41, "equilibrium")
+    assert settings.damping_law().retardation == 0.002
+    settings = app.Dynamics.of(case, dt=0.004, damping=0.01)
+    assert (settings.dt, settings.damping_law().retardation) == (0.004, 0.01)
+    plain = app.Dynamics.of(softarm.load_case(EXAMPLES / "demo.toml"))
+    assert (plain.dt, plain.stations, plain.damping) == (2e-3, 41, None)
+
+
+def test_cli_static_and_dynamic_exclude_each_other(capsys):
+    from softarm import cli
+
+    assert cli.main(["app", str(EXAMPLES / "whip.toml"), "--static", "--dt", "0.001"]) == 2
+    _, err = capsys.readouterr()
+    assert err == "softarm: error: --static cannot go with --dynamic, --dt or --damping\n"

@@ -657,25 +657,53 @@ def serve(case: Case, *, port: int = 8050, browser: bool = True, stream=None,
 
 @dataclass(frozen=True)
 class Dynamics:
-    """The settings of the dynamic mode (``softarm app --dynamic``; later a case's
-    ``[simulate]`` table): the time step ``dt`` (s), the ``stations`` of the simulation,
-    Kelvin–Voigt ``damping`` (a retardation time τ in s, or None: undamped) and the
-    playback ``rate`` (1: real time)."""
+    """The settings of the dynamic mode (``softarm app --dynamic``, or a case's
+    ``[simulate]`` table: :meth:`of`): the time step ``dt`` (s), the ``stations``, ``tol``
+    and ``alpha`` of :class:`softarm.Simulator`, its Kelvin–Voigt ``damping`` (a
+    :class:`softarm.Damping`, a retardation time τ in s, or None: undamped), where it starts
+    (``initial``: "equilibrium", the case's loads balanced at rest, or "rest", the unloaded
+    arm at rest) and the playback ``rate`` (1: real time)."""
 
     dt: float = 2e-3
     stations: int = 41
-    damping: float | None = None
+    damping: object = None
+    initial: str = "equilibrium"
     rate: float = 1.0
+    tol: float = 1e-6
+    alpha: float = -0.5
 
     def __post_init__(self):
         for name in ("dt", "rate"):
             value = getattr(self, name)
             if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
                 raise ValueError(f"Dynamics.{name} must be a positive number, got {value!r}")
-        if self.damping is not None and not (math.isfinite(self.damping)
-                                             and self.damping >= 0):
-            raise ValueError(f"Dynamics.damping must be a retardation time >= 0 s or None, "
-                             f"got {self.damping!r}")
+        if isinstance(self.damping, (int, float)) and not isinstance(self.damping, bool):
+            if not (math.isfinite(self.damping) and self.damping >= 0):
+                raise ValueError(f"Dynamics.damping must be a retardation time >= 0 s, a "
+                                 f"softarm.Damping or None, got {self.damping!r}")
+        if self.initial not in ("equilibrium", "rest"):
+            raise ValueError(f"Dynamics.initial must be 'equilibrium' or 'rest', got "
+                             f"{self.initial!r}")
+
+    @classmethod
+    def of(cls, case: Case, **overrides) -> Dynamics:
+        """The settings of ``case``'s ``[simulate]`` table (its dt, stations, tol, alpha,
+        damping and initial state; its input schedules and base motion are not used: the
+        sliders drive the arm), with ``overrides``; the defaults without a table."""
+        table = case.simulation
+        settings = {} if table is None else {
+            "dt": table.dt, "stations": table.stations, "tol": table.tol,
+            "alpha": table.alpha, "damping": table.damping, "initial": table.initial}
+        settings.update({k: v for k, v in overrides.items() if v is not None})
+        return cls(**settings)
+
+    def damping_law(self):
+        """The :class:`softarm.Damping` (or None)."""
+        from .dynamics import Damping
+
+        if self.damping is None or isinstance(self.damping, Damping):
+            return self.damping
+        return Damping(retardation=float(self.damping))
 
 
 #: The longest a request for a newer state waits, s.
@@ -704,18 +732,19 @@ class LiveMotion:
 
     def __init__(self, case: Case, dynamics: Dynamics = Dynamics()):
         from .dispatch import solve
-        from .dynamics import Damping, Simulator
+        from .dynamics import Simulator
 
         self.case, self.dynamics = case, dynamics
         self.inputs = inputs(case)
         self.by_name = {item.name: item for item in self.inputs}
         self.values = {item.name: item.value for item in self.inputs}
         self._actuated = [i for i, load in enumerate(case.loads) if load.inputs]
-        self._damping = None if dynamics.damping is None else \
-            Damping(retardation=dynamics.damping)
+        self._damping = dynamics.damping_law()
         self._Simulator = Simulator
-        # at rest in the equilibrium of the case's loads (the arm moves when a slider does)
-        self._initial = solve(case.arm, case.loads)
+        # at rest in the equilibrium of the case's loads (the arm moves when a slider does),
+        # or the unloaded arm at rest (the loads act from t = 0)
+        self._initial = solve(case.arm, case.loads) if dynamics.initial == "equilibrium" \
+            else None
         self._lock = threading.Condition()
         self._thread = None
         self._running = False
@@ -751,7 +780,7 @@ class LiveMotion:
         actuators = [self.case.loads[i] for i in self._actuated]
         self.simulator = self._Simulator(self.case.arm, actuators, self._passive(), dt=d.dt,
                                          damping=self._damping, initial=initial,
-                                         stations=d.stations)
+                                         stations=d.stations, tol=d.tol, alpha=d.alpha)
         self._q = self._inputs_now() if actuators else None
         if initial is self._initial:  # from the start: the steps from here on
             self.history = [(self.index, None if self._q is None else self._q.tolist())]
@@ -934,9 +963,16 @@ class LiveMotion:
         scene = {"length": float(case.arm.length), "s": self.simulator.s.tolist(),
                  "radii": None if self.radii is None else self.radii.tolist(),
                  "base": first["states"][0]["positions"][0], "dt": d.dt, "rate": d.rate}
+        damping = self._damping
         settings = (f"dynamic: Δt = {d.dt:g} s, {d.stations} stations, "
-                    + ("undamped" if d.damping is None else f"damping τ = {d.damping:g} s")
+                    + ("undamped" if damping is None else
+                       f"damping τ = {damping.retardation:g} s" if damping.matrix is None
+                       else "damping B (6 × 6)")
                     + ("" if d.rate == 1 else f", {d.rate:g} × real time"))
+        table = case.simulation
+        if table is not None and (table.inputs or table.base is not None):
+            settings += ("; the [simulate] table's input schedules and base motion are not "
+                         "used here (the sliders drive the arm)")
         return _MOTION_PAGE.format(
             style=_STYLE, name=html.escape(case.name),
             description=html.escape(case.description or ""), settings=html.escape(settings),
