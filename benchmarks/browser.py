@@ -6,7 +6,8 @@ WebGL: --disable-gpu), printed as a small table:
 - sweep slider move -> redrawn frame in the viewer (plotly_sliderchange to two animation
   frames after the figure's plotly_afterplot);
 - app slider move -> redrawn arm (the input event to two animation frames after Plotly.react),
-  split into the solve on the server, the HTTP round trip and the redraw.
+  split into the solve on the server, the HTTP round trip and the redraw;
+- the app's dynamic mode: new states drawn a second, the round trip, the drawing.
 
 Run: python benchmarks/browser.py [--moves 20]   (needs chromium, chromium-driver, selenium
 and plotly; see tests/_browser.py). Times depend on the machine and its load.
@@ -102,6 +103,29 @@ def app_redraws(driver, moves: int) -> list[dict]:
         server.server_close()
 
 
+def motion_frames(driver, seconds: float = 4.0):
+    """The dynamic mode (softarm app --dynamic) on the demo case with a tip pull: the frames
+    drawn in the last ``seconds`` - 1 s ([state index, time, round trip, wait for the animation
+    frame, drawing] ms each) and the server's step time."""
+    live = app.LiveMotion(softarm.load_case(ROOT / "examples" / "demo.toml"),
+                          app.Dynamics(dt=2e-3, damping=0.02))
+    server = app.make_server(live, port=0)
+    threading.Thread(target=server.serve_forever, daemon=True).start()
+    live.start()
+    try:
+        driver.get(f"http://127.0.0.1:{server.server_address[1]}/")
+        _wait(driver, "return window.softarmFrames && window.softarmFrames.length > 5")
+        driver.execute_script("const s = document.getElementById('l2.force.y');"
+                              "s.value = s.max; s.dispatchEvent(new Event('input'));")
+        time.sleep(seconds)
+        frames = driver.execute_script("return window.softarmFrames")
+        return [f for f in frames if f[1] >= frames[-1][1] - 1e3 * (seconds - 1)], live.step_ms
+    finally:
+        live.stop()
+        server.shutdown()
+        server.server_close()
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--moves", type=int, default=20)
@@ -131,6 +155,7 @@ def main() -> None:
             print(f"viewer sweep slider -> redraw: median {statistics.median(redraws):.0f} ms, "
                   f"min {min(redraws):.0f}, max {max(redraws):.0f} ({len(redraws)} moves)")
             timings = app_redraws(driver, args.moves)
+            frames, step_ms = motion_frames(driver)
         finally:
             driver.quit()
     for key, what in (("total", "slider -> redrawn"), ("solve", "solve (server)"),
@@ -138,6 +163,12 @@ def main() -> None:
         values = [t[key] for t in timings]
         print(f"app {what}: median {statistics.median(values):.1f} ms, min {min(values):.1f}, "
               f"max {max(values):.1f} ({len(values)} moves)")
+    span = (frames[-1][1] - frames[0][1]) / 1e3
+    new = len({f[0] for f in frames})
+    print(f"app --dynamic (demo, dt 2 ms, 41 stations): {(len(frames) - 1) / span:.1f} frames a "
+          f"second, {new} new states of {len(frames)} drawn; median round trip "
+          f"{statistics.median(f[2] for f in frames):.1f} ms, drawing "
+          f"{statistics.median(f[4] for f in frames):.1f} ms; last step {step_ms:.2f} ms")
 
 
 if __name__ == "__main__":

@@ -31,7 +31,7 @@ import numpy as np
 from . import __version__
 from .case import Case, CaseError, load_case
 from .errors import ConvergenceError, InadmissibleStateError, StabilityWarning
-from .io import FORMATS, load_saved, save_result
+from .io import FORMATS, load_saved, read_trajectory, save_result
 from .sweep import solve_case
 
 __all__ = ["main"]
@@ -206,8 +206,16 @@ def _parser() -> argparse.ArgumentParser:
         "view", help="write an interactive 3D view of a saved result (HTML)",
         description="Write a self-contained HTML file (opens offline in any browser) with an "
         "interactive 3D view of a result written by 'softarm solve -o': the arm as a tube, "
-        "hover read-outs, the loads; a sweep gets a slider. Needs pip install 'softarm[view]'.")
-    view.add_argument("result", metavar="RESULT", help="result file (.csv, .json or .npz)")
+        "hover read-outs, the loads; a sweep gets a slider. A trajectory (written by softarm "
+        "simulate): the moving arm with a time slider, play at "
+        "real time or a chosen rate, the tip's path and the energy plot. Needs pip install "
+        "'softarm[view]'.")
+    view.add_argument("result", metavar="RESULT",
+                      help="result file (.csv, .json or .npz) or trajectory file (softarm "
+                      "simulate's .npz, .zarr or .csv)")
+    view.add_argument("--case", type=_positive, metavar="K",
+                      help="of a trajectory file of a sweep of simulations, the case to view "
+                      "(counted from 1; default 1)")
     view.add_argument("-o", "--output", metavar="HTML",
                       help="HTML file to write (default: RESULT with suffix .html)")
     view.set_defaults(run=_run_view)
@@ -222,6 +230,18 @@ def _parser() -> argparse.ArgumentParser:
                      help="TCP port on 127.0.0.1 (default 8050; 0: any free port)")
     app.add_argument("--no-browser", action="store_true",
                      help="do not open a browser tab, only print the address")
+    app.add_argument("--dynamic", action="store_true",
+                     help="the arm in motion: the sliders drive a simulation stepped in real "
+                     "time (softarm.Simulator) and the page shows the arm swinging; the "
+                     "default for a case with a [simulate] table (its dt, stations, damping)")
+    app.add_argument("--static", action="store_true",
+                     help="the static app even for a case with a [simulate] table")
+    app.add_argument("--dt", type=_seconds, metavar="DT",
+                     help="the dynamic mode's time step in s (default: the [simulate] "
+                     "table's, else 0.002; implies --dynamic)")
+    app.add_argument("--damping", type=_seconds, metavar="TAU",
+                     help="the dynamic mode's Kelvin-Voigt retardation time in s (default: "
+                     "the [simulate] table's, else undamped; implies --dynamic)")
     app.set_defaults(run=_run_app)
 
     inverse = commands.add_parser(
@@ -762,15 +782,46 @@ def _run_view(args) -> int:
     source = Path(args.result)
     page = _check_output(args.output or str(source.with_suffix(".html")), (".html", ".htm"),
                          "page", [source])
-    saved = load_saved(source)
+    trajectory = _is_trajectory(source)  # written by softarm simulate
+    saved = read_trajectory(source) if trajectory else load_saved(source)
     try:
         from . import view
 
-        view.view_result_file(saved, page)
+        if trajectory:
+            view.view_trajectory_file(saved, page, case=args.case)
+        else:
+            if args.case is not None:
+                raise CaseError(f"{source}: --case is for a trajectory file of a sweep of "
+                                "simulations; this is a result file")
+            view.view_result_file(saved, page)
     except ImportError as error:  # plotly missing
         raise CaseError(f"{page}: {error}") from None
     print(f"wrote {page}")
     return 0
+
+
+def _is_trajectory(path: Path) -> bool:
+    """True if ``path`` is a trajectory file (softarm.io.save_trajectory's: a ``.zarr``
+    folder, or ``.npz`` or ``.csv`` whose metadata say ``"kind": "trajectory"``)."""
+    import json
+    import zipfile
+
+    suffix = path.suffix.lower()
+    try:
+        if suffix == ".zarr":
+            return path.is_dir()
+        if suffix == ".npz" and zipfile.is_zipfile(path):
+            with np.load(path, allow_pickle=False) as data:
+                return "meta" in data.files and \
+                    json.loads(str(data["meta"])).get("kind") == "trajectory"
+        if suffix == ".csv" and path.is_file():
+            with path.open(encoding="utf-8") as stream:
+                for line, _ in zip(stream, range(50), strict=False):
+                    if line.startswith("# meta: "):
+                        return json.loads(line[len("# meta: "):]).get("kind") == "trajectory"
+    except (OSError, ValueError, UnicodeDecodeError):
+        return False  # (then read as a result file, which says what is wrong)
+    return False
 
 
 def _port(text: str) -> int:
@@ -783,12 +834,31 @@ def _port(text: str) -> int:
     return value
 
 
+def _seconds(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a time in s, got {text!r}") from None
+    if not (np.isfinite(value) and value >= 0):
+        raise argparse.ArgumentTypeError(f"must be a time >= 0 s, got {text!r}")
+    return value
+
+
 def _run_app(args) -> int:
     case = load_case(args.case)
     from . import app
 
+    dynamics = None
+    asked = args.dynamic or args.dt is not None or args.damping is not None
+    if args.static and asked:
+        raise CaseError("--static cannot go with --dynamic, --dt or --damping")
+    if asked or (case.simulation is not None and not args.static):
+        if args.dt == 0:
+            raise CaseError("--dt must be a positive time step in s, got 0")
+        dynamics = app.Dynamics.of(case, dt=args.dt, damping=args.damping)
     try:
-        return app.serve(case, port=args.port, browser=not args.no_browser)
+        return app.serve(case, port=args.port, browser=not args.no_browser,
+                         dynamics=dynamics)
     except ImportError as error:  # plotly missing
         raise CaseError(str(error)) from None
 

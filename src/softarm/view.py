@@ -1,5 +1,9 @@
 """Interactive 3D views of equilibria in a browser: ``softarm view RESULT -o view.html``,
-:meth:`softarm.Equilibrium.show` and the figures of the live app (``softarm app``).
+:meth:`softarm.Equilibrium.show` and the figures of the live app (``softarm app``); and of
+motions (:func:`trajectory_figure`, :func:`write_trajectory_html`, ``softarm view
+TRAJECTORY.npz`` of a ``softarm simulate`` output): the moving arm with a time slider, a
+player at real time or a chosen rate, the tip's path and the energy plot (see "trajectories"
+below).
 
 The figures are built here as plain dicts in plotly's figure schema (``data``, ``layout``,
 ``frames``; a sweep's tip plot as a second figure under ``"tips"``) from
@@ -43,9 +47,10 @@ from .geometry import (
     tube_surface,
 )
 
-__all__ = ["NOTEBOOK_PLOTLYJS", "PLOTLY_MISSING", "axis_ticks", "figure", "notebook_html",
-           "plotly_js_path", "scene_traces", "to_html", "to_json", "view_result_file",
-           "write_html"]
+__all__ = ["NOTEBOOK_PLOTLYJS", "PLAYBACK_RATES", "PLOTLY_MISSING", "TRAJECTORY_FRAMES",
+           "axis_ticks", "figure", "frame_indices", "notebook_html", "plotly_js_path",
+           "scene_traces", "to_html", "to_json", "trajectory_figure", "view_result_file",
+           "view_trajectory_file", "write_html", "write_trajectory_html"]
 
 #: The message when plotly is not installed.
 PLOTLY_MISSING = "the browser views need plotly: pip install 'softarm[view]'"
@@ -451,12 +456,26 @@ _DRAW = """(function () {
     if (!gd || gd.getAttribute("data-drawn")) return;
     gd.setAttribute("data-drawn", "1");
     gd.textContent = "";
-    var tips = fig.tips && document.getElementById(id + "-tips");
+    // a sweep's tip plot or a motion's energy plot, in a <div> of its own (see to_html)
+    var side = fig.tips || fig.energy, tips = side && document.getElementById(id + "-tips");
     Plotly.newPlot(gd, fig.data, fig.layout, config).then(function () {
-      if (fig.frames) sweep(gd, tips);
+      if (fig.player) motion(gd, tips); else if (fig.frames) sweep(gd, tips);
     });
-    if (tips) Plotly.newPlot(tips, fig.tips.data, fig.tips.layout,
+    if (tips) Plotly.newPlot(tips, side.data, side.layout,
                              {displaylogo: false, responsive: true, displayModeBar: false});
+  }
+  // a frame: its data merged into the figure and one Plotly.react (see sweep below)
+  function showFrame(gd, tips, k) {
+    var frame = fig.frames[k], side = fig.tips || fig.energy;
+    frame.traces.forEach(function (t, i) { Object.assign(gd.data[t], frame.data[i]); });
+    gd.layout.title = frame.layout.title;
+    gd.layout.sliders[0].active = k;
+    gd.layout.datarevision = (gd.layout.datarevision || 0) + 1;
+    // a 2D animation step without redraw moves the side plot's marker alone (a restyle
+    // would redraw that whole plot, as costly again as the 3D frame); it is the last trace
+    if (tips) Plotly.animate(tips, {data: [side.shown[k]], traces: [side.data.length - 1]},
+      {mode: "immediate", frame: {duration: 0, redraw: false}, transition: {duration: 0}});
+    return Plotly.react(gd, gd.data, gd.layout);
   }
   // A sweep's slider and play button (method "skip": plotly.js only draws them) show a
   // frame by merging its data into the figure and one Plotly.react. Plotly.animate would
@@ -465,18 +484,7 @@ _DRAW = """(function () {
   function sweep(gd, tips) {
     var frames = fig.frames, playing = null;
     var names = frames.map(function (frame) { return frame.name; });
-    function show(k) {
-      var frame = frames[k];
-      frame.traces.forEach(function (t, i) { Object.assign(gd.data[t], frame.data[i]); });
-      gd.layout.title = frame.layout.title;
-      gd.layout.sliders[0].active = k;
-      gd.layout.datarevision = (gd.layout.datarevision || 0) + 1;
-      // a 2D animation step without redraw moves the tip plot's marker alone (a restyle
-      // would redraw that whole plot, as costly again as the 3D frame)
-      if (tips) Plotly.animate(tips, {data: [fig.tips.shown[k]], traces: [3]},
-        {mode: "immediate", frame: {duration: 0, redraw: false}, transition: {duration: 0}});
-      return Plotly.react(gd, gd.data, gd.layout);
-    }
+    function show(k) { return showFrame(gd, tips, k); }
     function play() {
       var token = {}, k = gd.layout.sliders[0].active;
       playing = token;
@@ -496,6 +504,52 @@ _DRAW = """(function () {
     });
     gd.on("plotly_buttonclicked", function (event) {
       if (event.button.label === "\u25b6") play(); else playing = null;
+    });
+  }
+  // A motion's player: the last frame whose time has come at the chosen rate (real time:
+  // the trajectory's own seconds), redrawn as soon as the previous redraw is done; frames
+  // that come faster than the browser redraws are skipped, the motion keeps its pace.
+  // gd.softarmPlayed lists [frame, the playback's clock (s of the trajectory), the wall
+  // clock (ms)] when each frame drawn while playing was chosen.
+  function motion(gd, tips) {
+    var times = fig.player.times, rates = fig.player.rates, n = times.length;
+    var names = fig.frames.map(function (frame) { return frame.name; });
+    var rate = 1, playing = null, k = 0, t0 = 0, wall0 = 0;
+    gd.softarmPlayed = [];
+    function anchor() { t0 = times[k]; wall0 = performance.now(); }
+    function show(j) { k = j; return showFrame(gd, tips, j); }
+    function play() {
+      var token = {};
+      playing = token;
+      k = gd.layout.sliders[0].active;
+      var start = k >= n - 1 ? show(0) : Promise.resolve();
+      start.then(function () {
+        anchor();
+        (function tick() {
+          if (playing !== token) return;
+          var t = t0 + (performance.now() - wall0) / 1000 * rate, j = k;
+          while (j + 1 < n && times[j + 1] <= t) j++;
+          if (j === k) {  // the next frame's time has not come yet
+            setTimeout(tick, Math.max(0, (times[k + 1] - t) / rate * 1000));
+            return;
+          }
+          var chosen = performance.now();
+          show(j).then(function () {
+            gd.softarmPlayed.push([j, t, chosen]);
+            if (j >= n - 1) playing = null; else requestAnimationFrame(tick);
+          });
+        })();
+      });
+    }
+    gd.on("plotly_sliderchange", function (event) {
+      playing = null;
+      var j = names.indexOf(event.step.label);
+      if (j >= 0) show(j);
+    });
+    gd.on("plotly_buttonclicked", function (event) {
+      var label = event.button.label;
+      if (label in rates) { rate = rates[label]; anchor(); }
+      else if (label === "\u25b6") play(); else playing = null;
     });
   }
   if (window.Plotly) { draw(); return; }
@@ -538,10 +592,11 @@ def to_html(fig: dict, *, full_html: bool = True, div_id: str | None = None,
     size = f"height:{int(height)}px;" if height else f"height:100vh; min-height:{_MIN_HEIGHT}px;"
     script = _DRAW % {"id": json.dumps(div_id), "fig": to_json(fig).replace("</", "<\\/"),
                       "waiting": json.dumps(_WAITING)}
-    own = "height:100%;" if "tips" in fig else size  # a sweep's: that of its container
+    side = "tips" in fig or "energy" in fig  # a sweep's tip plot, a motion's energy plot
+    own = "height:100%;" if side else size  # then: that of its container
     main = (f'<div id="{html.escape(div_id)}" class="plotly-graph-div" '
             f'style="{own} width:100%;"></div>')
-    if "tips" in fig:  # a sweep's tip plot over the right of the 3D figure, see figure()
+    if side:  # a sweep's tip plot over the right of the 3D figure, see figure()
         # its axes from 0.1 to 0.7 of the plotting area's height (that of the page less the
         # 3D figure's margins), whatever the page's height: CSS percentages of the container
         margin = fig["layout"]["margin"]
@@ -623,3 +678,297 @@ def view_result_file(saved, path: str | os.PathLike) -> Path:
     return write_html(result, path, name=case.name if case is not None else None,
                       values=saved.sweep_values, label=saved.sweep_label,
                       sweep=case.sweep if case is not None else None)
+
+
+# ---------------------------------------------------------------------------- trajectories
+#
+# A trajectory's page: the 3D scene of view.figure's kind (the tube, the centreline, the tip's
+# frame, the base, the fixed axis cube) with one frame per shown time, the tip's path over the
+# whole motion, and the energy budget against time in a 2D figure of its own (fig["energy"],
+# laid over the right of the 3D figure like a sweep's tip plot, see to_html) with a cursor at
+# the shown time. The page's script (_DRAW, "trajectory") plays it at real time times the
+# chosen rate: each redraw shows the last frame whose time has come, so a browser that redraws
+# slower than the frames come drops frames instead of slowing the motion down.
+
+#: Frames of a trajectory's page, at most (a frame holds the tube: about 10 kB in the page).
+TRAJECTORY_FRAMES = 240
+#: Points of the tip's path and of the energy curves, at most (every k-th time).
+_CURVE_POINTS = 4000
+#: The playback rates' drop-down menu's width in pixels.
+_RATES_WIDTH = 90
+#: The playback rates offered (label, rate); "real time" (1) first, the default.
+PLAYBACK_RATES = (("real time", 1.0), ("1/2 ×", 0.5), ("1/4 ×", 0.25), ("1/10 ×", 0.1),
+                  ("1/100 ×", 0.01), ("2 ×", 2.0), ("5 ×", 5.0))
+_ENERGIES = (("kinetic", "rgb(31,119,180)"), ("elastic", "rgb(44,160,44)"),
+             ("gravity", "rgb(140,86,75)"), ("dissipated", "rgb(214,39,40)"),
+             ("total", "rgb(0,0,0)"))
+
+
+def frame_indices(times, frames: int = TRAJECTORY_FRAMES) -> np.ndarray:
+    """The indices of the times shown as frames: all of them up to ``frames``, else
+    ``frames`` times evenly spread in time (the nearest stored time to each of
+    ``frames`` equally spaced instants from the first to the last, without repeats),
+    always the first and the last.
+
+    >>> frame_indices(np.linspace(0.0, 1.0, 1001), 5).tolist()
+    [0, 250, 500, 750, 1000]
+    """
+    times = np.asarray(times, dtype=float)
+    if isinstance(frames, bool) or not isinstance(frames, (int, np.integer)) or frames < 2:
+        raise ValueError(f"frames must be an integer >= 2, got {frames!r}")
+    if times.size <= frames:
+        return np.arange(times.size)
+    wanted = np.linspace(times[0], times[-1], frames)
+    index = np.clip(np.searchsorted(times, wanted), 1, times.size - 1)
+    nearer = np.where(wanted - times[index - 1] <= times[index] - wanted, index - 1, index)
+    return np.unique(np.concatenate([[0], nearer, [times.size - 1]]))
+
+
+def _every(count: int, most: int) -> np.ndarray:
+    """Every k-th of ``count`` indices (k the smallest that keeps at most ``most``) and the
+    last."""
+    step = max(1, math.ceil(count / most))
+    return np.unique(np.append(np.arange(0, count, step), count - 1))
+
+
+def _trajectory_arrays(trajectory):
+    """(times (T,), s (S,), poses (T, S, 4, 4), energies {name: (T,)}) of an unbatched
+    trajectory (anything with :class:`softarm.Trajectory`'s ``times``, ``s``,
+    ``positions``, ``rotations`` and ``energy``), checked."""
+    times = np.asarray(trajectory.times, dtype=float)
+    s = np.asarray(trajectory.s, dtype=float)
+    positions = np.asarray(trajectory.positions, dtype=float)
+    rotations = np.asarray(trajectory.rotations, dtype=float)
+    if positions.ndim != 3:
+        raise ValueError("trajectory must be unbatched (positions of shape (T, S, 3)), got "
+                         f"positions of shape {positions.shape}; view one case: pass the "
+                         "arrays of that case")
+    T, S = times.size, s.size
+    if positions.shape != (T, S, 3) or rotations.shape != (T, S, 3, 3):
+        raise ValueError(f"trajectory: positions {positions.shape} and rotations "
+                         f"{rotations.shape} do not match {T} times and {S} stations")
+    if T < 1 or np.any(np.diff(times) <= 0) or not np.all(np.isfinite(times)):
+        raise ValueError("trajectory.times must be finite and increasing")
+    poses = np.zeros((T, S, 4, 4))
+    poses[..., :3, :3] = rotations
+    poses[..., :3, 3] = positions
+    poses[..., 3, 3] = 1.0
+    energy = trajectory.energy
+    energies = {name: np.asarray(getattr(energy, name), dtype=float)
+                for name, _ in _ENERGIES[:4]}
+    energies["total"] = sum(energies.values())
+    for name, values in energies.items():
+        if values.shape != (T,):
+            raise ValueError(f"trajectory.energy.{name} must have shape ({T},), got "
+                             f"{values.shape}")
+    return times, s, poses, energies
+
+
+def _ring_stations(s, radii, arm):
+    """The rings of the tube (index, radii) or None (no radius known)."""
+    if arm is not None:
+        return tube_rings(arm, s, _RINGS)
+    if radii is None:
+        return None
+    radii = np.broadcast_to(np.asarray(radii, dtype=float), s.shape)
+    if not np.all(np.isfinite(radii) & (radii > 0)):
+        raise ValueError("radii must be positive finite tube radii in m, one per station")
+    index = _every(s.size, _RINGS)
+    return index, radii[index]
+
+
+def _pose_traces(poses, s, rings, length: float) -> list[dict]:
+    """The traces that move: tube, centreline, tip frame e1 e2 e3, base (this order)."""
+    p = poses[:, :3, 3]
+    traces = []
+    if rings is not None:
+        index, radii = rings
+        vertices, triangles = tube_mesh(poses[index], radii, sides=_SIDES)
+        traces.append({"type": "mesh3d", "x": vertices[:, 0], "y": vertices[:, 1],
+                       "z": vertices[:, 2], "i": triangles[:, 0], "j": triangles[:, 1],
+                       "k": triangles[:, 2], "color": _TUBE, "opacity": 1.0,
+                       "hoverinfo": "skip", "name": "arm", "showlegend": True})
+    traces.append({"type": "scatter3d", "mode": "lines" if rings is not None else
+                   "lines+markers", "x": p[:, 0], "y": p[:, 1], "z": p[:, 2],
+                   "customdata": s, "line": {"color": _LINE, "width": 4},
+                   "marker": {"size": 2, "color": _LINE}, "name": "centreline",
+                   "hovertemplate": "s = %{customdata:.4g} m<br>p = (%{x:.4g}, %{y:.4g}, "
+                                    "%{z:.4g}) m<extra>centreline</extra>"})
+    frame = tip_frame(poses, 0.15 * length)
+    for k, axis in enumerate(("e1", "e2", "e3")):
+        traces.append({"type": "scatter3d", "mode": "lines", "x": frame[k, :, 0],
+                       "y": frame[k, :, 1], "z": frame[k, :, 2],
+                       "line": {"color": _AXES[k], "width": 6}, "name": axis,
+                       "legendgroup": "tip frame", "legendgrouptitle": {"text": "tip frame"},
+                       "showlegend": True, "hovertemplate": f"tip frame {axis}<extra></extra>"})
+    # the base moves too where the simulation moved it
+    traces.append({"type": "scatter3d", "mode": "markers", "x": p[:1, 0], "y": p[:1, 1],
+                   "z": p[:1, 2], "marker": {"symbol": "square", "size": 5,
+                                             "color": "rgb(80,80,80)"},
+                   "name": "base", "hovertemplate": "base<extra></extra>",
+                   "showlegend": False})
+    return traces
+
+
+def trajectory_figure(trajectory, *, arm=None, radii=None, name: str | None = None,
+                      frames: int = TRAJECTORY_FRAMES, height: int | None = 650) -> dict:
+    """The plotly figure of a motion: a dict with ``data``, ``layout``, ``frames`` (the
+    moving traces at the shown times) and ``energy`` (the energy plot, a figure of its own),
+    drawn by :func:`to_html`'s page with a time slider, play and pause and a choice of
+    playback rates (real time: the trajectory's own times).
+
+    Parameters
+    ----------
+    trajectory : softarm.Trajectory
+        Unbatched (or anything with its ``times``, ``s``, ``positions``, ``rotations`` and
+        ``energy``, such as :func:`softarm.io.read_trajectory`'s answer).
+    arm : Arm, optional
+        Draws the tube of its real radius (with a step at a joint).
+    radii : array_like, shape (S,), optional
+        Else the tube's radius at each station (m); neither: the centreline alone.
+    name : str, optional
+        For the title.
+    frames : int
+        The most frames (default :data:`TRAJECTORY_FRAMES`); a longer trajectory shows
+        that many times evenly spread over its duration (:func:`frame_indices`: the slider
+        steps through them, the playback shows the last one whose time has come), and its
+        tip path and energy curves keep every k-th time, at most 4000.
+    height : int or None
+        As :func:`figure`'s.
+    """
+    times, s, poses, energies = _trajectory_arrays(trajectory)
+    shown = frame_indices(times, frames)
+    curve = _every(times.size, _CURVE_POINTS)
+    length = float(s[-1] - s[0])
+    rings = _ring_stations(s, radii, arm)
+    # the axis cube holds the whole motion (the tube's surface at the shown frames)
+    points = [poses[..., :3, 3].reshape(-1, 3)]
+    if rings is not None:
+        index, ring_radii = rings
+        points += [tube_surface(poses[k][index], ring_radii, sides=8).reshape(3, -1).T
+                   for k in shown]
+    centre, half = cube_limits(np.concatenate(points))
+    scene = {"aspectmode": "cube", "domain": {"x": [0.0, 0.66], "y": [0.0, 1.0]},
+             "camera": {"eye": {"x": 1.27, "y": -1.84, "z": 0.86}}}
+    for k, axis in enumerate("xyz"):
+        low, high = centre[k] - half, centre[k] + half
+        scene[f"{axis}axis"] = {"range": [low, high], "tickmode": "array",
+                                "tickvals": axis_ticks(low, high),
+                                "title": {"text": f"{axis} (m)"}}
+    tip = poses[curve, -1, :3, 3]
+    data = _pose_traces(poses[0], s, rings, length)
+    moving = len(data)
+    data.append({"type": "scatter3d", "mode": "lines", "x": tip[:, 0], "y": tip[:, 1],
+                 "z": tip[:, 2], "customdata": times[curve], "name": "tip path",
+                 "line": {"color": "rgb(120,120,120)", "width": 3, "dash": "solid"},
+                 "hovertemplate": "tip at t = %{customdata:.4g} s<br>(%{x:.4g}, %{y:.4g}, "
+                                  "%{z:.4g}) m<extra></extra>"})
+    data.append(_cube_anchor(centre, half))
+    head = name or "softarm"
+    duration = times[-1] - times[0]
+    subtitle = (f"{times.size} times over {duration:.4g} s"
+                + (f"; {shown.size} frames shown (every {duration / (shown.size - 1):.3g} s)"
+                   if shown.size < times.size else ""))
+
+    def caption(k: int) -> str:
+        return (f"{head}: motion, t = {times[k]:.4g} s<br><sub>tip at "
+                f"{_vec(poses[k, -1, :3, 3])} m; {subtitle}</sub>")
+
+    layout = {"scene": scene, "margin": {"l": 10, "r": 10, "t": 60, "b": 40},
+              "legend": {"x": 0.0, "y": 1.0}, "hovermode": "closest",
+              "uirevision": "keep the camera",
+              "title": {"text": caption(0), "x": 0.02, "font": {"size": 14}}}
+    if height is not None:
+        layout["height"] = height
+    names = [f"{t:.6g}" for t in times[shown]]
+    fig = {"data": data, "layout": layout}
+    fig["frames"] = [{"name": names[n], "traces": list(range(moving)),
+                      "data": [_changing(t) for t in _pose_traces(poses[k], s, rings, length)],
+                      "layout": {"title": {"text": caption(k), "x": 0.02,
+                                           "font": {"size": 14}}}}
+                     for n, k in enumerate(shown)]
+    # what the page's player needs: the frames' times (s) and the playback rates
+    fig["player"] = {"times": times[shown].tolist(), "rates": dict(PLAYBACK_RATES)}
+    layout["sliders"] = [{
+        "active": 0, "x": 0.0, "len": 1.0, "y": 0.0, "yanchor": "top",
+        "pad": {"t": 10, "l": _BUTTONS_WIDTH + _RATES_WIDTH + 30, "r": 20},
+        "currentvalue": {"prefix": "t = ", "suffix": " s", "font": {"size": 13}},
+        "steps": [{"label": n, "method": "skip", "args": [[n]]} for n in names]}]
+    layout["updatemenus"] = [
+        {"type": "buttons", "direction": "left", "x": 0.0, "xanchor": "left", "y": 0.0,
+         "yanchor": "top", "pad": {"t": 36, "l": 10}, "showactive": False,
+         "buttons": [{"label": "▶", "method": "skip", "args": [None]},
+                     {"label": "❚❚", "method": "skip", "args": [None]}]},
+        # the playback rate, in the same row right of the buttons (opening upwards)
+        {"type": "dropdown", "direction": "up", "x": 0.0, "xanchor": "left", "y": 0.0,
+         "yanchor": "top", "pad": {"t": 36, "l": _BUTTONS_WIDTH + 15}, "showactive": True,
+         "active": 0,
+         "buttons": [{"label": label, "method": "skip", "args": [None]}
+                     for label, _ in PLAYBACK_RATES]}]
+    # the energy budget, with a cursor (a vertical line) at the shown time
+    energy = [{"type": "scatter", "mode": "lines", "x": times[curve], "y": values[curve],
+               "name": label, "line": {"color": color, "width": 2.5 if label == "total"
+                                       else 1.5, "dash": "dash" if label == "total"
+                                       else "solid"},
+               "hovertemplate": f"t = %{{x:.4g}} s<br>{label} = %{{y:.4g}} J<extra></extra>"}
+              for (label, color), values in zip(_ENERGIES, energies.values(), strict=True)]
+    every = np.concatenate(list(energies.values()))
+    low, high = float(np.min(every)), float(np.max(every))
+    pad = 0.05 * max(high - low, 1e-12 * max(abs(low), abs(high)), 1e-300)
+    bounds = [low - pad, high + pad]
+    energy.append({"type": "scatter", "mode": "lines", "x": [times[0]] * 2, "y": bounds,
+                   "name": "shown", "line": {"color": "rgb(90,90,90)", "width": 1},
+                   "hoverinfo": "skip", "showlegend": False})
+    fig["energy"] = {"data": energy, "layout": {
+        "xaxis": {"title": {"text": "t (s)"}, "range": [times[0], times[-1]]},
+        "yaxis": {"title": {"text": "energy (J)"}, "range": bounds},
+        "margin": {"l": 60, "r": 10, "t": 30, "b": 50},
+        "legend": {"orientation": "h", "x": 0.0, "y": 1.0, "yanchor": "bottom"},
+        "paper_bgcolor": "rgba(0,0,0,0)", "plot_bgcolor": "rgba(0,0,0,0)",
+        "hovermode": "closest"},
+        "shown": [{"x": [float(t)] * 2, "y": bounds} for t in times[shown]]}
+    return fig
+
+
+def write_trajectory_html(trajectory, path: str | os.PathLike, **options) -> Path:
+    """Write :func:`trajectory_figure` (``options`` as there; ``height`` default None: the
+    figure fills the browser's window) as a self-contained HTML file, atomically; returns
+    its path."""
+    options.setdefault("height", None)
+    text = to_html(trajectory_figure(trajectory, **options), div_id="softarm-view")
+    path = Path(path)
+    with write_atomic(path, "wb") as stream:
+        stream.write(text.encode("utf-8"))
+    return path
+
+
+def view_trajectory_file(saved, path: str | os.PathLike, *, case: int | None = None) -> Path:
+    """:func:`write_trajectory_html` for a trajectory file read by
+    :func:`softarm.io.read_trajectory` (``saved``, a :class:`softarm.io.SavedTrajectory`):
+    the tube of its case's arm, titled with the case's name; of a sweep of simulations, case
+    number ``case`` (counted from 1; default 1), with its parameter in the title."""
+    import dataclasses
+
+    if isinstance(saved, (str, os.PathLike)):
+        raise TypeError(f"saved must be a softarm.io.SavedTrajectory (softarm.io."
+                        f"read_trajectory(path)), got the path {str(saved)!r}")
+    batch = tuple(saved.batch_shape)
+    name = saved.case.name
+    if len(batch) > 1:
+        raise ValueError(f"{saved.path}: cannot view a batch of shape {batch}")
+    if batch:
+        k = 1 if case is None else case
+        if isinstance(k, bool) or not isinstance(k, int) or not 1 <= k <= batch[0]:
+            raise ValueError(f"{saved.path}: case must be 1 ... {batch[0]} (the file holds "
+                             f"{batch[0]} simulations), got {case!r}")
+        energy = saved.energy
+        saved = dataclasses.replace(
+            saved, positions=saved.positions[k - 1], rotations=saved.rotations[k - 1],
+            energy=type(energy)(*(getattr(energy, n)[k - 1] for n, _ in _ENERGIES[:4])))
+        label = saved.sweep_label or "case"
+        value = saved.sweep_values[k - 1] if saved.sweep_values is not None else k
+        name = f"{name} ({label} = {value:.6g})"
+    elif case not in (None, 1):
+        raise ValueError(f"{saved.path}: case must be 1 (the file holds one simulation), got "
+                         f"{case!r}")
+    return write_trajectory_html(saved, path, arm=saved.case.arm, name=name)
