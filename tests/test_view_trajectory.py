@@ -212,3 +212,15 @@ def test_cli_view_bad_trajectory(swing, tmp_path, capsys, change):
         assert err == (f"softarm: error: {source}: not a valid softarm trajectory: "
                        "'positions' has shape (151, 5, 3), expected (151, 21, 3)\n")
     assert not page.exists()
+
+
+def test_trajectory_show_writes_the_motions_page(tmp_path):
+    import softarm as _softarm
+
+    arm = _softarm.Arm(0.3, _softarm.Circle(0.01),
+                       _softarm.Material(1e6, poisson_ratio=0.5, density=1100.0))
+    path = _softarm.simulate(arm, [_softarm.Gravity()], duration=0.01, dt=1e-3, stations=11)
+    page = path.show(tmp_path / "motion.html", arm=arm, browser=False)
+    text = page.read_text(encoding="utf-8")
+    assert page == tmp_path / "motion.html" and "softarm-view" in text
+    assert f"{path.times[-1]:g}" in text  # the slider's last time

@@ -264,21 +264,9 @@ class Equilibrium:
         a self-contained HTML file, ``path`` or a new temporary file, open it in the web
         browser unless ``browser`` is False, and return its path. Needs plotly
         (``pip install "softarm[view]"``)."""
-        import tempfile
-        import webbrowser
-        from pathlib import Path
+        from .view import show_page, write_html
 
-        from .view import write_html
-
-        if path is None:
-            handle, path = tempfile.mkstemp(prefix="softarm-", suffix=".html")
-            import os
-
-            os.close(handle)
-        path = write_html(self, path, **options)
-        if browser:
-            webbrowser.open(Path(path).resolve().as_uri())
-        return path
+        return show_page(lambda where: write_html(self, where, **options), path, browser)
 
     def _repr_html_(self) -> str | None:
         """Jupyter's rich display: the interactive 3D view (:func:`softarm.view.notebook_html`:

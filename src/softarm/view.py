@@ -930,6 +930,22 @@ def trajectory_figure(trajectory, *, arm=None, radii=None, name: str | None = No
     return fig
 
 
+def show_page(write, path=None, browser: bool = True) -> Path:
+    """``write(path)`` a page to ``path`` or a new temporary file, open it in the web browser
+    unless ``browser`` is False, and return its path (``Equilibrium.show``,
+    ``Trajectory.show``)."""
+    import tempfile
+    import webbrowser
+
+    if path is None:
+        handle, path = tempfile.mkstemp(prefix="softarm-", suffix=".html")
+        os.close(handle)
+    path = write(path)
+    if browser:
+        webbrowser.open(Path(path).resolve().as_uri())
+    return path
+
+
 def write_trajectory_html(trajectory, path: str | os.PathLike, **options) -> Path:
     """Write :func:`trajectory_figure` (``options`` as there; ``height`` default None: the
     figure fills the browser's window) as a self-contained HTML file, atomically; returns

@@ -149,3 +149,14 @@ class Trajectory(Trajectories):
     tendon_lengths: np.ndarray | None
     final: State
     failed: np.ndarray | None = None
+
+    def show(self, path=None, *, arm=None, browser: bool = True, **options):
+        """Write the motion's page (:func:`softarm.view.trajectory_figure`: the arm moving
+        with a time slider, play at real time or other rates, the tip's path, the energy;
+        ``arm`` draws it as a tube of its radius; ``options`` as there) to a self-contained
+        HTML file, ``path`` or a new temporary file, open it in the web browser unless
+        ``browser`` is False, and return its path. Needs plotly (``softarm[view]``)."""
+        from ..view import show_page, write_trajectory_html
+
+        return show_page(lambda where: write_trajectory_html(self, where, arm=arm, **options),
+                         path, browser)

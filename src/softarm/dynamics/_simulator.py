@@ -456,6 +456,7 @@ class Simulator:
         self._arrays = tuple(a.copy() for a in self._initial)
         self.time = self.t0
         self._q = self.inputs[None].copy() if self.actuators else None  # (C, n)
+        self._lengths_now = None  # the tendons' lengths of the current state, if known
         #: (case index, time the failed step would have reached (s), residual) of every
         #: case that failed in a run(failures="keep")
         self.failures = []
@@ -614,6 +615,8 @@ class Simulator:
             self._mark_failures(done, info, steps, times, out, energy)
         if q is not None:
             self._q = np.array(q[:, -1])
+        if "tendons" in out:
+            self._lengths_now = out["tendons"][:, -1][:, self._tendon_columns]
         self._arrays = arrays
         self._fresh = False
         self.time = float(times[-1])
@@ -722,10 +725,13 @@ class Simulator:
     def _make_state(self, record, error, iterations) -> State:
         shape, S = self.shape, self._at.size
         lengths = record.get("tendons")
-        if lengths is None:
-            lengths = self._tendon_lengths(self._arrays[2])
-        else:
+        if lengths is not None:
             lengths = lengths[:, self._tendon_columns]
+        elif self._lengths_now is not None:  # (the last step's, from the kernel)
+            lengths = self._lengths_now
+        else:
+            lengths = self._tendon_lengths(self._arrays[2])  # (at the start: by quadrature)
+        self._lengths_now = lengths
         return State(
             time=self.time, s=self.s,
             positions=_frozen(record["positions"].reshape(*shape, S, 3)),
