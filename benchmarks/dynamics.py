@@ -210,7 +210,8 @@ def measure(quick: bool, with_pyelastica: bool = False) -> str:
     for row in steps:
         print(f"  step: {row[0]} ({row[1]} stations): {1e6 * row[2]:.0f} µs wall, "
               f"{1e6 * row[3]:.0f} µs CPU", flush=True)
-    settings = [(51, 1e-3)] if quick else [(51, 1e-3), (101, 2e-3), (101, 1e-3), (151, 1e-3)]
+    settings = [(51, 1e-3)] if quick else [(26, 2e-3), (41, 2e-3), (51, 1e-3), (101, 2e-3),
+                                           (101, 1e-3), (151, 1e-3)]
     swings = swing(settings, repeats)
     for row in swings:
         print(f"  swing: {row[0]} stations, dt {row[1]:g}: error {row[2]:.1e} L, "
