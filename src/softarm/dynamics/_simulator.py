@@ -18,7 +18,7 @@ from .._validate import (
 )
 from ..equilibrium import Equilibrium, _frozen
 from ..errors import ConvergenceError
-from ..loads import as_actuators, as_loads
+from ..loads import Gravity, as_actuators, as_loads
 from ..statics import Solver
 from ..statics.solver import _kernels, check_tol
 from ._results import Energy, State, Trajectory
@@ -146,11 +146,13 @@ class Simulator:
     arm : Arm or SegmentedArm
         Its mass (density or ``mass_per_length``) and rotary inertia
         (``inertia_per_length`` for an arm given by its stiffnesses) are required.
-    actuators : sequence
-        Not yet modelled in dynamics (tendons, chambers, magnets: ValueError).
+    actuators : sequence of loads with inputs
+        Tendons (under tension control), chambers, magnetic fields, unbatched: their inputs
+        (``inputs`` of :meth:`step` and :meth:`run`, in :class:`~softarm.ForwardSolver`'s
+        order) may change in time; their own values are the inputs at first.
     loads : load or sequence of loads
-        Gravity, tip loads, distributed and point loads (dead or follower), constant in
-        time; batch axes give one trajectory per case.
+        Gravity, tip loads, distributed and point loads (dead or follower), any load of the
+        statics, constant in time; batch axes give one trajectory per case.
     dt : float
         Δt in s.
     damping : Damping, optional
@@ -307,7 +309,7 @@ class Simulator:
     def _gravity_of(loads, shape) -> np.ndarray:
         g = np.zeros((*shape, 3))
         for load in loads:
-            if type(load).__name__ == "Gravity":
+            if isinstance(load, Gravity):
                 g = g + np.asarray(load.acceleration)
         return np.ascontiguousarray(np.broadcast_to(g, (*shape, 3)).reshape(-1, 3))
 
