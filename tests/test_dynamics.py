@@ -308,3 +308,21 @@ def test_each_case_of_a_batch_takes_its_own_inputs():
     assert state.positions.shape == (2, 21, 3)
     with pytest.raises(ValueError, match="batch axes"):
         sim.step(np.ones((3, 1)))
+
+
+def test_runs_after_runs_with_and_without_tendons_carry_their_lengths():
+    """A run continues from the last one's state: tendon lengths where there are tendons
+    (the kernel's, equal to the quadrature of the state's strains), None where the
+    actuators are chambers only."""
+    chamber = softarm.Chamber(2e4, area=2e-5, routing=softarm.routing.Straight(0.0, -0.005))
+    sim = Simulator(ROBOT, [chamber], [Gravity()], dt=1e-3, stations=21)
+    first, second = sim.run(2), sim.run(2)
+    assert first.tendon_lengths is None and second.tendon_lengths is None
+    assert second.times[0] == pytest.approx(2e-3)
+    tendon = softarm.Tendon(0.5, softarm.routing.Straight(0.0, 0.008))
+    sim = Simulator(ROBOT, [tendon, chamber], [Gravity()], dt=1e-3, stations=21)
+    sim.run(3)
+    quadrature = sim._tendon_lengths(sim._arrays[2])[0]  # (of the state now)
+    carried = sim.run(1).tendon_lengths[0]  # (the next run's first row: that state's)
+    assert carried[0] < 0.2999  # (pulled in)
+    np.testing.assert_allclose(carried, quadrature, rtol=0, atol=1e-12)

@@ -617,7 +617,7 @@ class Simulator:
             self._mark_failures(done, info, steps, times, out, energy)
         if q is not None:
             self._q = np.array(q[:, -1])
-        if "tendons" in out:
+        if "tendons" in out and self._tendon_columns.size:
             self._lengths_now = out["tendons"][:, -1][:, self._tendon_columns]
         self._arrays = arrays
         self._fresh = False
@@ -727,7 +727,9 @@ class Simulator:
     def _make_state(self, record, error, iterations) -> State:
         shape, S = self.shape, self._at.size
         lengths = record.get("tendons")
-        if lengths is not None:
+        if not self._tendon_columns.size:  # (no tendon: chambers, magnets or none)
+            lengths = None
+        elif lengths is not None:
             lengths = lengths[:, self._tendon_columns]
         elif self._lengths_now is not None:  # (the last step's, from the kernel)
             lengths = self._lengths_now
