@@ -33,3 +33,15 @@ def rng():
 def reference_table(name: str) -> dict:
     """A reference table shipped in the package (softarm/validation/data, with provenance)."""
     return _packaged_table(name)
+
+
+@pytest.fixture(scope="module")
+def browser():
+    """A module's headless chromium (tests/_browser.py: skipped, or failed in CI, without
+    it), whose scripts may take a minute."""
+    import _browser
+
+    driver = _browser.chromium()
+    driver.set_script_timeout(60)
+    yield driver
+    driver.quit()

@@ -28,14 +28,6 @@ from softarm import app, io, view
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 
-@pytest.fixture(scope="module")
-def browser():
-    driver = _browser.chromium()
-    driver.set_script_timeout(60)
-    yield driver
-    driver.quit()
-
-
 def wait_for(driver, script, timeout=60.0):
     end = time.monotonic() + timeout
     while time.monotonic() < end:

@@ -27,14 +27,6 @@ from softarm import app, view
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 
-@pytest.fixture(scope="module")
-def browser():
-    driver = _browser.chromium()
-    driver.set_script_timeout(60)
-    yield driver
-    driver.quit()
-
-
 def test_motion_page_plays_at_the_trajectorys_pace(browser, tmp_path):
     arm = softarm.Arm(0.5, softarm.Circle(0.02),
                       softarm.Material(1e6, poisson_ratio=0.5, density=1100.0))

@@ -155,6 +155,15 @@ def _arrow_scales(arrows_per_frame, length: float) -> dict[str, float]:
             for key, value in largest.items() if value > 0}
 
 
+def _tube_trace(poses, radii, **extra) -> dict:
+    """The arm as an opaque tube (a plotly mesh3d) through ``poses`` (..., 4, 4) of the
+    given ``radii``; ``extra`` trace keys (hover, legend)."""
+    vertices, triangles = tube_mesh(poses, radii, sides=_SIDES)
+    return {"type": "mesh3d", "x": vertices[:, 0], "y": vertices[:, 1], "z": vertices[:, 2],
+            "i": triangles[:, 0], "j": triangles[:, 1], "k": triangles[:, 2], "color": _TUBE,
+            "opacity": 1.0, "name": "arm", **extra}
+
+
 def _scene_traces(result, arrows, scales, rings) -> list[dict]:
     """The traces of one (unbatched) equilibrium, always the same number and order (``rings``:
     :func:`softarm.geometry.tube_rings` of the arm, or None to draw no tube)."""
@@ -166,13 +175,10 @@ def _scene_traces(result, arrows, scales, rings) -> list[dict]:
                             axis=-1)
     if rings is not None:
         index, radii = rings
-        vertices, triangles = tube_mesh(poses[index], radii, sides=_SIDES)
-        traces.append({"type": "mesh3d", "x": vertices[:, 0], "y": vertices[:, 1],
-                       "z": vertices[:, 2], "i": triangles[:, 0], "j": triangles[:, 1],
-                       "k": triangles[:, 2], "color": _TUBE, "opacity": 1.0,
-                       "customdata": np.repeat(custom[index], _SIDES, axis=0),
-                       "hovertemplate": _HOVER.replace("centreline", "arm"), "name": "arm",
-                       "showlegend": True})
+        traces.append(_tube_trace(poses[index], radii,
+                                  customdata=np.repeat(custom[index], _SIDES, axis=0),
+                                  hovertemplate=_HOVER.replace("centreline", "arm"),
+                                  showlegend=True))
     # inside the opaque tube the stations' markers cannot be seen: drawn without a tube only
     traces.append({"type": "scatter3d", "mode": "lines" if rings is not None else
                    "lines+markers", "x": p[:, 0], "y": p[:, 1],
@@ -783,11 +789,7 @@ def _pose_traces(poses, s, rings, length: float) -> list[dict]:
     traces = []
     if rings is not None:
         index, radii = rings
-        vertices, triangles = tube_mesh(poses[index], radii, sides=_SIDES)
-        traces.append({"type": "mesh3d", "x": vertices[:, 0], "y": vertices[:, 1],
-                       "z": vertices[:, 2], "i": triangles[:, 0], "j": triangles[:, 1],
-                       "k": triangles[:, 2], "color": _TUBE, "opacity": 1.0,
-                       "hoverinfo": "skip", "name": "arm", "showlegend": True})
+        traces.append(_tube_trace(poses[index], radii, hoverinfo="skip", showlegend=True))
     traces.append({"type": "scatter3d", "mode": "lines" if rings is not None else
                    "lines+markers", "x": p[:, 0], "y": p[:, 1], "z": p[:, 2],
                    "customdata": s, "line": {"color": _LINE, "width": 4},
