@@ -280,15 +280,7 @@ def figure(result, *, name: str | None = None, values=None, label: str | None = 
     scales = _arrow_scales(arrows, length) if scales is None else scales
     centre, half = cube_limits(_extent(result, radii, arrows, scales)) if limits is None \
         else limits
-    scene = {"aspectmode": "cube", "domain": {"x": [0.0, 0.66 if batch else 1.0],
-                                              "y": [0.0, 1.0]},
-             # the camera far enough out that the whole box and its labels are in the picture
-             "camera": {"eye": {"x": 1.27, "y": -1.84, "z": 0.86}}}
-    for k, axis in enumerate("xyz"):
-        low, high = centre[k] - half, centre[k] + half
-        scene[f"{axis}axis"] = {"range": [low, high], "tickmode": "array",
-                                "tickvals": axis_ticks(low, high),
-                                "title": {"text": f"{axis} (m)"}}
+    scene = _cube_scene(centre, half, 0.66 if batch else 1.0)
     head = name or "softarm"
     layout = {"scene": scene, "margin": {"l": 10, "r": 10, "t": 60, "b": 10},
               "legend": {"x": 0.0, "y": 1.0}, "hovermode": "closest",
@@ -370,6 +362,20 @@ def figure(result, *, name: str | None = None, values=None, label: str | None = 
 _BUTTONS_WIDTH = 75
 #: The smallest height of a figure that fills the window, pixels.
 _MIN_HEIGHT = 480
+
+
+def _cube_scene(centre, half: float, width: float) -> dict:
+    """A 3D scene: the cube of half-side ``half`` about ``centre`` (m) with ticks, over the
+    page's left ``width`` fraction."""
+    # the camera far enough out that the whole box and its labels are in the picture
+    scene = {"aspectmode": "cube", "domain": {"x": [0.0, width], "y": [0.0, 1.0]},
+             "camera": {"eye": {"x": 1.27, "y": -1.84, "z": 0.86}}}
+    for k, axis in enumerate("xyz"):
+        low, high = centre[k] - half, centre[k] + half
+        scene[f"{axis}axis"] = {"range": [low, high], "tickmode": "array",
+                                "tickvals": axis_ticks(low, high),
+                                "title": {"text": f"{axis} (m)"}}
+    return scene
 
 
 def axis_ticks(low: float, high: float) -> list[float]:
@@ -850,13 +856,7 @@ def trajectory_figure(trajectory, *, arm=None, radii=None, name: str | None = No
         points += [tube_surface(poses[k][index], ring_radii, sides=8).reshape(3, -1).T
                    for k in shown]
     centre, half = cube_limits(np.concatenate(points))
-    scene = {"aspectmode": "cube", "domain": {"x": [0.0, 0.66], "y": [0.0, 1.0]},
-             "camera": {"eye": {"x": 1.27, "y": -1.84, "z": 0.86}}}
-    for k, axis in enumerate("xyz"):
-        low, high = centre[k] - half, centre[k] + half
-        scene[f"{axis}axis"] = {"range": [low, high], "tickmode": "array",
-                                "tickvals": axis_ticks(low, high),
-                                "title": {"text": f"{axis} (m)"}}
+    scene = _cube_scene(centre, half, 0.66)
     tip = poses[curve, -1, :3, 3]
     data = _pose_traces(poses[0], s, rings, length)
     moving = len(data)
