@@ -469,42 +469,47 @@ class _Handler(BaseHTTPRequestHandler):
 
     def do_GET(self):
         url = urlsplit(self.path)
-        if isinstance(self.live, LiveMotion):
-            return self._motion(url)
         try:
-            if url.path == "/":
-                with self.lock:
-                    page = _page(self.live)
-                self._send(200, page, "text/html; charset=utf-8")
-            elif url.path == "/plotly.min.js":
-                self._send(200, self.plotly_js, "text/javascript; charset=utf-8")
-            elif url.path == "/inputs":
-                self._json(200, [i.__dict__ | {"step": i.step} for i in self.live.inputs])
-            elif url.path in ("/solve", "/reset"):
-                query = _query(url.query)
-                # one solve at a time (they share the Solver and its last equilibrium); the
-                # reply is encoded and sent after the lock is let go
-                failure = None
-                with self.lock:
-                    old = self.live.values
-                    self.live.update(query)
-                    if url.path == "/reset":
-                        self.live.solver.reset()
-                    try:
-                        body = self.live.solve()
-                    except (ConvergenceError, ValueError) as error:
-                        self.live.values = old
-                        failure = f"cannot solve for these inputs: {error}"
-                if failure is not None:
-                    self._json(422, {"error": _one_line(failure)})
-                else:
-                    self._send(200, to_json(body).encode("utf-8"), "application/json")
+            if isinstance(self.live, LiveMotion):
+                self._motion(url)
             else:
-                self._json(404, {"error": f"no such page: {url.path}"})
+                self._still(url)
         except BadRequest as error:
             self._json(400, {"error": str(error)})
         except Exception as error:  # never let one request stop the app
             self._json(500, {"error": _one_line(f"{type(error).__name__}: {error}")})
+
+    def _still(self, url) -> None:
+        """The static mode's endpoints."""
+        if url.path == "/":
+            with self.lock:
+                page = _page(self.live)
+            self._send(200, page, "text/html; charset=utf-8")
+        elif url.path == "/plotly.min.js":
+            self._send(200, self.plotly_js, "text/javascript; charset=utf-8")
+        elif url.path == "/inputs":
+            self._json(200, [i.__dict__ | {"step": i.step} for i in self.live.inputs])
+        elif url.path in ("/solve", "/reset"):
+            query = _query(url.query)
+            # one solve at a time (they share the Solver and its last equilibrium); the
+            # reply is encoded and sent after the lock is let go
+            failure = None
+            with self.lock:
+                old = self.live.values
+                self.live.update(query)
+                if url.path == "/reset":
+                    self.live.solver.reset()
+                try:
+                    body = self.live.solve()
+                except (ConvergenceError, ValueError) as error:
+                    self.live.values = old
+                    failure = f"cannot solve for these inputs: {error}"
+            if failure is not None:
+                self._json(422, {"error": _one_line(failure)})
+            else:
+                self._send(200, to_json(body).encode("utf-8"), "application/json")
+        else:
+            self._json(404, {"error": f"no such page: {url.path}"})
 
     def _motion(self, url) -> None:
         """The dynamic mode's endpoints: ``/`` the page, ``/state?after=INDEX&NAME=VALUE...``
@@ -512,46 +517,41 @@ class _Handler(BaseHTTPRequestHandler):
         first; ``/reset`` back to the start; ``/history`` the actuators' inputs per step;
         ``/inputs``, ``/plotly.min.js`` as in the static mode."""
         live = self.live
-        try:
-            if url.path == "/":
-                self._send(200, live.page(), "text/html; charset=utf-8")
-            elif url.path == "/inputs":
-                self._json(200, [i.__dict__ | {"step": i.step} for i in live.inputs])
-            elif url.path in ("/state", "/reset"):
-                query = _query(url.query)
-                after = query.pop("after", "-1")
+        if url.path == "/":
+            self._send(200, live.page(), "text/html; charset=utf-8")
+        elif url.path == "/inputs":
+            self._json(200, [i.__dict__ | {"step": i.step} for i in live.inputs])
+        elif url.path in ("/state", "/reset"):
+            query = _query(url.query)
+            after = query.pop("after", "-1")
+            try:
+                after = int(after)
+            except ValueError:
+                raise BadRequest(f"after must be a state index, got {after!r}") from None
+            with live._lock:
+                if url.path == "/reset":
+                    live.reset()
                 try:
-                    after = int(after)
-                except ValueError:
-                    raise BadRequest(f"after must be a state index, got {after!r}") from None
-                with live._lock:
-                    if url.path == "/reset":
-                        live.reset()
-                    try:
-                        live.update(query)
-                    except (ConvergenceError, ValueError) as error:
-                        if isinstance(error, BadRequest):
-                            raise
-                        body = None
-                        failure = _one_line(f"cannot continue with these inputs: {error}")
-                    else:
-                        body, failure = live.states_after(after), None
-                if failure is not None:
-                    self._json(422, {"error": failure})
+                    live.update(query)
+                except (ConvergenceError, ValueError) as error:
+                    if isinstance(error, BadRequest):
+                        raise
+                    body = None
+                    failure = _one_line(f"cannot continue with these inputs: {error}")
                 else:
-                    self._json(200, body)
-            elif url.path == "/history":
-                with live._lock:
-                    self._json(200, {"history": live.history, "replayable": live.replayable,
-                                     "index": live.index, "dt": live.dynamics.dt})
-            elif url.path == "/plotly.min.js":
-                self._send(200, self.plotly_js, "text/javascript; charset=utf-8")
+                    body, failure = live.states_after(after), None
+            if failure is not None:
+                self._json(422, {"error": failure})
             else:
-                self._json(404, {"error": f"no such page: {url.path}"})
-        except BadRequest as error:
-            self._json(400, {"error": str(error)})
-        except Exception as error:  # never let one request stop the app
-            self._json(500, {"error": _one_line(f"{type(error).__name__}: {error}")})
+                self._json(200, body)
+        elif url.path == "/history":
+            with live._lock:
+                self._json(200, {"history": live.history, "replayable": live.replayable,
+                                 "index": live.index, "dt": live.dynamics.dt})
+        elif url.path == "/plotly.min.js":
+            self._send(200, self.plotly_js, "text/javascript; charset=utf-8")
+        else:
+            self._json(404, {"error": f"no such page: {url.path}"})
 
     def do_POST(self):
         self._json(HTTPStatus.METHOD_NOT_ALLOWED, {"error": "use GET"})
