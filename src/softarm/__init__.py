@@ -8,6 +8,7 @@ __version__ = "0.1.0"  # first, so that submodules may import it
 
 from . import analytic, routing, sweep
 from .case import Case, CaseError, load_case
+from .contact import Capsule, Contact, Plane, Sphere
 from .control import ForwardResult, ForwardSolver, InverseResult, InverseSolver, inverse
 from .dispatch import solve
 from .dynamics import Damping, Energy, Simulator, State, Trajectory, simulate
@@ -37,10 +38,12 @@ __all__ = [
     "ApproximationWarning",
     "Arm",
     "Branch",
+    "Capsule",
     "Case",
     "CaseError",
     "Chamber",
     "Circle",
+    "Contact",
     "ConvergenceError",
     "CriticalPoint",
     "Damping",
@@ -57,12 +60,14 @@ __all__ = [
     "Load",
     "MagneticField",
     "Material",
+    "Plane",
     "PointLoad",
     "Rectangle",
     "Rigidities",
     "Section",
     "SegmentedArm",
     "Simulator",
+    "Sphere",
     "Stability",
     "StabilityWarning",
     "State",

@@ -259,6 +259,42 @@ class Equilibrium:
         """Internal moment R m in the spatial frame about the centreline point (N m)."""
         return np.einsum("...ij,...j->...i", self.rotations, self.stresses[..., 3:])
 
+    def _contact(self):
+        """The Contact among the loads (with the stiffness the solver used), or None."""
+        return next((load for load in self.loads if getattr(load, "kind", "") == "contact"),
+                    None)
+
+    @property
+    def gaps(self) -> np.ndarray:
+        """(B..., N): the distance from the arm's surface to the nearest obstacle at each
+        station, m (inf without a :class:`~softarm.Contact`)."""
+        return self._contact_state()[0]
+
+    @property
+    def contact_forces(self) -> np.ndarray:
+        """(B..., N, 3): the obstacles' force per unit length on the arm at each station,
+        N/m, spatial (zero without a :class:`~softarm.Contact`, and wherever the gap is at
+        least the contact distance)."""
+        return self._contact_state()[1]
+
+    @property
+    def contact_wrench(self) -> np.ndarray:
+        """(B..., 6): the total contact force (N) and its moment about the spatial origin
+        (N m) on the arm: :attr:`contact_forces` and p × them integrated over the stations
+        (trapezoidal rule: pass stations fine enough to resolve the contact zones, whose
+        width is about √(EI/GA); docs/contact.md)."""
+        forces = self.contact_forces
+        moments = np.cross(self.positions, forces)
+        wrench = np.concatenate([forces, moments], axis=-1)
+        ds = np.diff(self.s)[:, None]
+        return (0.5 * (wrench[..., 1:, :] + wrench[..., :-1, :]) * ds).sum(-2)
+
+    def _contact_state(self) -> tuple[np.ndarray, np.ndarray]:
+        contact = self._contact()
+        if contact is None:
+            return (np.full(self.poses.shape[:-2], np.inf), np.zeros(self.positions.shape))
+        return contact.gaps(self.positions, contact.station_radii(self.arm, self.s))
+
     def show(self, path=None, *, browser: bool = True, **options):
         """Write an interactive 3D view (:func:`softarm.view.figure`, ``options`` as there) to
         a self-contained HTML file, ``path`` or a new temporary file, open it in the web

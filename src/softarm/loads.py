@@ -132,6 +132,10 @@ class LoadTarget(Protocol):
         """A magnetic field B(x) = B0 + G x, spatial (T, T/m), acting on the arm's
         magnetisation and dipoles."""
 
+    def contact(self, load) -> None:
+        """Contact with rigid obstacles (a :class:`softarm.Contact`, which carries its
+        obstacles and law): a force that depends on the arm's shape."""
+
 
 @dataclass(frozen=True)
 class Key:
@@ -1070,6 +1074,9 @@ class _Sizes:
     def displaced_tendon(self, displacement, routing, span):
         # a length change, measured against the arm's length (the tension is solved)
         self.size = max(self.size, _largest(displacement) / self.length)
+
+    def contact(self, load):
+        pass  # (a reaction: as large as the loads that press the arm on the obstacles)
 
     def field(self, field, gradient=None):
         # B over the arm: |B0| + |G| L; the torque m × B and the force Gᵀ m on the magnets

@@ -556,6 +556,16 @@ def _deriv(work, twork, nt, stage, s, arm, act, j, now, rate, law):
         for i in range(3):
             w[_N + i] -= law[2][3, i]
             w[_M + i] -= law[2][3, 3 + i]
+    # contact with the obstacles: a force per unit length through the centreline (_contact)
+    cf0 = cf1 = cf2 = c00 = c01 = c02 = c11 = c12 = c22 = 0.0
+    touching = False
+    if act is not None and act[5].shape[0] > 0:
+        cf0, cf1, cf2, c00, c01, c02, c11, c12, c22 = _contact(
+            work[Y, _P], work[Y, _P + 1], work[Y, _P + 2], act[5], act[6][j])
+        touching = cf0 != 0.0 or cf1 != 0.0 or cf2 != 0.0
+        w[_N] -= cf0
+        w[_N + 1] -= cf1
+        w[_N + 2] -= cf2
     # the tendons' lengths: ℓ' = |w| where they run
     if act is not None:
         for a in range(w.size - 18):
@@ -652,6 +662,11 @@ def _deriv(work, twork, nt, stage, s, arm, act, j, now, rate, law):
             k0 -= law[2][3, 3]
             k1 -= law[2][3, 4]
             k2 -= law[2][3, 5]
+        if act is not None and touching:  # -∂f/∂p δp (∂f/∂p symmetric: the obstacles' Hessians)
+            dp0, dp1, dp2 = t[_TP], t[_TP + 1], t[_TP + 2]
+            g0 -= c00 * dp0 + c01 * dp1 + c02 * dp2
+            g1 -= c01 * dp0 + c11 * dp1 + c12 * dp2
+            g2 -= c02 * dp0 + c12 * dp1 + c22 * dp2
         o = twork[stage, d]
         o[_TP] = q0
         o[_TP + 1] = q1
@@ -745,6 +760,85 @@ def _dipole(y, T, which, m0, m1, m2, now, rate, out):
     out[3] = e1 * b2 - e2 * b1 + a1 * g2 - a2 * g1
     out[4] = e2 * b0 - e0 * b2 + a2 * g0 - a0 * g2
     out[5] = e0 * b1 - e1 * b0 + a0 * g1 - a1 * g0
+
+
+# Contact (issue 33; docs/contact.md). ``act[5]``: the obstacles (K, 8), one row each: kind,
+# then a plane's point and outward unit normal, a sphere's centre (and 0, 0, 0), or a
+# capsule's two axis ends, then the radius (0 for a plane). ``act[6]`` (P, 3): per piece the
+# arm's surface radius r (m), the contact distance δ (m) and the penalty stiffness k
+# (N/m per m of arm).
+PLANE, SPHERE, CAPSULE = 0, 1, 2
+OBSTACLE = 8
+
+
+@_jit
+def _pressure(gap, band, stiffness):
+    """The contact force per unit length at a gap g (the law's value and its derivative in
+    g): zero for g >= δ, then k δ (t³ - t⁴/2) with t = (δ - g)/δ up to g = 0, then linear,
+    k (δ/2 - g): twice continuously differentiable (RK4 keeps its order across the onset),
+    k δ/2 at contact, and the slope k from g = 0 into the obstacle. Penetration is what is
+    left of a pressure beyond k δ/2 (the Solver raises k until none is left; contact.md)."""
+    if gap >= band:
+        return 0.0, 0.0
+    if gap <= 0.0:
+        return stiffness * (0.5 * band - gap), -stiffness
+    t = (band - gap) / band
+    return stiffness * band * t * t * t * (1.0 - 0.5 * t), -stiffness * t * t * (3.0 - 2.0 * t)
+
+
+@_jit
+def _nearest(px, py, pz, row):
+    """(distance d, outward unit normal n (3), curvature c, axis e (3)) of the point p from
+    obstacle ``row`` (act[5]'s layout): d the signed distance from its surface, n = ∇d, and
+    the Hessian ∇²d = c (I - n nᵀ - e eᵀ) (c = 1/|p - q| around a sphere's centre or a
+    capsule's axis, e the axis on a capsule's cylinder, else 0)."""
+    kind = row[0]
+    if kind == PLANE:
+        return ((px - row[1]) * row[4] + (py - row[2]) * row[5] + (pz - row[3]) * row[6],
+                row[4], row[5], row[6], 0.0, 0.0, 0.0, 0.0)
+    qx, qy, qz = row[1], row[2], row[3]
+    e0 = e1 = e2 = 0.0
+    if kind == CAPSULE:
+        a0, a1, a2 = row[4] - qx, row[5] - qy, row[6] - qz
+        aa = a0 * a0 + a1 * a1 + a2 * a2
+        t = ((px - qx) * a0 + (py - qy) * a1 + (pz - qz) * a2) / aa
+        if t > 0.0 and t < 1.0:
+            qx, qy, qz = qx + t * a0, qy + t * a1, qz + t * a2
+            norm = math.sqrt(aa)
+            e0, e1, e2 = a0 / norm, a1 / norm, a2 / norm
+        elif t >= 1.0:
+            qx, qy, qz = row[4], row[5], row[6]
+    dx, dy, dz = px - qx, py - qy, pz - qz
+    r = math.sqrt(dx * dx + dy * dy + dz * dz)
+    if r == 0.0:  # on the centre or the axis: the normal is undefined (deep inside)
+        return -row[7], 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    return r - row[7], dx / r, dy / r, dz / r, 1.0 / r, e0, e1, e2
+
+
+@_jit
+def _contact(px, py, pz, obstacles, params):
+    """The contact force per unit length on a section at p (spatial, N/m; frictionless,
+    along each obstacle's normal, through the centreline: no moment) and its Jacobian
+    ∂f/∂p (row-major), summed over the obstacles: f = φ(d - r) ∇d,
+    ∂f/∂p = φ' ∇d ∇dᵀ + φ ∇²d (``params`` = the piece's (r, δ, k), act[6]'s row)."""
+    f0 = f1 = f2 = 0.0
+    j00 = j01 = j02 = j11 = j12 = j22 = 0.0
+    for k in range(obstacles.shape[0]):
+        d, n0, n1, n2, c, e0, e1, e2 = _nearest(px, py, pz, obstacles[k])
+        phi, dphi = _pressure(d - params[0], params[1], params[2])
+        if phi == 0.0:
+            continue
+        f0 += phi * n0
+        f1 += phi * n1
+        f2 += phi * n2
+        pc = phi * c
+        j00 += dphi * n0 * n0 + pc * (1.0 - n0 * n0 - e0 * e0)
+        j01 += dphi * n0 * n1 - pc * (n0 * n1 + e0 * e1)
+        j02 += dphi * n0 * n2 - pc * (n0 * n2 + e0 * e2)
+        j11 += dphi * n1 * n1 + pc * (1.0 - n1 * n1 - e1 * e1)
+        j12 += dphi * n1 * n2 - pc * (n1 * n2 + e1 * e2)
+        j22 += dphi * n2 * n2 + pc * (1.0 - n2 * n2 - e2 * e2)
+    return f0, f1, f2, j00, j01, j02, j11, j12, j22
 
 
 @_inline
@@ -2333,9 +2427,12 @@ def _sweep(x, lam, steps, base, arm, act, case, scratch, nt, r, J, states, field
 
 
 @_jit
-def _tangent_columns(arm, piece):
-    """3, or 6 where a load depends on position (a field gradient): then a translation of
-    the tip section is no longer a solution of the linearised equations by itself."""
+def _tangent_columns(arm, act, piece):
+    """3, or 6 where a load depends on position (a field gradient, contact): then a
+    translation of the tip section is no longer a solution of the linearised equations by
+    itself."""
+    if act is not None and act[5].shape[0] > 0:
+        return 6
     for j in range(piece.shape[0]):
         for i in range(9):
             if piece[j, _FG + i] != 0.0:
@@ -2395,7 +2492,7 @@ def stability_cases(base, arm, act, loads, xs, Ns, tips, factor, index, theta0, 
     none4 = np.empty((0, 1, 1))
     for b in range(piece_loads.shape[0]):
         case = (start, piece_loads[b:b + 1], tip_start, tip_loads[b:b + 1])
-        nt = _tangent_columns(arm, piece_loads[b])
+        nt = _tangent_columns(arm, act, piece_loads[b])
         conservative[b] = _conservative(piece_loads[b], tip_loads[b])
         _fill_steps(arm[6], arm[1], int(Ns[b]), factor, steps)
         t0 = np.zeros((nt, nt))
@@ -2942,15 +3039,24 @@ _CJ, _CS, _CL, _CFIRST, _CI = 0, 1, 2, 3, 4
 
 
 @_jit
-def _stiffness_size(arm, w):
+def _stiffness_size(arm, act, w):
     """kL estimated from the case's load size ``w`` (in EI/L² of the *stiffest* bending,
     :func:`_load_size`) with the softest bending stiffness of the arm: the growth exponent of
-    single shooting under a tension of that size."""
+    single shooting under a tension of that size; with contact, the larger of that and the
+    penalty's own, L max(√(k/GA), (k/EI)^¼) (the growth rates of a shearable rod on an
+    elastic foundation of stiffness k: contact.md)."""
     soft = 0.0
     for j in range(arm[1].size):
         soft = max(soft, arm[2][j, 4, 4], arm[2][j, 5, 5])
     stiff = arm[7][3] * arm[6]  # the bending scale's EI
-    return math.sqrt(max(w, 0.0) * stiff * soft)
+    kl = math.sqrt(max(w, 0.0) * stiff * soft)
+    if act is not None and act[5].shape[0] > 0:
+        for j in range(arm[1].size):
+            C, k = arm[2][j], act[6][j, 2]
+            shear = max(C[1, 1], C[2, 2])
+            bending = max(C[4, 4], C[5, 5])
+            kl = max(kl, arm[6] * max(math.sqrt(k * shear), (k * bending) ** 0.25))
+    return kl
 
 
 @_jit
@@ -3749,7 +3855,7 @@ def solve_stiff_cases(base, arm, act, loads, options, s_out, out, verdicts, inpu
             tip_rate[0, i] = tip_loads[b, i]
         w, turning = _load_size(arm, act, scale, start, piece_loads[b], tip_start, tip_loads[b])
         threshold = 1e-12 * w + 1e-300
-        kl = _stiffness_size(arm, w)
+        kl = _stiffness_size(arm, act, w)
         # M = M_base 2^levels >= kL / _GROWTH (within 25 %): the path's levels halve it
         needed = max(1, min(math.ceil(kl / _GROWTH), n_max // 4))
         levels = 0
@@ -3977,7 +4083,7 @@ def _ms_verdict(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, N
     states = np.empty((total + 1, scratch[0].size))
     _ms_record(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, grid, out, b,
                states, None)
-    nt = _tangent_columns(arm, piece)
+    nt = _tangent_columns(arm, act, piece)
     verdicts[1][b] = _conservative(piece, tip)
     one_case = (case[0], case[1][:1], case[2], case[3][:1])
     r = np.empty(6)

@@ -30,6 +30,7 @@ from .._validate import (
 )
 from ..equilibrium import Equilibrium, Stability
 from ..errors import ConvergenceError, InadmissibleStateError
+from ..lie import se3
 from ..loads import Gravity, Tendon, as_loads, batch_shape, check_magnitudes, path_tangent
 from ..model import Arm, Circle, Material, SegmentedArm
 from ..routing import Straight
@@ -124,6 +125,10 @@ class _ArmData:
                              f"be finite and >= 0 kg/m, got {self.mu.tolist()!r}")
         #: the largest bending compliance 1/EI (the tension's kL, _stiff.py)
         self.soft = float(np.max(self.C[:, [4, 5], [4, 5]]))
+        #: the narrowest shear zone √(EI/GA) (m; bending about z with shear along y, and
+        #: about y with shear along z): where contact spreads a point reaction (contact.md)
+        self.shear_zone = float(np.sqrt(np.min(self.C[:, [1, 2], [1, 2]]
+                                               / self.C[:, [5, 4], [5, 4]])))
         bending = float(np.max(self.K[:, [3, 4, 5], [3, 4, 5]]))
         self.force_scale = bending / self.length**2
         _normal_positive([self.force_scale, bending / self.length],
@@ -186,6 +191,62 @@ class _ArmData:
                 self.mu[segment], segment)
 
 
+#: ``act``'s contact arrays out of contact: no obstacle (statics/_kernels.py, act[5], act[6])
+_NO_CONTACT = (np.zeros((0, 8)), np.zeros((1, 3)))
+
+
+#: Retries of a solve whose answer penetrates an obstacle, each with the penalty raised
+#: (:func:`_penetration`), before it is an error.
+_CONTACT_RETRIES = 4
+
+
+def _penetration(solver, contact, poses, s, attempt: int) -> float | None:
+    """None if no station of the solved cases (poses (B, S, 4, 4) at stations s) is inside
+    an obstacle by more than tol·L; else the penalty stiffness that carries the largest
+    pressure found within the band (k δ/2 = 1.25 × it, and at least twice the last k). A
+    ConvergenceError when this was the solve's last attempt (``attempt`` counts from 0)."""
+    gaps, forces = contact.gaps(poses[..., :3, 3], contact.station_radii(solver.arm, s))
+    depth = -float(np.min(gaps))
+    if depth <= solver.tol * solver.length:
+        return None
+    if attempt >= _CONTACT_RETRIES:
+        raise ConvergenceError(
+            f"the arm penetrates an obstacle by {depth:.3g} m (more than tol·L = "
+            f"{solver.tol * solver.length:.3g} m) at the contact stiffness k = "
+            f"{contact.stiffness:.3g} N/m², raised {attempt} times: pass a larger "
+            f"Contact(stiffness=...) or distance=", residual=depth)
+    peak = float(np.max(np.linalg.norm(forces, axis=-1)))
+    return max(2.5 * peak / contact.distance, 2.0 * contact.stiffness)
+
+
+def unloaded_poses(arm, s, base) -> np.ndarray:
+    """The unloaded arm's poses (S, 4, 4) at stations s, clamped at ``base`` (4, 4): each
+    segment the exponential of its reference strain f⁰ (a helix, a circle or a line)."""
+    bounds = np.asarray(arm.boundaries)
+    segment = np.clip(np.searchsorted(bounds, s, side="right") - 1, 0, len(bounds) - 2)
+    strains = np.array([seg.reference_strain for seg in arm.segments], dtype=np.float64)
+    starts = [np.asarray(base, dtype=np.float64)]
+    for k, seg in enumerate(arm.segments[:-1]):
+        starts.append(starts[-1] @ se3.exp(strains[k] * seg.length))
+    along = (np.asarray(s) - bounds[segment])[:, None] * strains[segment]
+    return np.stack(starts)[segment] @ se3.exp(along)
+
+
+def _check_outside(solver, contact, loads) -> None:
+    """ValueError if the unloaded arm (clamped at the solver's base) is inside an obstacle
+    at some station: no path from it leads out."""
+    s = np.linspace(0.0, solver.length, 201)
+    poses = unloaded_poses(solver.arm, s, solver._base_kernel)
+    gaps, _ = contact.gaps(poses[:, :3, 3], contact.station_radii(solver.arm, s))
+    inside = np.flatnonzero(gaps < -solver.tol * solver.length)
+    if inside.size:
+        i = inside[0]
+        raise ValueError(
+            f"Contact: the unloaded arm starts inside an obstacle (its surface {-gaps[i]:.3g} "
+            f"m deep at station s = {s[i]:.6g} m): the equilibrium connected to it is not "
+            f"defined; move the obstacles or the base")
+
+
 def _magnet(segment, name: str) -> np.ndarray:
     """A segment's ``magnetization`` or ``tip_magnet`` (material components), zeros if None."""
     value = getattr(segment, name, None)
@@ -235,6 +296,9 @@ class _Channels:
         self._tip = self.tip_loads.reshape(*shape, k.TIP_LOADS)
         self.data = data
         self.actuators = []  # (kind code, routing, active rows, span) per actuator column
+        #: the Contact load, if any (:meth:`contact`); its arrays for the kernel, made once
+        self.contact_load = None
+        self._contact_arrays = None
 
     def _rows(self, span):
         if span is None or (span[0] <= 0.0 and span[1] >= self.length):  # the whole arm
@@ -299,11 +363,83 @@ class _Channels:
             G = np.asarray(gradient).reshape(*np.shape(gradient)[:-2], 9)
             self._piece[..., :, k.FG:k.FG + 9] += G[..., None, :]
 
+    def contact(self, load):
+        if self.contact_load is not None:
+            raise ValueError("loads may hold one Contact: put every obstacle in it, "
+                             "Contact([obstacle, ...])")
+        self.contact_load = load
+
     def arm_tuple(self) -> tuple:
         """The kernel's (arm, act) pair, passed on as ``*arm_tuple()``: the pieces, and the
-        actuators' paths and the magnets, or None for a passive arm (see _kernels: a passive
-        arm's solve is compiled without them)."""
-        return self._actuated_arm()[0]
+        actuators' paths, the magnets and the obstacles, or None for a passive arm out of
+        contact (see _kernels: a passive arm's solve is compiled without them)."""
+        arm, act = self._actuated_arm()[0]
+        if self.contact_load is None:
+            return arm, (None if act is None else (*act, *_NO_CONTACT))
+        if self._contact_arrays is None:
+            self._contact_arrays = self._contact_kernel_arrays()
+        if act is None:  # a passive arm: no actuators, no magnets
+            P = self.starts.size
+            act = (np.zeros((0, 6)), np.zeros(0, dtype=np.int64), np.zeros((P, 0)),
+                   self.pieces[9], self.pieces[10])
+        return arm, (*act, *self._contact_arrays)
+
+    def resolve_contact(self, stiffness: float | None = None):
+        """The Contact with its contact distance and penalty stiffness set (``stiffness``,
+        else the load's own, else :meth:`_contact_stiffness`'s estimate), made this
+        channels' contact; returns it (None without contact)."""
+        load = self.contact_load
+        if load is None:
+            return None
+        band = load.band(self.length)
+        k = stiffness or load.stiffness or self._contact_stiffness(band)
+        self.contact_load = load.replace(distance=band, stiffness=k)
+        self._contact_arrays = None
+        return self.contact_load
+
+    def _contact_stiffness(self, band: float) -> float:
+        """The penalty stiffness k (N/m²) that carries the largest pressure expected within
+        the band (k δ/2, contact.md): the loads' size W (forces, and moments over L/2: the
+        largest of the batch, the actuators' tension times their offset counted as a
+        moment) spread over the width of the arm's shear zone √(EI/GA), where a shearable
+        rod carries what an unshearable one would carry as a point reaction."""
+        k, lengths = self.k, self.lengths
+        piece, tip = np.abs(self.piece), np.abs(self.tip_loads)
+        forces = ((piece[..., k.FD:k.FD + 6].sum(-1) @ lengths)
+                  + piece[..., k.JD:k.JD + 3].sum((-1, -2))
+                  + piece[..., k.JF:k.JF + 3].sum((-1, -2))
+                  + tip[:, k.TD:k.TD + 3].sum(-1) + tip[:, k.TF:k.TF + 3].sum(-1))
+        moments = ((piece[..., k.LD:k.LD + 3].sum(-1) @ lengths)
+                   + (piece[..., k.LF:k.LF + 3].sum(-1) @ lengths)
+                   + piece[..., k.JD + 3:k.JD + 6].sum((-1, -2))
+                   + piece[..., k.JF + 3:k.JF + 6].sum((-1, -2))
+                   + tip[:, k.TD + 3:k.TD + 6].sum(-1) + tip[:, k.TF + 3:k.TF + 6].sum(-1))
+        if self.actuators:
+            offsets = self._actuated_arm()[0][1][0][:, 0]  # routes' _RHO column
+            moments = moments + (piece[..., k.ACT:].max(-2) * offsets).sum(-1)
+        W = float(np.max(forces + 2.0 * moments / self.length, initial=0.0))
+        return 2.0 * max(W, 1e-12 * self.data.force_scale) / (self.data.shear_zone * band)
+
+    def _contact_kernel_arrays(self) -> tuple:
+        load = self.contact_load
+        radii = load.surface_radii(self.arm)[self.pieces[12]]
+        params = np.empty((self.starts.size, 3))
+        params[:, 0] = radii
+        params[:, 1] = load.distance
+        params[:, 2] = load.stiffness
+        return load.kernel_rows(), params
+
+    def contact_kl(self) -> float:
+        """The penalty's growth exponent kL (the kernel's _stiffness_size): 0 out of
+        contact."""
+        load = self.contact_load
+        if load is None:
+            return 0.0
+        C = self.data.C
+        shear = float(np.max(C[:, [1, 2], [1, 2]]))
+        bending = float(np.max(C[:, [4, 5], [4, 5]]))
+        k = load.stiffness
+        return self.length * max(math.sqrt(k * shear), (k * bending) ** 0.25)
 
     def tendons(self) -> tuple[np.ndarray, np.ndarray]:
         """The actuator columns that are tendons (in the order given) and their lengths in
@@ -926,8 +1062,9 @@ class Solver:
         "single" none, "auto" those whose estimated kL reaches STIFF_KL (_stiff.py)."""
         if self.shooting != "auto":
             return np.full(channels.count, self.shooting == "multiple")
-        return tension_kl(channels.piece, channels.tip_loads, channels.lengths, self.length,
-                          self._data.soft) >= STIFF_KL
+        return np.maximum(tension_kl(channels.piece, channels.tip_loads, channels.lengths,
+                                     self.length, self._data.soft),
+                          channels.contact_kl()) >= STIFF_KL
 
     def _threads(self, cases: int) -> int:
         """Threads for a batch of ``cases`` independent cases."""
@@ -981,6 +1118,7 @@ class Solver:
         channels = _Channels(data, pieces, shape, count)
         for load in loads:
             load.apply(channels)
+        channels.resolve_contact()
         return loads, shape, count, pieces, channels
 
     def _options(self, near: bool = False) -> np.ndarray:
@@ -1024,11 +1162,13 @@ class Solver:
         return self._solve(loads, chained=False, jacobians=jacobians)
 
     def _solve(self, loads, *, chained: bool, jacobians: bool, near: bool = False,
-               outputs: bool = True, checked: bool = False) -> Equilibrium | None:
+               outputs: bool = True, checked: bool = False,
+               contact_retry: tuple[float, int] | None = None) -> Equilibrium | None:
         """``near``: a single case whose path starts at its own loads, from the memory
         :meth:`solve_near` wrote (λ = 0 and λ = 1 the same loads); ``outputs=False``: only
         the memory of a chained solve (the tip its one station, no verdict), None;
-        ``checked``: ``loads`` is what :meth:`check_loads` returned."""
+        ``checked``: ``loads`` is what :meth:`check_loads` returned; ``contact_retry``:
+        (the contact's penalty stiffness, attempt) after a penetration (:func:`_penetration`)."""
         if not isinstance(jacobians, (bool, np.bool_)):
             raise TypeError(f"jacobians must be True or False, got {jacobians!r}")
         if not checked:
@@ -1067,6 +1207,11 @@ class Solver:
             # other actuators than the last case's: no continuous path from it
             self.reset()
             last = None
+        attempt = 0 if contact_retry is None else contact_retry[1]
+        contact = channels.resolve_contact(None if contact_retry is None else contact_retry[0])
+        if contact is not None:
+            _check_outside(self, contact, loads)
+            loads = tuple(contact if load.kind == "contact" else load for load in loads)
         # unchained: no first loads, no memory (that code is not even compiled, _kernels)
         first = memory = None
         if chained or near:
@@ -1135,6 +1280,14 @@ class Solver:
                                       None if chained else info[failed[0], 2],
                                       error.residual) or error
             raise error
+        if contact is not None:
+            stiffer = _penetration(self, contact, poses, s_kernel, attempt)
+            if stiffer is not None:  # raise the penalty until the pressure fits the band
+                if chained:
+                    self.reset()
+                return self._solve(loads, chained=chained, jacobians=jacobians, near=near,
+                                   outputs=outputs, checked=True,
+                                   contact_retry=(stiffer, attempt + 1))
         _admissible(self, strains, stresses, s_kernel, shape, info[:, 0], chained)
         if chained and count:
             self._last = (pieces[0], channels.piece[-1].copy(), channels.tip_loads[-1].copy(),

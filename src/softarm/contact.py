@@ -1,0 +1,369 @@
+"""Contact with rigid obstacles fixed in space: :class:`Plane`, :class:`Sphere`,
+:class:`Capsule`, and the load :class:`Contact` that lets the arm's surface touch them.
+
+The method (docs/contact.md): a penalty on the gap g between the arm's surface (a tube of
+radius r around the centreline) and each obstacle, a force per unit length along the
+obstacle's outward normal through the centreline,
+
+    f = φ(g) n,   φ(g) = 0 for g >= δ,   k δ (t³ - t⁴/2) with t = (δ - g)/δ for 0 < g < δ,
+    φ(g) = k (δ/2 - g) for g <= 0,
+
+twice continuously differentiable, so that the shooting solver keeps its order; δ the
+contact distance (default 1e-5 L), k a stiffness (N/m per m of arm) that the solver chooses
+so that the largest pressure is carried within the band g ∈ [0, δ] (k δ/2 above it). The
+shape is then within δ of the hard-contact solution's, and no point penetrates beyond tol·L
+(the solver checks it at the stations and raises k where it must).
+
+Frictionless: the force passes through the centreline, so it has no moment about it.
+Friction (``friction`` = μ > 0) acts in the dynamics only (softarm.simulate): in statics the
+frictionless equilibrium is returned (a Coulomb equilibrium for any μ, with zero tangential
+force; not necessarily the one a quasi-static path with friction would reach: contact.md).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import ClassVar
+
+import numpy as np
+
+from ._validate import as_array, format_value, real
+from .loads import Key, Load
+
+__all__ = ["Capsule", "Contact", "Obstacle", "Plane", "Sphere", "pressure"]
+
+# The kernel's obstacle kinds (statics/_kernels.py: PLANE, SPHERE, CAPSULE, one row of 8).
+_PLANE, _SPHERE, _CAPSULE = 0, 1, 2
+#: The default contact distance δ, as a fraction of the arm's length.
+DISTANCE = 1e-5
+
+
+def _point(value, name: str) -> np.ndarray:
+    """A finite 3-vector (m), read-only."""
+    array = as_array(value, name)
+    if array.shape != (3,):
+        raise ValueError(f"{name} must be a 3-vector (m, spatial), got shape {array.shape}: "
+                         f"{format_value(value)}")
+    if not np.all(np.isfinite(array)):
+        raise ValueError(f"{name} must be finite, got {format_value(value)}")
+    array = array.copy()
+    array.setflags(write=False)
+    return array
+
+
+def _radius(value, name: str) -> float:
+    r = real(value, name, "m")
+    if not (math.isfinite(r) and r > 0.0):
+        raise ValueError(f"{name} must be a positive finite radius in m, got "
+                         f"{format_value(value)}")
+    return r
+
+
+class Obstacle:
+    """A rigid obstacle fixed in space (spatial frame, m). :meth:`distance` is the signed
+    distance of points from its surface and the outward normal there."""
+
+    kind: ClassVar[str]
+
+    def distance(self, points) -> tuple[np.ndarray, np.ndarray]:
+        """(d (...), n (..., 3)) for points (..., 3), m, spatial: the signed distance from
+        the surface (negative inside) and the outward unit normal at the nearest surface
+        point (∇d)."""
+        return _distance(self.kernel_row(), np.asarray(points, dtype=np.float64))
+
+    def kernel_row(self) -> np.ndarray:
+        """The solver's row (8,): kind, two points, radius (statics/_kernels.py)."""
+        raise NotImplementedError
+
+    def moved(self, R, origin) -> Obstacle:
+        """The same obstacle in a frame rotated by R at ``origin``: x → Rᵀ (x - origin)."""
+        raise NotImplementedError
+
+    def to_case(self) -> dict:
+        """The obstacle's ``[[obstacle]]`` table."""
+        raise NotImplementedError
+
+
+@dataclass(frozen=True, eq=False)
+class Plane(Obstacle):
+    """The half-space behind a plane: the solid is on the side opposite to ``normal``.
+
+    Parameters
+    ----------
+    point : (3,) array_like
+        A point of the plane, m, spatial.
+    normal : (3,) array_like
+        Its outward normal (pointing out of the solid), any non-zero length; stored unit.
+    """
+
+    point: np.ndarray
+    normal: np.ndarray
+    kind: ClassVar[str] = "plane"
+
+    def __post_init__(self):
+        object.__setattr__(self, "point", _point(self.point, "Plane.point"))
+        normal = _point(self.normal, "Plane.normal")
+        size = float(np.linalg.norm(normal))
+        if not size > 0.0:
+            raise ValueError(f"Plane.normal must be a non-zero vector, got "
+                             f"{format_value(self.normal)}")
+        normal = normal / size
+        normal.setflags(write=False)
+        object.__setattr__(self, "normal", normal)
+
+    def kernel_row(self):
+        return np.array([_PLANE, *self.point, *self.normal, 0.0])
+
+    def moved(self, R, origin):
+        return Plane(R.T @ (self.point - origin), R.T @ self.normal)
+
+    def to_case(self):
+        return {"kind": "plane", "point": self.point.tolist(), "normal": self.normal.tolist()}
+
+
+@dataclass(frozen=True, eq=False)
+class Sphere(Obstacle):
+    """A solid ball.
+
+    Parameters
+    ----------
+    center : (3,) array_like
+        m, spatial.
+    radius : float
+        m, > 0.
+    """
+
+    center: np.ndarray
+    radius: float
+    kind: ClassVar[str] = "sphere"
+
+    def __post_init__(self):
+        object.__setattr__(self, "center", _point(self.center, "Sphere.center"))
+        object.__setattr__(self, "radius", _radius(self.radius, "Sphere.radius"))
+
+    def kernel_row(self):
+        return np.array([_SPHERE, *self.center, 0.0, 0.0, 0.0, self.radius])
+
+    def moved(self, R, origin):
+        return Sphere(R.T @ (self.center - origin), self.radius)
+
+    def to_case(self):
+        return {"kind": "sphere", "center": self.center.tolist(), "radius": self.radius}
+
+
+@dataclass(frozen=True, eq=False)
+class Capsule(Obstacle):
+    """A solid cylinder of radius ``radius`` around the segment from ``a`` to ``b``, with
+    hemispherical ends: a pin, a rod, a finger, a vessel's wall seen from outside.
+
+    Parameters
+    ----------
+    a, b : (3,) array_like
+        The ends of its axis, m, spatial (distinct).
+    radius : float
+        m, > 0.
+    """
+
+    a: np.ndarray
+    b: np.ndarray
+    radius: float
+    kind: ClassVar[str] = "capsule"
+
+    def __post_init__(self):
+        object.__setattr__(self, "a", _point(self.a, "Capsule.a"))
+        object.__setattr__(self, "b", _point(self.b, "Capsule.b"))
+        object.__setattr__(self, "radius", _radius(self.radius, "Capsule.radius"))
+        if not np.linalg.norm(self.b - self.a) > 0.0:
+            raise ValueError(f"Capsule.a and Capsule.b must be distinct points, got "
+                             f"{format_value(self.a)} twice")
+
+    def kernel_row(self):
+        return np.array([_CAPSULE, *self.a, *self.b, self.radius])
+
+    def moved(self, R, origin):
+        return Capsule(R.T @ (self.a - origin), R.T @ (self.b - origin), self.radius)
+
+    def to_case(self):
+        return {"kind": "capsule", "a": self.a.tolist(), "b": self.b.tolist(),
+                "radius": self.radius}
+
+
+#: Every obstacle kind by its case-file name.
+OBSTACLE_KINDS = {cls.kind: cls for cls in (Plane, Sphere, Capsule)}
+
+
+def _distance(row: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The kernel's ``_nearest`` in numpy, for points p (..., 3): (d, n)."""
+    kind = int(row[0])
+    if kind == _PLANE:
+        normal = row[4:7]
+        return (p - row[1:4]) @ normal, np.broadcast_to(normal, p.shape).copy()
+    q = np.broadcast_to(row[1:4], p.shape)
+    if kind == _CAPSULE:
+        axis = row[4:7] - row[1:4]
+        t = np.clip(((p - row[1:4]) @ axis) / (axis @ axis), 0.0, 1.0)
+        q = row[1:4] + t[..., None] * axis
+    offset = p - q
+    r = np.linalg.norm(offset, axis=-1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        n = np.where(r[..., None] > 0.0, offset / r[..., None], 0.0)
+    return r - row[7], n
+
+
+def pressure(gap, distance: float, stiffness: float) -> np.ndarray:
+    """The contact law φ(g) (N/m per unit arm length) at gaps ``gap`` (m): the kernel's
+    ``_pressure`` (module docstring)."""
+    g = np.asarray(gap, dtype=np.float64)
+    t = np.clip((distance - g) / distance, 0.0, 1.0)
+    inside = stiffness * (0.5 * distance - np.minimum(g, 0.0))
+    return np.where(g <= 0.0, inside, stiffness * distance * t**3 * (1.0 - 0.5 * t))
+
+
+def _obstacles(value) -> tuple[Obstacle, ...]:
+    items = (value,) if isinstance(value, Obstacle) else value
+    try:
+        items = tuple(items)
+    except TypeError:
+        raise TypeError(f"obstacles must be an obstacle (softarm.Plane, Sphere, Capsule) or "
+                        f"a sequence of them, got {format_value(value)}") from None
+    for k, item in enumerate(items):
+        if not isinstance(item, Obstacle):
+            raise TypeError(f"obstacles[{k}] must be a softarm.Plane, Sphere or Capsule, got "
+                            f"{format_value(item)}")
+    if not items:
+        raise ValueError("obstacles must name at least one obstacle, got none")
+    return items
+
+
+def _optional_positive(value, name: str, unit: str) -> float | None:
+    if value is None:
+        return None
+    number = real(value, name, unit)
+    if not (math.isfinite(number) and number > 0.0):
+        raise ValueError(f"{name} must be a positive finite number in {unit} or None, got "
+                         f"{format_value(value)}")
+    return number
+
+
+@dataclass(frozen=True, eq=False)
+class Contact(Load):
+    """The arm's surface touches rigid obstacles fixed in space (a :class:`Load`; module
+    docstring and docs/contact.md for the method and its accuracy).
+
+    Parameters
+    ----------
+    obstacles : Obstacle or sequence of Obstacle
+        :class:`Plane`, :class:`Sphere`, :class:`Capsule` (spatial frame, m).
+    friction : float
+        Coulomb's μ >= 0 (dynamics; statics returns the frictionless equilibrium).
+    distance : float or None
+        The contact distance δ (m): forces act only where the gap is below it. Default
+        1e-5 L. The shape is within about δ of the hard-contact solution.
+    radius : float or None
+        The arm's surface radius (m). Default: the section's (``Arm.radius``, per segment);
+        required for an arm given by its stiffnesses.
+    stiffness : float or None
+        The penalty's k (N/m per m of arm, the force per length per m of penetration
+        beyond the band). Default: chosen by the solver from the loads, and raised where a
+        solution penetrates beyond tol·L (the value used is on ``eq.loads``).
+
+    Examples
+    --------
+    >>> import softarm
+    >>> table = softarm.Plane(point=(0, 0, -0.05), normal=(0, 0, 1))
+    >>> softarm.Contact(table).describe()
+    'contact with 1 obstacle (plane), frictionless, contact distance 1e-05 L'
+    """
+
+    obstacles: tuple
+    friction: float = 0.0
+    distance: float | None = None
+    radius: float | None = None
+    stiffness: float | None = None
+    kind: ClassVar[str] = "contact"
+    schema: ClassVar = (Key("friction", "number"), Key("distance", "number", "m"),
+                        Key("radius", "number", "m"), Key("stiffness", "number", "N/m²"))
+
+    def __post_init__(self):
+        object.__setattr__(self, "obstacles", _obstacles(self.obstacles))
+        mu = real(self.friction, "Contact.friction", "")
+        if not (math.isfinite(mu) and mu >= 0.0):
+            raise ValueError(f"Contact.friction must be a finite number >= 0 (Coulomb's μ), "
+                             f"got {format_value(self.friction)}")
+        object.__setattr__(self, "friction", mu)
+        for name, unit in (("distance", "m"), ("radius", "m"), ("stiffness", "N/m²")):
+            object.__setattr__(self, name, _optional_positive(getattr(self, name),
+                                                              f"Contact.{name}", unit))
+
+    @property
+    def batch_shape(self) -> tuple[int, ...]:
+        return ()
+
+    def apply(self, target) -> None:
+        target.contact(self)
+
+    def scaled(self, factor) -> Contact:
+        return self  # (obstacles are geometry, not a load magnitude)
+
+    def in_base_frame(self, R, origin=None) -> Contact:
+        origin = np.zeros(3) if origin is None else np.asarray(origin, dtype=np.float64)
+        return self.replace(obstacles=tuple(o.moved(np.asarray(R), origin)
+                                            for o in self.obstacles))
+
+    def take(self, index) -> Contact:
+        return self
+
+    def describe(self, swept=None) -> str:
+        kinds = ", ".join(o.kind for o in self.obstacles)
+        count = len(self.obstacles)
+        friction = f"μ = {self.friction:g}" if self.friction else "frictionless"
+        distance = (f"{self.distance:g} m" if self.distance is not None
+                    else f"{DISTANCE:g} L")
+        return (f"contact with {count} obstacle{'s' * (count != 1)} ({kinds}), {friction}, "
+                f"contact distance {distance}")
+
+    def check(self, arm) -> None:
+        self.surface_radii(arm)
+
+    def surface_radii(self, arm) -> np.ndarray:
+        """The surface radius of each of the arm's segments (m): ``radius``, else the
+        sections'. ValueError where neither is known."""
+        if self.radius is not None:
+            return np.full(len(arm.segments), self.radius)
+        radii = [segment.radius for segment in arm.segments]
+        if any(r is None for r in radii):
+            raise ValueError("Contact.radius is required for an arm given by its stiffnesses "
+                             "(Arm.from_stiffness, from_stiffness_matrix): the arm's surface "
+                             "radius in m, e.g. Contact(obstacles, radius=0.01)")
+        return np.array(radii, dtype=np.float64)
+
+    def station_radii(self, arm, s) -> np.ndarray:
+        """The arm's surface radius at each station s (m)."""
+        bounds = np.asarray(arm.boundaries)
+        segment = np.clip(np.searchsorted(bounds, s, side="right") - 1, 0, len(bounds) - 2)
+        return self.surface_radii(arm)[segment]
+
+    def band(self, length: float) -> float:
+        """The contact distance δ in m for an arm of length ``length``."""
+        return self.distance if self.distance is not None else DISTANCE * length
+
+    def kernel_rows(self) -> np.ndarray:
+        """The obstacles' rows for the solver (K, 8)."""
+        return np.array([o.kernel_row() for o in self.obstacles])
+
+    def gaps(self, positions, radii) -> tuple[np.ndarray, np.ndarray]:
+        """(gaps (...), forces (..., 3)): at centreline positions (..., 3) with surface
+        radii (...) (m), the distance from the arm's surface to the nearest obstacle (m) and
+        the contact force per unit length (N/m, spatial) with this law (``stiffness`` set)."""
+        p = np.asarray(positions, dtype=np.float64)
+        gap = np.full(p.shape[:-1], np.inf)
+        force = np.zeros(p.shape)
+        k = self.stiffness or 0.0
+        for obstacle in self.obstacles:
+            d, n = _distance(obstacle.kernel_row(), p)
+            g = d - radii
+            gap = np.minimum(gap, g)
+            if k:
+                force += pressure(g, self.distance, k)[..., None] * n
+        return gap, force
