@@ -267,6 +267,9 @@ class Contact(Load):
         The penalty's k (N/m per m of arm, the force per length per m of penetration
         beyond the band). Default: chosen by the solver from the loads, and raised where a
         solution penetrates beyond tol·L (the value used is on ``eq.loads``).
+    slip_velocity : float
+        Dynamics with friction: the sliding speed w_ε (m/s) below which Coulomb's law is
+        regularised (a sticking contact creeps at about that speed; docs/contact.md).
 
     Examples
     --------
@@ -281,9 +284,11 @@ class Contact(Load):
     distance: float | None = None
     radius: float | None = None
     stiffness: float | None = None
+    slip_velocity: float = 1e-4
     kind: ClassVar[str] = "contact"
     schema: ClassVar = (Key("friction", "number"), Key("distance", "number", "m"),
-                        Key("radius", "number", "m"), Key("stiffness", "number", "N/m²"))
+                        Key("radius", "number", "m"), Key("stiffness", "number", "N/m²"),
+                        Key("slip_velocity", "number", "m/s"))
 
     def __post_init__(self):
         object.__setattr__(self, "obstacles", _obstacles(self.obstacles))
@@ -292,9 +297,12 @@ class Contact(Load):
             raise ValueError(f"Contact.friction must be a finite number >= 0 (Coulomb's μ), "
                              f"got {format_value(self.friction)}")
         object.__setattr__(self, "friction", mu)
-        for name, unit in (("distance", "m"), ("radius", "m"), ("stiffness", "N/m²")):
+        for name, unit in (("distance", "m"), ("radius", "m"), ("stiffness", "N/m²"),
+                           ("slip_velocity", "m/s")):
             object.__setattr__(self, name, _optional_positive(getattr(self, name),
                                                               f"Contact.{name}", unit))
+        if self.slip_velocity is None:
+            raise ValueError("Contact.slip_velocity must be a positive speed in m/s, got None")
 
     @property
     def batch_shape(self) -> tuple[int, ...]:

@@ -205,6 +205,10 @@ class Simulator:
             cuts = tuple(c for load in initial.loads for c in load.cuts(initial.arm))
         self.loads, shape, _, pieces, channels = self._solver._prepare(everything, cuts)
         self.loads = self.loads[:len(self.loads) - len(self.actuators)]
+        contact = channels.resolve_contact(dt=self.dt)
+        if contact is not None:  # (the law the steps use, on the trajectory's loads)
+            self.loads = tuple(contact if load.kind == "contact" else load
+                               for load in self.loads)
         self.shape = shape
         self._channels = channels
         self._act = channels.arm_tuple()[1]

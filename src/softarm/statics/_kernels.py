@@ -764,9 +764,9 @@ def _dipole(y, T, which, m0, m1, m2, now, rate, out):
 
 # Contact (issue 33; docs/contact.md). ``act[5]``: the obstacles (K, 8), one row each: kind,
 # then a plane's point and outward unit normal, a sphere's centre (and 0, 0, 0), or a
-# capsule's two axis ends, then the radius (0 for a plane). ``act[6]`` (P, 3): per piece the
-# arm's surface radius r (m), the contact distance δ (m) and the penalty stiffness k
-# (N/m per m of arm).
+# capsule's two axis ends, then the radius (0 for a plane). ``act[6]`` (P, 5): per piece the
+# arm's surface radius r (m), the contact distance δ (m), the penalty stiffness k
+# (N/m per m of arm), Coulomb's μ and the friction's regularising speed w_ε (m/s; dynamics).
 PLANE, SPHERE, CAPSULE = 0, 1, 2
 OBSTACLE = 8
 
@@ -820,7 +820,7 @@ def _contact(px, py, pz, obstacles, params):
     """The contact force per unit length on a section at p (spatial, N/m; frictionless,
     along each obstacle's normal, through the centreline: no moment) and its Jacobian
     ∂f/∂p (row-major), summed over the obstacles: f = φ(d - r) ∇d,
-    ∂f/∂p = φ' ∇d ∇dᵀ + φ ∇²d (``params`` = the piece's (r, δ, k), act[6]'s row)."""
+    ∂f/∂p = φ' ∇d ∇dᵀ + φ ∇²d (``params`` = the piece's act[6] row: r, δ, k)."""
     f0 = f1 = f2 = 0.0
     j00 = j01 = j02 = j11 = j12 = j22 = 0.0
     for k in range(obstacles.shape[0]):
@@ -4103,6 +4103,7 @@ DYN = 24
 # Unknowns and rates per node (DUNK = 18): δp, δθ (material), δn, δm, δq, δω; a node's rate
 # vector holds p', u, n', m', q', ω' in the same order.
 DUNK = 18
+_DYN_HALVINGS = 12  # the most halvings of a damped Newton step (contact, _dyn_newton)
 _DKL = 29  # the band's lower width: rows of interval k meet node k's columns 29 back
 # History per node (DHIST = 36): x = (ε (6), q, ω) at t - Δt, at t - 2Δt, and ẋ at t - Δt.
 DHIST = 36
@@ -4258,6 +4259,8 @@ def _node_rates(z, s, j, props, now, hist_h, coef, out, eps, act, actuation, len
         _dipole(z, law[2], np.int64(0), ma0, ma1, ma2, now[j], now[j], law[2][3])
         for k in range(6):
             fd[k] += law[2][3, k]
+    if act is not None and act[5].shape[0] > 0:
+        _moving_contact(z, act[5], act[6][j], fd)
     fl = np.empty(6)
     _mat_t_vec(z, _DR, fd[0], fd[1], fd[2], fl, 0)
     _mat_t_vec(z, _DR, fd[3], fd[4], fd[5], fl, 3)
@@ -4286,6 +4289,50 @@ def _node_rates(z, s, j, props, now, hist_h, coef, out, eps, act, actuation, len
     out[15] = ut0 - (u1 * w2 - u2 * w1)
     out[16] = ut1 - (u2 * w0 - u0 * w2)
     out[17] = ut2 - (u0 * w1 - u1 * w0)
+
+
+@_jit
+def _moving_contact(z, obstacles, params, out):
+    """Add the contact's force and moment per unit length (spatial) on the moving node z to
+    out[0:6]: the statics' normal force (:func:`_contact`) and Coulomb friction at the
+    surface point p - r n, regularised, f_t = -μ φ w / √(|w|² + w_ε²) with w the surface
+    point's sliding velocity (its velocity R q + (R ω) × (-r n), less the normal part) and
+    w_ε = ``params[4]`` (m/s): sliding where |w| >> w_ε, sticking as a creep of speed
+    about w_ε |f_t| / (μ φ) below the friction cone (contact.md). ``params`` = the piece's
+    (r, δ, k, μ, w_ε)."""
+    px, py, pz = z[_DP], z[_DP + 1], z[_DP + 2]
+    r, mu, slip = params[0], params[3], params[4]
+    # the section's velocity and spin, spatial
+    vx = z[_DR] * z[_DQ] + z[_DR + 1] * z[_DQ + 1] + z[_DR + 2] * z[_DQ + 2]
+    vy = z[_DR + 3] * z[_DQ] + z[_DR + 4] * z[_DQ + 1] + z[_DR + 5] * z[_DQ + 2]
+    vz = z[_DR + 6] * z[_DQ] + z[_DR + 7] * z[_DQ + 1] + z[_DR + 8] * z[_DQ + 2]
+    wx = z[_DR] * z[_DW] + z[_DR + 1] * z[_DW + 1] + z[_DR + 2] * z[_DW + 2]
+    wy = z[_DR + 3] * z[_DW] + z[_DR + 4] * z[_DW + 1] + z[_DR + 5] * z[_DW + 2]
+    wz = z[_DR + 6] * z[_DW] + z[_DR + 7] * z[_DW + 1] + z[_DR + 8] * z[_DW + 2]
+    for k in range(obstacles.shape[0]):
+        d, n0, n1, n2, _, _, _, _ = _nearest(px, py, pz, obstacles[k])
+        phi, _ = _pressure(d - r, params[1], params[2])
+        if phi == 0.0:
+            continue
+        out[0] += phi * n0
+        out[1] += phi * n1
+        out[2] += phi * n2
+        if mu == 0.0:
+            continue
+        a0, a1, a2 = -r * n0, -r * n1, -r * n2  # the surface point from the centreline
+        s0 = vx + wy * a2 - wz * a1
+        s1 = vy + wz * a0 - wx * a2
+        s2 = vz + wx * a1 - wy * a0
+        normal = s0 * n0 + s1 * n1 + s2 * n2
+        s0, s1, s2 = s0 - normal * n0, s1 - normal * n1, s2 - normal * n2
+        scale = -mu * phi / math.sqrt(s0 * s0 + s1 * s1 + s2 * s2 + slip * slip)
+        t0, t1, t2 = scale * s0, scale * s1, scale * s2
+        out[0] += t0
+        out[1] += t1
+        out[2] += t2
+        out[3] += a1 * t2 - a2 * t1
+        out[4] += a2 * t0 - a0 * t2
+        out[5] += a0 * t1 - a1 * t0
 
 
 @_jit
@@ -4484,6 +4531,14 @@ def _dyn_apply(Z, dx, S):
 
 
 @_jit
+def _sum_squares(r):
+    total = 0.0
+    for i in range(r.size):
+        total += r[i] * r[i]
+    return total
+
+
+@_jit
 def _dyn_newton(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, tol, max_iter,
                 factors, kl, work):
     """Chord-Newton on one step's equations from the guess Z (the factors (Bm, Lm, piv,
@@ -4494,11 +4549,18 @@ def _dyn_newton(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, tol, 
     n = r.size
     last = math.inf
     factored = 0
+    # with contact, a Newton step on a fresh Jacobian that does not lower the residual is
+    # halved until it does (a contact that opens or closes within the step changes the
+    # equations' slope by the penalty's k: the full step overshoots deep into the obstacle)
+    damped = act is not None and act[5].shape[0] > 0
+    before_step = np.empty((Z.shape[0], Z.shape[1]) if damped else (1, 1))
+    merit_before = 0.0
     worst = _dyn_residual(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, r, rates,
                           eps, lengths)
     for it in range(max_iter):
         if not math.isfinite(worst):
             return DYN_NOT_FINITE, worst, it, factored
+        fresh = valid[0] == 0
         if valid[0] == 0:
             _dyn_jacobian(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, rates, Gk,
                           Bm, kl)
@@ -4514,10 +4576,26 @@ def _dyn_newton(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, tol, 
         step = 0.0
         for i in range(n):
             step = max(step, abs(dx[i]))
+        if damped:
+            _copy(Z, before_step)
+            merit_before = _sum_squares(r)
         _dyn_apply(Z, dx, S)
         before = worst
         worst = _dyn_residual(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, r,
                               rates, eps, lengths)
+        halvings = 0
+        if damped and fresh:  # (merit: the residual's 2-norm; the max norm can stall)
+            merit = _sum_squares(r)
+            while not (merit < merit_before) and halvings < _DYN_HALVINGS:
+                halvings += 1
+                _copy(before_step, Z)
+                for i in range(n):
+                    dx[i] *= 0.5
+                step *= 0.5
+                _dyn_apply(Z, dx, S)
+                worst = _dyn_residual(Z, grid, props, coef, S, now, tip_now, hh, act,
+                                      actuation, r, rates, eps, lengths)
+                merit = _sum_squares(r)
         # converged when the residual is below tol and so is the error left, estimated
         # from the contraction ρ of the last two corrections: ρ/(1 - ρ) × this one
         rho = step / last if last < math.inf else 1.0
@@ -4699,6 +4777,25 @@ def dynamic_steps(Z, Zold, H, aux, props, loads, tip, grid, coef, S, options, ba
                 Zw[0, _DR + i] = base[bb, t, 3 + i]
             code, res, its, nf = _dyn_newton(Zw, grid, props, coef, S, now, tip_now, hh, act,
                                              actuation, tol, max_iter, fac, kl, work)
+            if code != DYN_OK and act is not None and act[5].shape[0] > 0:
+                # contact: a contact that closes within the step can put the extrapolated
+                # guess deep in an obstacle, outside Newton's reach; again from the last
+                # state, with fresh factors
+                for k in range(G):
+                    for i in range(DYN):
+                        Zw[k, i] = Z[b, k, i]
+                for i in range(3):
+                    Zw[0, _DP + i] = base[bb, t, i]
+                    Zw[0, _DQ + i] = base[bb, t, 12 + i]
+                    Zw[0, _DW + i] = base[bb, t, 15 + i]
+                for i in range(9):
+                    Zw[0, _DR + i] = base[bb, t, 3 + i]
+                fac[3][0] = 0
+                code, res, again, nf2 = _dyn_newton(Zw, grid, props, coef, S, now, tip_now, hh,
+                                                    act, actuation, tol, max_iter, fac, kl,
+                                                    work)
+                its += again
+                nf += nf2
             info[b, t, 0] = res
             info[b, t, 2] = nf
             for k in range(G):  # the model's limit: a section turned inside out (v₁ <= 0)

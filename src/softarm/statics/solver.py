@@ -192,7 +192,7 @@ class _ArmData:
 
 
 #: ``act``'s contact arrays out of contact: no obstacle (statics/_kernels.py, act[5], act[6])
-_NO_CONTACT = (np.zeros((0, 8)), np.zeros((1, 3)))
+_NO_CONTACT = (np.zeros((0, 8)), np.zeros((1, 5)))
 
 
 #: Retries of a solve whose answer penetrates an obstacle, each with the penalty raised
@@ -297,7 +297,7 @@ class _Channels:
         self.data = data
         self.actuators = []  # (kind code, routing, active rows, span) per actuator column
         #: the Contact load, if any (:meth:`contact`); its arrays for the kernel, made once
-        self.contact_load = None
+        self.contact_load = self._contact_given = None  # (as resolved, as given)
         self._contact_arrays = None
 
     def _rows(self, span):
@@ -367,7 +367,7 @@ class _Channels:
         if self.contact_load is not None:
             raise ValueError("loads may hold one Contact: put every obstacle in it, "
                              "Contact([obstacle, ...])")
-        self.contact_load = load
+        self.contact_load = self._contact_given = load
 
     def arm_tuple(self) -> tuple:
         """The kernel's (arm, act) pair, passed on as ``*arm_tuple()``: the pieces, and the
@@ -384,15 +384,27 @@ class _Channels:
                    self.pieces[9], self.pieces[10])
         return arm, (*act, *self._contact_arrays)
 
-    def resolve_contact(self, stiffness: float | None = None):
+    def resolve_contact(self, stiffness: float | None = None, *, dt: float | None = None):
         """The Contact with its contact distance and penalty stiffness set (``stiffness``,
         else the load's own, else :meth:`_contact_stiffness`'s estimate), made this
-        channels' contact; returns it (None without contact)."""
-        load = self.contact_load
+        channels' contact; returns it (None without contact).
+
+        ``dt`` (s): for time steps of that length, an estimated k above μ/Δt² (μ the
+        lightest linear density) is lowered to it, with δ widened by the same factor (the
+        same pressure k δ/2 carried within the band), unless the Contact gives its own
+        distance or stiffness: a stiffer penalty rings at ω Δt > 1, and an implicit step's
+        Newton iteration does not converge across a band much thinner than the arm moves
+        in a step (contact.md, "Dynamics")."""
+        load = self._contact_given
         if load is None:
             return None
         band = load.band(self.length)
         k = stiffness or load.stiffness or self._contact_stiffness(band)
+        if dt is not None and load.distance is None and load.stiffness is None:
+            lightest = float(np.nanmin(self.mu)) if np.any(self.mu > 0.0) else 0.0
+            largest = lightest / dt**2
+            if 0.0 < largest < k:
+                band, k = band * k / largest, largest
         self.contact_load = load.replace(distance=band, stiffness=k)
         self._contact_arrays = None
         return self.contact_load
@@ -423,10 +435,12 @@ class _Channels:
     def _contact_kernel_arrays(self) -> tuple:
         load = self.contact_load
         radii = load.surface_radii(self.arm)[self.pieces[12]]
-        params = np.empty((self.starts.size, 3))
+        params = np.empty((self.starts.size, 5))
         params[:, 0] = radii
         params[:, 1] = load.distance
         params[:, 2] = load.stiffness
+        params[:, 3] = load.friction
+        params[:, 4] = load.slip_velocity
         return load.kernel_rows(), params
 
     def contact_kl(self) -> float:
