@@ -98,7 +98,7 @@ def test_penalty_converges_to_hard_contact(hard):
         force_errors.append(abs(pn0 - n0))
         moment_errors.append(abs(pm0 - m0))
     errors = np.array(errors)
-    # the clamp's reaction: force 3.0e-4 … 3.4e-7 N (of 0.89 N), moment 1.14e-4 … 1.13e-8 N m
+    # the clamp's reaction: force 3.0e-4 … 3.4e-7 N (of −0.504 N), moment 1.14e-4 … 1.13e-8 N m
     assert np.all(np.diff(force_errors) < 0) and force_errors[-1] < 5e-7
     assert np.allclose(-np.diff(np.log10(moment_errors)), 1.0, atol=0.01)
     rates = -np.diff(np.log10(errors))
