@@ -224,8 +224,9 @@ def table_reference(L, EA, GA, EI, r, w, d, *, tol=1e-8, max_nodes=200_000) -> T
     length w (N/m), drop d = h − r (m) of the centreline from the clamp to its height on the
     table; ``tol`` is solve_bvp's (relative collocation residual).
 
-    Raises ValueError if the arm does not reach the table (the solve's s_c not in (0, L)) and
-    RuntimeError if solve_bvp fails.
+    Raises ValueError if the solution's structure is not admissible (s_c not in (0, L), the
+    free arc through the table, or a pull at the end: the arm touches with its tip only or
+    not at all) and RuntimeError if solve_bvp fails.
     """
     L, EA, GA, EI, r, w, d = (_check(n, v) for n, v in zip(
         ("L", "EA", "GA", "EI", "r", "w", "d"), (L, EA, GA, EI, r, w, d), strict=True))
@@ -249,25 +250,39 @@ def table_reference(L, EA, GA, EI, r, w, d, *, tol=1e-8, max_nodes=200_000) -> T
                          ya[5] - yb[0], ya[6] - yb[2], ya[7] - yb[4],
                          yb[7]])
 
-    # Small-deflection start: EI z'''' = −w on [0, σ], z'(σ) = z''(σ) = 0 (point reaction).
-    sig = min((72.0 * dt / qt) ** 0.25, 0.9)
     t = np.linspace(0.0, 1.0, 81)
-    sa = sig * t
-    z = -qt * sa**4 / 24 + qt * sig * sa**3 / 9 - qt * sig**2 * sa**2 / 12
-    th = -qt * sa**3 / 6 + qt * sig * sa**2 / 3 - qt * sig**2 * sa / 6
-    m = -qt * sa**2 / 2 + 2 * qt * sig * sa / 3 - qt * sig**2 / 6
-    nz = -(-qt * sa + 2 * qt * sig / 3)
-    y = np.vstack([sa, z, th, nz, m, sig + (1 - sig) * t, 0 * t, 0 * t])
+    sig, air = _small_deflection_start(qt, dt, t)
+    y = np.vstack([air, sig + (1 - sig) * t, 0 * t, 0 * t])
     sol = solve_bvp(fun, bc, t, y, p=[sig], tol=tol, max_nodes=max_nodes)
     if not sol.success:
         raise RuntimeError(f"solve_bvp failed: {sol.message}")
     s_c = float(sol.p[0]) * L
     tip_reaction = float(_zone_shear(sol.sol(1.0)[6], eps_a, eps_g)) * EI / L**2
-    if not (0.0 < s_c < L and tip_reaction >= 0.0):
+    # The assumed structure must be admissible: s_c on the arm, the free arc above the table
+    # (checked at the mesh nodes), no pull at the end (the pressure on the table exceeds w on
+    # the stable manifold; the tests check it).
+    gap = float(np.min(sol.y[1, :-1] + dt)) if 0.0 < s_c < L else -1.0
+    if not (gap > 0.0 and tip_reaction >= 0.0):
         raise ValueError(f"d must let the arm's far part lie flat on the table, got d = {d!r} m "
                          f"(lift-off at s_c = {s_c!r} m for L = {L!r} m, tip reaction "
                          f"{tip_reaction!r} N): a larger d touches with the tip only or not at all")
     return TableSolution(L, EA, GA, EI, r, w, d, s_c, tip_reaction, sol)
+
+
+def _small_deflection_start(qt, dt, t):
+    """Euler–Bernoulli start for the free arc: EI z⁗ = −w on [0, σ], z = z' = 0 at the clamp,
+    z(σ) = −d, z'(σ) = z''(σ) = 0 (a point reaction at lift-off), so that d = w σ⁴/(72 EI).
+
+    Nondimensional load qt = w L³/EI and drop dt = d/L; returns σ = s_c/L (at most 0.9) and
+    the (5, t.size) rows x, z, θ, n_z, m at s/L = σ t.
+    """
+    sig = min((72.0 * dt / qt) ** 0.25, 0.9)
+    s = sig * t
+    z = -qt * s**4 / 24 + qt * sig * s**3 / 9 - qt * sig**2 * s**2 / 12
+    th = -qt * s**3 / 6 + qt * sig * s**2 / 3 - qt * sig**2 * s / 6
+    m = -qt * s**2 / 2 + 2 * qt * sig * s / 3 - qt * sig**2 / 6
+    nz = qt * s - 2 * qt * sig / 3
+    return sig, np.vstack([s, z, th, nz, m])
 
 
 def point_reaction_reference(L, EA, GA, EI, r, w, d, *, tol=1e-8):
@@ -288,10 +303,8 @@ def point_reaction_reference(L, EA, GA, EI, r, w, d, *, tol=1e-8):
     def bc(ya, yb, p):
         return np.array([ya[0], ya[1], ya[2], yb[1] + dt, yb[2], yb[4]])
 
-    sig = min((72.0 * dt / qt) ** 0.25, 0.9)
     t = np.linspace(0.0, 1.0, 81)
-    y = np.zeros((5, t.size))
-    y[0] = sig * t
+    sig, y = _small_deflection_start(qt, dt, t)
     sol = solve_bvp(fun, bc, t, y, p=[sig], tol=tol, max_nodes=100_000)
     if not sol.success:
         raise RuntimeError(f"solve_bvp failed: {sol.message}")
