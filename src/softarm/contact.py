@@ -220,6 +220,20 @@ def pressure(gap, distance: float, stiffness: float) -> np.ndarray:
     return np.where(g <= 0.0, inside, stiffness * distance * t**3 * (1.0 - 0.5 * t))
 
 
+def _stiffness(value):
+    """None, a positive finite float, or a read-only array of them (one per case)."""
+    if value is None:
+        return None
+    if np.ndim(value) == 0:
+        return _optional_positive(value, "Contact.stiffness", "N/m²")
+    array = np.array(value, dtype=np.float64)
+    if not np.all(np.isfinite(array) & (array > 0.0)):
+        raise ValueError(f"Contact.stiffness must be positive and finite (N/m²), got "
+                         f"{format_value(value)}")
+    array.setflags(write=False)
+    return array
+
+
 def _obstacles(value) -> tuple[Obstacle, ...]:
     items = (value,) if isinstance(value, Obstacle) else value
     try:
@@ -266,7 +280,8 @@ class Contact(Load):
     stiffness : float or None
         The penalty's k (N/m per m of arm, the force per length per m of penetration
         beyond the band). Default: chosen by the solver from the loads, and raised where a
-        solution penetrates beyond tol·L (the value used is on ``eq.loads``).
+        solution penetrates beyond tol·L (the values used, one per case where they differ,
+        are on ``eq.loads``).
     slip_velocity : float
         Dynamics with friction: the sliding speed w_ε (m/s) below which Coulomb's law is
         regularised (a sticking contact creeps at about that speed; docs/contact.md).
@@ -297,16 +312,16 @@ class Contact(Load):
             raise ValueError(f"Contact.friction must be a finite number >= 0 (Coulomb's μ), "
                              f"got {format_value(self.friction)}")
         object.__setattr__(self, "friction", mu)
-        for name, unit in (("distance", "m"), ("radius", "m"), ("stiffness", "N/m²"),
-                           ("slip_velocity", "m/s")):
+        for name, unit in (("distance", "m"), ("radius", "m"), ("slip_velocity", "m/s")):
             object.__setattr__(self, name, _optional_positive(getattr(self, name),
                                                               f"Contact.{name}", unit))
+        object.__setattr__(self, "stiffness", _stiffness(self.stiffness))
         if self.slip_velocity is None:
             raise ValueError("Contact.slip_velocity must be a positive speed in m/s, got None")
 
     @property
     def batch_shape(self) -> tuple[int, ...]:
-        return ()
+        return np.shape(self.stiffness)  # (per case where the solver raised it)
 
     def apply(self, target) -> None:
         target.contact(self)
@@ -320,7 +335,9 @@ class Contact(Load):
                                             for o in self.obstacles))
 
     def take(self, index) -> Contact:
-        return self
+        if np.ndim(self.stiffness) == 0:
+            return self
+        return self.replace(stiffness=self.stiffness[index])
 
     def describe(self, swept=None) -> str:
         kinds = ", ".join(o.kind for o in self.obstacles)
@@ -367,11 +384,11 @@ class Contact(Load):
         p = np.asarray(positions, dtype=np.float64)
         gap = np.full(p.shape[:-1], np.inf)
         force = np.zeros(p.shape)
-        k = self.stiffness or 0.0
+        k = None if self.stiffness is None else np.asarray(self.stiffness)[..., None]
         for obstacle in self.obstacles:
             d, n = _distance(obstacle.kernel_row(), p)
             g = d - radii
             gap = np.minimum(gap, g)
-            if k:
+            if k is not None:
                 force += pressure(g, self.distance, k)[..., None] * n
         return gap, force

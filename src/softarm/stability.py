@@ -94,6 +94,8 @@ def critical_load(arm, loads, vary=None, *, max_factor=10.0, steps=STEPS, tol=1e
     if not 1e-13 <= tol <= 1e-2:
         raise ValueError(f"tol must be a relative accuracy in [1e-13, 1e-2], got {tol!r}")
     fixed, varied = _split(loads, vary)
+    if any(load.kind == "contact" for load in fixed + varied):
+        return _critical_in_contact(arm, fixed, varied, max_factor, tol, base)
     solver = Solver(arm, base=base, stability=False)
     previous = None
     n = int(steps)
@@ -123,6 +125,60 @@ def critical_load(arm, loads, vary=None, *, max_factor=10.0, steps=STEPS, tol=1e
                           f"tol = {tol:g} up to {n // 2} RK4 steps", RuntimeWarning,
                           stacklevel=2)
             return point
+
+
+#: Load factors sampled on (0, max_factor] to bracket a contact problem's first loss of
+#: stability before bisection (:func:`_critical_in_contact`).
+_CONTACT_SAMPLES = 16
+
+
+def _critical_in_contact(arm, fixed, varied, max_factor, tol, base) -> CriticalPoint | None:
+    """:func:`critical_load` with a Contact among the loads: the Morse index of the
+    multiple-shooting solve (the route that resolves a contact, docs/contact.md) sampled on
+    _CONTACT_SAMPLES load factors, then bisected on the first bracket of a change, each
+    point solved from the unloaded arm (a continuation in λ on a fixed grid does not resolve
+    a contact's band). The point's ``mode`` is None and ``x`` the base reaction at the last
+    stable factor; ``kind`` is "fold" where the solve fails beyond it (no equilibrium
+    connected to the unloaded arm), else "bifurcation"."""
+    solver = Solver(arm, base=base, stability=True)
+
+    def index(lam):
+        """(Morse index, base reaction) at λ, or (None, None) where no solve succeeds."""
+        case = (*fixed, *(load.scaled(lam) for load in varied))
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")  # (an unstable answer is what is looked for)
+                eq = solver.solve_from_unloaded(case)
+        except ConvergenceError:
+            return None, None
+        return int(eq.stability.index), np.asarray(eq.base_wrench)
+
+    start, x = index(0.0)
+    if start is None or start != 0:
+        raise ValueError(f"the equilibrium at λ = 0 (the held loads alone) is "
+                         f"{'not found' if start is None else 'already unstable'} "
+                         f"(Morse index {start})")
+    low = 0.0
+    for k in range(1, _CONTACT_SAMPLES + 1):
+        high = max_factor * k / _CONTACT_SAMPLES
+        found, y = index(high)
+        if found != 0:
+            break
+        low, x = high, y
+    else:
+        return None
+    after = found
+    while high - low > tol * high:
+        middle = 0.5 * (low + high)
+        found, y = index(middle)
+        if found == 0:
+            low, x = middle, y
+        else:
+            high, after = middle, found
+    fold = after is None
+    return CriticalPoint(factor=0.5 * (low + high), kind="fold" if fold else "bifurcation",
+                         nullity=1 if fold else after, mode=None, x=x, index_before=0,
+                         index_after=-1 if fold else after)
 
 
 def _start(path: Path):

@@ -125,7 +125,7 @@ _TP, _TT, _TN, _TM = 0, 3, 6, 9
 NT = 12
 LAM = 6  # the tangent column of the load factor
 
-# Per-piece load channels (PIECE_LOADS = 36, then one column per actuator): distributed dead
+# Per-piece load channels (PIECE_LOADS = 37, then one column per actuator): distributed dead
 # force (spatial), follower force (material), dead moment, follower moment, each per unit
 # length; the point wrench at the piece start, dead (spatial) and follower (material); the
 # magnetic field B(x) = B0 + G x (B0 in T, G row-major in T/m, spatial; the same on every
@@ -133,8 +133,11 @@ LAM = 6  # the tangent column of the load factor
 # a tendon's tension τ (N), a chamber's pressure times area p A (N).
 FD, FF, LD, LF, JD, JF = _FD, _FF, _LD, _LF, _JD, _JF = 0, 3, 6, 9, 12, 18
 FB, FG = _FB, _FG = 24, 27
-PIECE_LOADS = 36
-ACT = _ACT = 36
+# The contact's penalty scale: 1 with a Contact (0 without), so that a path from the
+# unloaded arm (λ from 0 to 1) stiffens the contact with the loads (contact.md, "The path").
+CT = _CT = 36
+PIECE_LOADS = 37
+ACT = _ACT = 37
 # Actuator kinds (``act``'s ``kinds``).
 TENDON, CHAMBER = 0, 1
 # The columns of an actuator's routing row (``act``'s ``routes``): a bound of its
@@ -559,13 +562,15 @@ def _deriv(work, twork, nt, stage, s, arm, act, j, now, rate, law):
     # contact with the obstacles: a force per unit length through the centreline (_contact)
     cf0 = cf1 = cf2 = c00 = c01 = c02 = c11 = c12 = c22 = 0.0
     touching = False
+    contact = 0.0  # the penalty's scale at this λ (the channel CT)
     if act is not None and act[5].shape[0] > 0:
+        contact = now[j, _CT]
         cf0, cf1, cf2, c00, c01, c02, c11, c12, c22 = _contact(
             work[Y, _P], work[Y, _P + 1], work[Y, _P + 2], act[5], act[6][j])
         touching = cf0 != 0.0 or cf1 != 0.0 or cf2 != 0.0
-        w[_N] -= cf0
-        w[_N + 1] -= cf1
-        w[_N + 2] -= cf2
+        w[_N] -= contact * cf0
+        w[_N + 1] -= contact * cf1
+        w[_N + 2] -= contact * cf2
     # the tendons' lengths: ℓ' = |w| where they run
     if act is not None:
         for a in range(w.size - 18):
@@ -664,9 +669,13 @@ def _deriv(work, twork, nt, stage, s, arm, act, j, now, rate, law):
             k2 -= law[2][3, 5]
         if act is not None and touching:  # -∂f/∂p δp (∂f/∂p symmetric: the obstacles' Hessians)
             dp0, dp1, dp2 = t[_TP], t[_TP + 1], t[_TP + 2]
-            g0 -= c00 * dp0 + c01 * dp1 + c02 * dp2
-            g1 -= c01 * dp0 + c11 * dp1 + c12 * dp2
-            g2 -= c02 * dp0 + c12 * dp1 + c22 * dp2
+            g0 -= contact * (c00 * dp0 + c01 * dp1 + c02 * dp2)
+            g1 -= contact * (c01 * dp0 + c11 * dp1 + c12 * dp2)
+            g2 -= contact * (c02 * dp0 + c12 * dp1 + c22 * dp2)
+            if d >= LAM:  # the penalty's own change along the path
+                g0 -= rate[rr, j, _CT] * cf0
+                g1 -= rate[rr, j, _CT] * cf1
+                g2 -= rate[rr, j, _CT] * cf2
         o = twork[stage, d]
         o[_TP] = q0
         o[_TP + 1] = q1
@@ -3039,12 +3048,13 @@ _CJ, _CS, _CL, _CFIRST, _CI = 0, 1, 2, 3, 4
 
 
 @_jit
-def _stiffness_size(arm, act, w):
+def _stiffness_size(arm, act, w, loads):
     """kL estimated from the case's load size ``w`` (in EI/L² of the *stiffest* bending,
     :func:`_load_size`) with the softest bending stiffness of the arm: the growth exponent of
     single shooting under a tension of that size; with contact, the larger of that and the
     penalty's own, L max(√(k/GA), (k/EI)^¼) (the growth rates of a shearable rod on an
-    elastic foundation of stiffness k: contact.md)."""
+    elastic foundation of stiffness k times the case's scale, the channel CT of ``loads``
+    (P, W): contact.md)."""
     soft = 0.0
     for j in range(arm[1].size):
         soft = max(soft, arm[2][j, 4, 4], arm[2][j, 5, 5])
@@ -3052,7 +3062,7 @@ def _stiffness_size(arm, act, w):
     kl = math.sqrt(max(w, 0.0) * stiff * soft)
     if act is not None and act[5].shape[0] > 0:
         for j in range(arm[1].size):
-            C, k = arm[2][j], act[6][j, 2]
+            C, k = arm[2][j], act[6][j, 2] * loads[j, _CT]
             shear = max(C[1, 1], C[2, 2])
             bending = max(C[4, 4], C[5, 5])
             kl = max(kl, arm[6] * max(math.sqrt(k * shear), (k * bending) ** 0.25))
@@ -3855,7 +3865,7 @@ def solve_stiff_cases(base, arm, act, loads, options, s_out, out, verdicts, inpu
             tip_rate[0, i] = tip_loads[b, i]
         w, turning = _load_size(arm, act, scale, start, piece_loads[b], tip_start, tip_loads[b])
         threshold = 1e-12 * w + 1e-300
-        kl = _stiffness_size(arm, act, w)
+        kl = _stiffness_size(arm, act, w, piece_loads[b])
         # M = M_base 2^levels >= kL / _GROWTH (within 25 %): the path's levels halve it
         needed = max(1, min(math.ceil(kl / _GROWTH), n_max // 4))
         levels = 0
@@ -4259,8 +4269,8 @@ def _node_rates(z, s, j, props, now, hist_h, coef, out, eps, act, actuation, len
         _dipole(z, law[2], np.int64(0), ma0, ma1, ma2, now[j], now[j], law[2][3])
         for k in range(6):
             fd[k] += law[2][3, k]
-    if act is not None and act[5].shape[0] > 0:
-        _moving_contact(z, act[5], act[6][j], fd)
+    if act is not None and act[5].shape[0] > 0 and now[j, _CT] != 0.0:
+        _moving_contact(z, act[5], act[6][j], now[j, _CT], fd)
     fl = np.empty(6)
     _mat_t_vec(z, _DR, fd[0], fd[1], fd[2], fl, 0)
     _mat_t_vec(z, _DR, fd[3], fd[4], fd[5], fl, 3)
@@ -4292,14 +4302,14 @@ def _node_rates(z, s, j, props, now, hist_h, coef, out, eps, act, actuation, len
 
 
 @_jit
-def _moving_contact(z, obstacles, params, out):
+def _moving_contact(z, obstacles, params, scale, out):
     """Add the contact's force and moment per unit length (spatial) on the moving node z to
     out[0:6]: the statics' normal force (:func:`_contact`) and Coulomb friction at the
     surface point p - r n, regularised, f_t = -μ φ w / √(|w|² + w_ε²) with w the surface
     point's sliding velocity (its velocity R q + (R ω) × (-r n), less the normal part) and
     w_ε = ``params[4]`` (m/s): sliding where |w| >> w_ε, sticking as a creep of speed
     about w_ε |f_t| / (μ φ) below the friction cone (contact.md). ``params`` = the piece's
-    (r, δ, k, μ, w_ε)."""
+    (r, δ, k, μ, w_ε); ``scale`` the penalty's (the channel CT)."""
     px, py, pz = z[_DP], z[_DP + 1], z[_DP + 2]
     r, mu, slip = params[0], params[3], params[4]
     # the section's velocity and spin, spatial
@@ -4312,6 +4322,7 @@ def _moving_contact(z, obstacles, params, out):
     for k in range(obstacles.shape[0]):
         d, n0, n1, n2, _, _, _, _ = _nearest(px, py, pz, obstacles[k])
         phi, _ = _pressure(d - r, params[1], params[2])
+        phi *= scale
         if phi == 0.0:
             continue
         out[0] += phi * n0

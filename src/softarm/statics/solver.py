@@ -200,23 +200,35 @@ _NO_CONTACT = (np.zeros((0, 8)), np.zeros((1, 5)))
 _CONTACT_RETRIES = 4
 
 
-def _penetration(solver, contact, poses, s, attempt: int) -> float | None:
-    """None if no station of the solved cases (poses (B, S, 4, 4) at stations s) is inside
-    an obstacle by more than tol·L; else the penalty stiffness that carries the largest
-    pressure found within the band (k δ/2 = 1.25 × it, and at least twice the last k). A
-    ConvergenceError when this was the solve's last attempt (``attempt`` counts from 0)."""
+def _penetration(solver, contact, poses, s, attempt: int, given: bool) -> np.ndarray | None:
+    """None if no station of the solved cases (poses (B, S, 4, 4) at stations s, with the
+    law ``contact``, its stiffness (B,)) is inside an obstacle by more than tol·L; else each
+    case's new stiffness: a case that penetrates gets the one that carries its largest
+    pressure within the band (k δ/2 = 1.25 × it, and at least twice its last k), the others
+    keep theirs (a case's answer never depends on the others': batch = loop). A
+    ConvergenceError when this was the solve's last attempt (``attempt`` counts from 0), or
+    at once for a stiffness the user ``given`` (it is theirs to raise)."""
     gaps, forces = contact.gaps(poses[..., :3, 3], contact.station_radii(solver.arm, s))
-    depth = -float(np.min(gaps))
-    if depth <= solver.tol * solver.length:
+    depth = -gaps.min(axis=-1)
+    deep = depth > solver.tol * solver.length
+    if not deep.any():
         return None
+    worst = int(np.argmax(depth))
+    k = contact.stiffness
+    if given:
+        raise ConvergenceError(
+            f"the arm penetrates an obstacle by {depth[worst]:.3g} m (more than tol·L = "
+            f"{solver.tol * solver.length:.3g} m) with the given Contact(stiffness="
+            f"{k[worst]:.3g}) N/m²: give a larger one, or none (the solver then raises it "
+            f"until no case penetrates)", residual=float(depth[worst]))
     if attempt >= _CONTACT_RETRIES:
         raise ConvergenceError(
-            f"the arm penetrates an obstacle by {depth:.3g} m (more than tol·L = "
+            f"the arm penetrates an obstacle by {depth[worst]:.3g} m (more than tol·L = "
             f"{solver.tol * solver.length:.3g} m) at the contact stiffness k = "
-            f"{contact.stiffness:.3g} N/m², raised {attempt} times: pass a larger "
-            f"Contact(stiffness=...) or distance=", residual=depth)
-    peak = float(np.max(np.linalg.norm(forces, axis=-1)))
-    return max(2.5 * peak / contact.distance, 2.0 * contact.stiffness)
+            f"{k[worst]:.3g} N/m², raised {attempt} times: pass a larger "
+            f"Contact(stiffness=...) or distance=", residual=float(depth[worst]))
+    peak = np.linalg.norm(forces, axis=-1).max(axis=-1)
+    return np.where(deep, np.maximum(2.5 * peak / contact.distance, 2.0 * k), k)
 
 
 def unloaded_poses(arm, s, base) -> np.ndarray:
@@ -368,6 +380,7 @@ class _Channels:
             raise ValueError("loads may hold one Contact: put every obstacle in it, "
                              "Contact([obstacle, ...])")
         self.contact_load = self._contact_given = load
+        self._piece[..., :, self.k.CT] = 1.0
 
     def arm_tuple(self) -> tuple:
         """The kernel's (arm, act) pair, passed on as ``*arm_tuple()``: the pieces, and the
@@ -384,10 +397,16 @@ class _Channels:
                    self.pieces[9], self.pieces[10])
         return arm, (*act, *self._contact_arrays)
 
-    def resolve_contact(self, stiffness: float | None = None, *, dt: float | None = None):
-        """The Contact with its contact distance and penalty stiffness set (``stiffness``,
-        else the load's own, else :meth:`_contact_stiffness`'s estimate), made this
-        channels' contact; returns it (None without contact).
+    def resolve_contact(self, stiffness: np.ndarray | None = None, *,
+                        dt: float | None = None):
+        """The Contact with its contact distance and each case's penalty stiffness set, made
+        this channels' contact (``contact_load``, its stiffness (B,) per flattened case;
+        returned with it in the batch shape, for the result); None without contact.
+
+        The stiffness: ``stiffness`` (B,) (a retry after a penetration), else the load's
+        own, else :meth:`_contact_stiffness`'s estimate per case. It goes to the kernel in
+        the channel CT (the kernel's own k is 1), so that each case's law is its own (batch
+        = loop) and a path from the unloaded arm stiffens the contact with the loads.
 
         ``dt`` (s): for time steps of that length, an estimated k above μ/Δt² (μ the
         lightest linear density) is lowered to it, with δ widened by the same factor (the
@@ -399,21 +418,30 @@ class _Channels:
         if load is None:
             return None
         band = load.band(self.length)
-        k = stiffness or load.stiffness or self._contact_stiffness(band)
+        if load.stiffness is not None and np.ndim(load.stiffness):
+            raise ValueError("Contact.stiffness must be one number for a solve (N/m²), got an "
+                             "array: it varies per case only where the solver raised it")
+        self.contact_given_stiffness = load.stiffness is not None
+        if stiffness is None:
+            stiffness = np.full(self.count, load.stiffness) if load.stiffness is not None \
+                else self._contact_stiffness(band)
         if dt is not None and load.distance is None and load.stiffness is None:
             lightest = float(np.nanmin(self.mu)) if np.any(self.mu > 0.0) else 0.0
-            largest = lightest / dt**2
-            if 0.0 < largest < k:
-                band, k = band * k / largest, largest
-        self.contact_load = load.replace(distance=band, stiffness=k)
+            ratio = float(np.max(stiffness, initial=0.0)) * dt**2 / lightest \
+                if lightest > 0.0 else 0.0
+            if ratio > 1.0:
+                band, stiffness = band * ratio, stiffness / ratio
+        self.piece[:, :, self.k.CT] = stiffness[:, None]
+        self.contact_load = load.replace(distance=band, stiffness=stiffness)
         self._contact_arrays = None
-        return self.contact_load
+        single = stiffness.size == 1 or np.all(stiffness == stiffness[0])
+        return load.replace(distance=band, stiffness=float(stiffness[0]) if single
+                            else stiffness.reshape(self.shape))
 
-    def _contact_stiffness(self, band: float) -> float:
-        """The penalty stiffness k (N/m²) that carries the largest pressure expected within
-        the band (k δ/2, contact.md): the loads' size W (forces, and moments over L/2: the
-        largest of the batch, the actuators' tension times their offset counted as a
-        moment) spread over the width of the arm's shear zone √(EI/GA), where a shearable
+    def _contact_stiffness(self, band: float) -> np.ndarray:
+        """Each case's penalty stiffness k (N/m², (B,)) that carries the largest pressure
+        expected within the band (k δ/2, contact.md): the loads' size W (forces, and
+        moments over L/2, the actuators' tension times their offset counted as a moment) spread over the width of the arm's shear zone √(EI/GA), where a shearable
         rod carries what an unshearable one would carry as a point reaction."""
         k, lengths = self.k, self.lengths
         piece, tip = np.abs(self.piece), np.abs(self.tip_loads)
@@ -429,8 +457,8 @@ class _Channels:
         if self.actuators:
             offsets = self._actuated_arm()[0][1][0][:, 0]  # routes' _RHO column
             moments = moments + (piece[..., k.ACT:].max(-2) * offsets).sum(-1)
-        W = float(np.max(forces + 2.0 * moments / self.length, initial=0.0))
-        return 2.0 * max(W, 1e-12 * self.data.force_scale) / (self.data.shear_zone * band)
+        W = np.maximum(forces + 2.0 * moments / self.length, 1e-12 * self.data.force_scale)
+        return 2.0 * W / (self.data.shear_zone * band)
 
     def _contact_kernel_arrays(self) -> tuple:
         load = self.contact_load
@@ -438,22 +466,10 @@ class _Channels:
         params = np.empty((self.starts.size, 5))
         params[:, 0] = radii
         params[:, 1] = load.distance
-        params[:, 2] = load.stiffness
+        params[:, 2] = 1.0  # (each case's k is in its channel CT)
         params[:, 3] = load.friction
         params[:, 4] = load.slip_velocity
         return load.kernel_rows(), params
-
-    def contact_kl(self) -> float:
-        """The penalty's growth exponent kL (the kernel's _stiffness_size): 0 out of
-        contact."""
-        load = self.contact_load
-        if load is None:
-            return 0.0
-        C = self.data.C
-        shear = float(np.max(C[:, [1, 2], [1, 2]]))
-        bending = float(np.max(C[:, [4, 5], [4, 5]]))
-        k = load.stiffness
-        return self.length * max(math.sqrt(k * shear), (k * bending) ** 0.25)
 
     def tendons(self) -> tuple[np.ndarray, np.ndarray]:
         """The actuator columns that are tendons (in the order given) and their lengths in
@@ -713,6 +729,8 @@ class PreparedSolve:
         self._route = None
         if solver.shooting != "auto":
             self._route = solver.shooting == "multiple"
+        elif channels.contact_load is not None:
+            self._route = True  # (as Solver._stiff)
         elif not (np.any(unit_piece[..., :21]) or np.any(unit_tip[..., :9])):
             self._route = bool(tension_kl(channels.piece, channels.tip_loads, pieces[1],
                                           solver.length, solver._data.soft)[0] >= STIFF_KL)
@@ -1076,9 +1094,10 @@ class Solver:
         "single" none, "auto" those whose estimated kL reaches STIFF_KL (_stiff.py)."""
         if self.shooting != "auto":
             return np.full(channels.count, self.shooting == "multiple")
-        return np.maximum(tension_kl(channels.piece, channels.tip_loads, channels.lengths,
-                                     self.length, self._data.soft),
-                          channels.contact_kl()) >= STIFF_KL
+        if channels.contact_load is not None:  # (contact.md: why contact takes this route)
+            return np.full(channels.count, True)
+        return tension_kl(channels.piece, channels.tip_loads, channels.lengths, self.length,
+                          self._data.soft) >= STIFF_KL
 
     def _threads(self, cases: int) -> int:
         """Threads for a batch of ``cases`` independent cases."""
@@ -1177,12 +1196,12 @@ class Solver:
 
     def _solve(self, loads, *, chained: bool, jacobians: bool, near: bool = False,
                outputs: bool = True, checked: bool = False,
-               contact_retry: tuple[float, int] | None = None) -> Equilibrium | None:
+               contact_retry: tuple[np.ndarray, int] | None = None) -> Equilibrium | None:
         """``near``: a single case whose path starts at its own loads, from the memory
         :meth:`solve_near` wrote (λ = 0 and λ = 1 the same loads); ``outputs=False``: only
         the memory of a chained solve (the tip its one station, no verdict), None;
         ``checked``: ``loads`` is what :meth:`check_loads` returned; ``contact_retry``:
-        (the contact's penalty stiffness, attempt) after a penetration (:func:`_penetration`)."""
+        (each case's penalty stiffness, attempt) after a penetration (:func:`_penetration`)."""
         if not isinstance(jacobians, (bool, np.bool_)):
             raise TypeError(f"jacobians must be True or False, got {jacobians!r}")
         if not checked:
@@ -1222,9 +1241,10 @@ class Solver:
             self.reset()
             last = None
         attempt = 0 if contact_retry is None else contact_retry[1]
-        contact = channels.resolve_contact(None if contact_retry is None else contact_retry[0])
+        contact = channels.resolve_contact(None if contact_retry is None else contact_retry[0]) \
+            if channels.contact_load is not None else None
         if contact is not None:
-            _check_outside(self, contact, loads)
+            _check_outside(self, channels.contact_load.replace(stiffness=None), loads)
             loads = tuple(contact if load.kind == "contact" else load for load in loads)
         # unchained: no first loads, no memory (that code is not even compiled, _kernels)
         first = memory = None
@@ -1295,7 +1315,8 @@ class Solver:
                                       error.residual) or error
             raise error
         if contact is not None:
-            stiffer = _penetration(self, contact, poses, s_kernel, attempt)
+            stiffer = _penetration(self, channels.contact_load, poses, s_kernel, attempt,
+                                   channels.contact_given_stiffness)
             if stiffer is not None:  # raise the penalty until the pressure fits the band
                 if chained:
                     self.reset()

@@ -1,0 +1,312 @@
+"""Contact in statics (issue 33): softarm.Contact against independent references.
+
+- the heavy arm on a frictionless table against the hard-contact free-boundary solution
+  (tests/_table_reference.py: solve_bvp, with the shear zone √(EI/GA));
+- global force and moment balance with the contact forces at every station;
+- no penetration beyond tol·L, forces only within the contact distance;
+- exactly no contact force, and the same answer, where no obstacle is near;
+- batch = loop; exact Jacobians against finite differences of solves;
+- the stability verdict and critical_load with contact: a column whose tip is held between
+  two pins buckles at the clamped-pinned load 20.19 EI/L² (Timoshenko & Gere §2.5), not at
+  the cantilever's π²/4;
+- the obstacles' distance functions against brute-force sampling of their surfaces;
+- bad input.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from _table_reference import table_reference
+
+import softarm as sa
+from softarm.contact import pressure
+
+L = 0.5
+RADIUS = 0.01
+DROP = 0.02  # the clamped centreline above the contact level (m)
+
+
+@pytest.fixture(scope="module")
+def soft_arm():
+    return sa.Arm(L, sa.Circle(RADIUS), sa.Material(youngs_modulus=1e6, poisson_ratio=0.5,
+                                                     density=1000.0))
+
+
+def _table(drop=DROP, **options):
+    return sa.Contact(sa.Plane((0.0, 0.0, -(drop + RADIUS)), (0.0, 0.0, 1.0)), **options)
+
+
+@pytest.fixture(scope="module")
+def lying(soft_arm):
+    """The arm lying on the table, at fine stations (the contact zone is √(EI/GA) = 8.7 mm
+    wide), and the hard-contact reference."""
+    s = np.linspace(0.0, L, 2001)
+    eq = sa.solve(soft_arm, [sa.Gravity(), _table()], s=s)
+    R = soft_arm.rigidities
+    ref = table_reference(L, R.EA, R.GAy, R.EIy, RADIUS, soft_arm.linear_density * 9.81, DROP)
+    return eq, ref
+
+
+def test_table_matches_the_hard_contact_solution(lying):
+    eq, ref = lying
+    error = np.abs(eq.positions - ref.positions(eq.s)).max() / L
+    assert error < 2e-5  # the issue asks 1e-4 L; measured 7.8e-6 L at δ = 1e-5 L
+    # the lift-off: the band (gap below δ = 5 µm) starts where the centreline, curving off
+    # the table quadratically, is within δ of it: a few mm before the reference's s_c
+    touching = eq.s[np.linalg.norm(eq.contact_forces, axis=-1) > 0.0]
+    assert 0.0 < ref.s_c - touching[0] < 5e-3
+
+
+def test_table_pressure_and_total_force_match_the_reference(lying):
+    eq, ref = lying
+    # past the lift-off zone the pressure is the reference's (the weight per length plus
+    # the shear zone's excess, decaying over ℓ = √(EI/GA)), and the weight far on
+    ell = ref.boundary_layer
+    zone = eq.s > ref.s_c + 3 * ell
+    assert eq.contact_forces[zone, 2] == pytest.approx(ref.pressure(eq.s[zone]), rel=1.5e-2)
+    assert eq.contact_forces[-1, 2] == pytest.approx(ref.weight, rel=1e-6)
+    assert np.allclose(eq.contact_forces[:, :2], 0.0)
+    total = eq.contact_wrench
+    assert total[2] == pytest.approx(ref.contact_force[1], rel=2e-3)
+    # moment about y: spatial M_y = z f_x - x f_z = -(planar x f_z - z f_x)
+    assert total[4] == pytest.approx(-ref.contact_moment, rel=2e-3)
+
+
+def test_no_penetration_and_forces_only_within_the_contact_distance(lying):
+    eq, _ = lying
+    contact = eq.loads[1]
+    assert contact.distance == pytest.approx(1e-5 * L)
+    assert eq.gaps.min() >= -1e-8 * L
+    force = np.linalg.norm(eq.contact_forces, axis=-1)
+    assert np.all(force[eq.gaps >= contact.distance] == 0.0)
+    assert np.all(force[eq.gaps < 0.5 * contact.distance] > 0.0)
+
+
+def test_global_balance_includes_the_contact_forces(lying, soft_arm):
+    eq, _ = lying
+    weight = soft_arm.linear_density * 9.81 * L
+    # the clamp carries what the table does not; the moment balance about the origin with
+    # the weight's moment ∫ p × (0, 0, -w) ds (trapezoidal on the 2001 stations)
+    clamp = np.asarray(eq.base_wrench)  # the load the rod puts on the clamp
+    w = np.array([0.0, 0.0, -soft_arm.linear_density * 9.81])
+    along = np.cross(eq.positions, w)
+    gravity_moment = (0.5 * (along[1:] + along[:-1]) * np.diff(eq.s)[:, None]).sum(0)
+    contact = eq.contact_wrench
+    # (to the trapezoidal rule's error on the 0.25 mm stations: about 1e-5 of the weight)
+    assert clamp[:3] == pytest.approx(np.array([0.0, 0.0, -weight]) + contact[:3],
+                                      abs=2e-5 * weight)
+    assert clamp[3:] == pytest.approx(gravity_moment + contact[3:], abs=2e-5 * weight * L)
+
+
+def test_contact_converges_to_the_hard_limit_as_the_distance_shrinks(soft_arm, lying):
+    _, ref = lying
+    s = np.linspace(0.0, L, 401)
+    errors = []
+    for distance in (1e-3 * L, 1e-4 * L):
+        eq = sa.solve(soft_arm, [sa.Gravity(), _table(distance=distance)], s=s)
+        errors.append(np.abs(eq.positions - ref.positions(s)).max() / L)
+    # the shape lies about one band width off the hard solution: first order in δ
+    assert errors[0] == pytest.approx(1e-3, rel=0.5)
+    assert errors[1] == pytest.approx(1e-4, rel=0.5)
+
+
+def test_far_obstacles_change_nothing(soft_arm):
+    s = np.linspace(0.0, L, 51)
+    far = sa.Contact([sa.Plane((0.0, 0.0, -2.0), (0.0, 0.0, 1.0)),
+                      sa.Sphere((0.0, 3.0, 0.0), 0.5)])
+    loads = [sa.Gravity(), sa.TipLoad(force=(0.0, 0.02, 0.0))]
+    free = sa.solve(soft_arm, loads, s=s, method="numeric", tol=1e-11)
+    near = sa.solve(soft_arm, [*loads, far], s=s, tol=1e-11)
+    assert np.abs(near.positions - free.positions).max() < 1e-9 * L
+    assert np.all(near.contact_forces == 0.0)
+    assert np.all(near.contact_wrench == 0.0)
+    assert near.gaps.min() > 1.0
+
+
+def test_batch_equals_loop(soft_arm):
+    s = np.linspace(0.0, L, 21)
+    forces = np.array([[0.0, 0.0, -0.01], [0.0, 0.0, 0.0], [0.0, 0.01, -0.02]])
+    contact = _table(distance=1e-4 * L)
+    batch = sa.solve(soft_arm, [sa.Gravity(), sa.TipLoad(force=forces), contact], s=s)
+    for b, force in enumerate(forces):
+        one = sa.solve(soft_arm, [sa.Gravity(), sa.TipLoad(force=force), contact], s=s)
+        assert np.array_equal(batch.positions[b], one.positions)
+        assert np.array_equal(batch.contact_forces[b], one.contact_forces)
+
+
+def test_tip_compliance_matches_finite_differences(soft_arm):
+    # the tip pressed on a table: the contact stiffens the tip (an exact Jacobian through
+    # the penalty's ∂f/∂p) and the finite difference of solves agrees (on a small ball the
+    # pressed tip would slide off: unstable, which the verdict says)
+    ball = sa.Contact(sa.Plane((0.0, 0.0, -0.03 - RADIUS), (0.0, 0.2, 1.0)),
+                      distance=1e-4 * L, stiffness=1e8)
+    force = np.array([0.0, 0.0, -0.05])
+    loads = [sa.TipLoad(force=force), ball]
+    eq = sa.solve(soft_arm, loads, jacobians=True, tol=1e-11)
+    assert np.linalg.norm(eq.contact_wrench[:3]) > 0.01  # it does press on the ball
+    h = 1e-5
+    columns = []
+    for k in range(3):
+        dF = np.zeros(3)
+        dF[k] = h
+        plus = sa.solve(soft_arm, [sa.TipLoad(force=force + dF), ball], tol=1e-11)
+        minus = sa.solve(soft_arm, [sa.TipLoad(force=force - dF), ball], tol=1e-11)
+        columns.append((plus.tip_position - minus.tip_position) / (2 * h))
+    fd = np.array(columns).T
+    assert eq.tip_compliance[:3, :3] == pytest.approx(fd, rel=1e-4, abs=1e-6)
+    free = sa.solve(soft_arm, [sa.TipLoad(force=force)], jacobians=True, method="numeric")
+    assert eq.tip_compliance[2, 2] < 0.5 * free.tip_compliance[2, 2]
+
+
+@pytest.fixture(scope="module")
+def pinned_column():
+    """A column (EIz = 1, in-plane bending; 100× stiffer out of plane) whose tip is held
+    laterally between two pins: clamped at the base, laterally supported at the tip."""
+    arm = sa.Arm.from_stiffness(1.0, EA=1e7, GAy=1e7, GAz=1e7, GJ=1.0, EIy=100.0, EIz=1.0)
+    r, R = 0.01, 0.02
+    pins = [sa.Capsule((1.0, side * (r + R), -1.0), (1.0, side * (r + R), 1.0), R)
+            for side in (1.0, -1.0)]
+    return arm, sa.Contact(pins, radius=r)
+
+
+def test_column_held_between_pins_buckles_at_the_clamped_pinned_load(pinned_column):
+    arm, pins = pinned_column
+    push = sa.TipLoad(force=(-1.0, 0.0, 0.0))
+    point = sa.critical_load(arm, [push, pins], vary=[push], max_factor=40.0, tol=1e-5)
+    # λ_c = β² EI/L² with tan β = β (β = 4.4934): 20.19, against 2.467 without the pins
+    beta = 4.493409457909064
+    assert point.factor == pytest.approx(beta**2, rel=1e-3)
+    assert point.kind == "bifurcation"
+    free = sa.critical_load(arm, [push], max_factor=40.0)
+    assert free.factor == pytest.approx(math.pi**2 / 4, rel=1e-4)
+
+
+def test_stability_verdict_includes_the_contact(pinned_column):
+    arm, pins = pinned_column
+    below = sa.solve(arm, [sa.TipLoad(force=(-19.5, 0.0, 0.0)), pins])
+    assert below.stability.index == 0
+    with pytest.warns(sa.StabilityWarning):
+        above = sa.solve(arm, [sa.TipLoad(force=(-21.0, 0.0, 0.0)), pins])
+    assert above.stability.index == 1
+    with pytest.warns(sa.StabilityWarning):  # without the pins it buckled long before
+        free = sa.solve(arm, [sa.TipLoad(force=(-19.5, 0.0, 0.0))], method="numeric")
+    assert free.stability.index >= 1
+
+
+def _brute_force_distance(obstacle, point, samples=400_000, seed=1):
+    """The distance from ``point`` to the obstacle's surface by sampling it densely."""
+    rng = np.random.default_rng(seed)
+    if isinstance(obstacle, sa.Sphere):
+        d = rng.normal(size=(samples, 3))
+        surface = obstacle.center + obstacle.radius * d / np.linalg.norm(d, axis=1)[:, None]
+    else:  # a capsule: the cylinder and the two end spheres
+        axis = obstacle.b - obstacle.a
+        e = axis / np.linalg.norm(axis)
+        u = np.cross(e, [1.0, 0.0, 0.0] if abs(e[0]) < 0.9 else [0.0, 1.0, 0.0])
+        u /= np.linalg.norm(u)
+        v = np.cross(e, u)
+        t = rng.uniform(0.0, 1.0, samples)
+        phi = rng.uniform(0.0, 2 * np.pi, samples)
+        ring = np.cos(phi)[:, None] * u + np.sin(phi)[:, None] * v
+        side = obstacle.a + t[:, None] * axis + obstacle.radius * ring
+        d = rng.normal(size=(samples, 3))
+        d /= np.linalg.norm(d, axis=1)[:, None]
+        ends = np.concatenate([obstacle.a + obstacle.radius * d[: samples // 2],
+                               obstacle.b + obstacle.radius * d[samples // 2:]])
+        surface = np.concatenate([side, ends])
+        inside_end = np.minimum(np.linalg.norm(surface - obstacle.a, axis=1),
+                                np.linalg.norm(surface - obstacle.b, axis=1))
+        t_all = np.clip((surface - obstacle.a) @ axis / (axis @ axis), 0, 1)
+        to_axis = np.linalg.norm(surface - (obstacle.a + t_all[:, None] * axis), axis=1)
+        surface = surface[(to_axis >= obstacle.radius - 1e-12) | (inside_end >= 0)]
+    return np.linalg.norm(surface - point, axis=1).min()
+
+
+@pytest.mark.parametrize("obstacle", [
+    sa.Sphere((0.1, -0.2, 0.3), 0.15),
+    sa.Capsule((0.0, 0.0, 0.0), (0.3, 0.1, -0.2), 0.05),
+])
+def test_distances_match_sampled_surfaces(obstacle):
+    points = np.array([[0.5, 0.1, 0.0], [-0.2, 0.0, 0.1], [0.15, 0.3, -0.4]])
+    d, n = obstacle.distance(points)
+    for point, distance, normal in zip(points, d, n, strict=True):
+        assert distance == pytest.approx(_brute_force_distance(obstacle, point), abs=2e-3)
+        # the normal: the direction in which the distance grows (finite difference)
+        h = 1e-6
+        grad = [(obstacle.distance(point + h * e)[0] - obstacle.distance(point - h * e)[0])
+                / (2 * h) for e in np.eye(3)]
+        assert normal == pytest.approx(np.array(grad), abs=1e-6)
+
+
+def test_plane_distance_and_the_law():
+    plane = sa.Plane((0.0, 0.0, 1.0), (0.0, 0.0, 2.0))  # normal normalised
+    d, n = plane.distance([[3.0, 4.0, 1.5], [0.0, 0.0, 0.0]])
+    assert d == pytest.approx([0.5, -1.0])
+    assert n == pytest.approx(np.array([[0, 0, 1.0]] * 2))
+    # the law: zero at and beyond δ, k δ / 2 at contact, slope -k inside, C¹ at both joins
+    delta, k = 1e-3, 1e6
+    assert pressure(delta, delta, k) == 0.0
+    assert pressure(0.0, delta, k) == pytest.approx(k * delta / 2)
+    assert pressure(-1e-3, delta, k) == pytest.approx(k * (delta / 2 + 1e-3))
+    h = 1e-9
+    for g in (0.0, delta):
+        left = (pressure(g, delta, k) - pressure(g - h, delta, k)) / h
+        right = (pressure(g + h, delta, k) - pressure(g, delta, k)) / h
+        assert left == pytest.approx(right, rel=1e-4, abs=1e-3 * k)
+
+
+@pytest.mark.parametrize(("make", "message"), [
+    (lambda: sa.Plane((0, 0, 0), (0, 0, 0)), "Plane.normal must be a non-zero vector"),
+    (lambda: sa.Plane((0, np.nan, 0), (0, 0, 1)), "Plane.point must be finite"),
+    (lambda: sa.Sphere((0, 0, 0), -0.1), "Sphere.radius must be a positive finite radius"),
+    (lambda: sa.Capsule((0, 0, 0), (0, 0, 0), 0.1), "Capsule.a and Capsule.b must be distinct"),
+    (lambda: sa.Capsule((0, 0, 0), (1, 0, 0), math.inf), "Capsule.radius must be a finite"),
+    (lambda: sa.Contact([]), "obstacles must name at least one obstacle"),
+    (lambda: sa.Contact(sa.Plane((0, 0, 0), (0, 0, 1)), friction=-0.1),
+     "Contact.friction must be a finite number >= 0"),
+    (lambda: sa.Contact(sa.Plane((0, 0, 0), (0, 0, 1)), distance=0.0),
+     "Contact.distance must be a positive finite number"),
+])
+def test_bad_obstacles_are_refused(make, message):
+    with pytest.raises(ValueError, match=message):
+        make()
+
+
+def test_a_non_obstacle_is_a_type_error():
+    with pytest.raises(TypeError, match=r"obstacles\[1\] must be a softarm.Plane"):
+        sa.Contact([sa.Plane((0, 0, 0), (0, 0, 1)), (0, 0, 1)])
+
+
+def test_an_arm_starting_inside_an_obstacle_is_refused(soft_arm):
+    inside = sa.Contact(sa.Sphere((0.3, 0.0, 0.0), 0.05))
+    with pytest.raises(ValueError, match=r"starts inside an obstacle .* s = 0\.2"):
+        sa.solve(soft_arm, [sa.Gravity(), inside])
+
+
+def test_an_arm_without_a_section_needs_a_radius():
+    arm = sa.Arm.from_stiffness(1.0, EA=1e4, GAy=1e4, GAz=1e4, GJ=1.0, EIy=1.0, EIz=1.0)
+    with pytest.raises(ValueError, match="Contact.radius is required"):
+        sa.solve(arm, [sa.TipLoad(force=(0, 0, -1.0)), _table()])
+
+
+def test_one_contact_per_solve(soft_arm):
+    with pytest.raises(ValueError, match="loads may hold one Contact"):
+        sa.solve(soft_arm, [sa.Gravity(), _table(), _table(drop=0.1)])
+
+
+def test_friction_in_statics_returns_the_frictionless_equilibrium(soft_arm):
+    s = np.linspace(0.0, L, 21)
+    options = {"distance": 1e-4 * L}
+    smooth = sa.solve(soft_arm, [sa.Gravity(), _table(**options)], s=s)
+    rough = sa.solve(soft_arm, [sa.Gravity(), _table(friction=0.5, **options)], s=s)
+    assert np.array_equal(smooth.positions, rough.positions)
+    assert "μ = 0.5" in rough.loads[1].describe()
+
+
+def test_a_given_stiffness_that_lets_the_arm_penetrate_is_an_error(soft_arm):
+    soft = _table(distance=1e-4 * L, stiffness=1e5)  # k δ/2 = 2.5 N/m < the weight, 3.1 N/m
+    with pytest.raises(sa.ConvergenceError, match=r"penetrates an obstacle by [1-9]\.\d+e-05 m .* Contact\(stiffness=1e\+05\)"):
+        sa.solve(soft_arm, [sa.Gravity(), soft])
