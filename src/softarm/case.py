@@ -590,7 +590,7 @@ def solve_case(case: Case, *, method: str | None = None, stations: int | None = 
     if options.branch == "stable":
         parts = []
         for k in range(len(case.sweep.values)):
-            parts.append(_batched(solve(case.arm, _take(loads, k, k + 1), **kwargs)))
+            parts.append(_batched(solve(case.arm, _step(loads, k), **kwargs)))
             if progress is not None:
                 progress(k + 1, len(case.sweep.values))
         return _concatenate(parts, loads)
@@ -626,6 +626,11 @@ def _batched(eq: Equilibrium) -> Equilibrium:
                    tip_compliance=None, compliance=None, base_wrench=None,
                    tendon_tensions=None, tendon_lengths=None, tendon_length_changes=None,
                    tendon_slack=None)
+
+
+def _step(loads: tuple, k: int) -> tuple:
+    """Case k of the batched loads, unbatched (branch='stable' takes one case)."""
+    return tuple(load.take(k) if load.batch_shape else load for load in loads)
 
 
 def _take(loads: tuple, start: int, stop: int) -> tuple:
