@@ -122,6 +122,18 @@ name = "payload"
     assert case.sweep.label == "payload (N)" and case.sweep.column == "payload_N"
 
 
+def test_a_sweep_on_the_stable_branch_solves_each_step(tmp_path):
+    """branch = "stable" solves a sweep one step at a time (each step unbatched: it once
+    failed with 'takes a single load case, got batch shape (1,)'): the paper's Fig. 2
+    circles, tip (sin τ/τ, 0, -(1 - cos τ)/τ) for τ = 1 ... 5 N m on EI = 1 N m² (eq. 38)."""
+    case = load_case(write(tmp_path, (EXAMPLES / "fig2_sweep.toml").read_text()
+                           + '\n[solve]\nbranch = "stable"\n'))
+    result = softarm.case.solve_case(case)
+    tau = np.asarray(case.sweep.values)
+    np.testing.assert_allclose(result.tip_position[:, 0], np.sin(tau) / tau, atol=1e-6)
+    np.testing.assert_allclose(result.tip_position[:, 2], -(1 - np.cos(tau)) / tau, atol=1e-6)
+
+
 BAD_CASES = {
     "misspelled key": (f"[arm]\nlenght = 1.0\n{STIFF}\n", "arm.lenght", "did you mean 'length'"),
     "unknown top-level table": (f"[arm]\nlength = 1.0\n{STIFF}\n[solver]\nmethod = 'auto'\n",

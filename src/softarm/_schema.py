@@ -10,6 +10,8 @@ rows the load classes declare in ``Load.schema``), and each description serves b
 - :data:`SECTIONS`: one schema per section ``kind`` (``circle``, ``tube``, ``rectangle``,
   ``general``);
 - each load class's ``schema`` (:data:`softarm.loads.LOAD_KINDS`);
+- :data:`OBSTACLES` and :data:`CONTACT`: the ``[[obstacle]]`` tables by ``kind`` and the
+  ``[contact]`` table, which together make one :class:`softarm.Contact` load;
 - :data:`SOLVE` and :data:`SWEEP`: the ``[solve]`` and ``[sweep]`` tables.
 
 The reader checks only what a TOML value is (its type and shape: a string is not a number);
@@ -32,6 +34,7 @@ import numpy as np
 
 from ._sweep_table import COMPONENTS, Sweep
 from ._validate import as_array, format_value
+from .contact import OBSTACLE_KINDS, Contact
 from .errors import CaseError, CaseTypeError
 from .loads import Key, as_loads
 from .model import (
@@ -49,8 +52,10 @@ from .routing import ROUTINGS
 
 __all__ = [
     "ARM",
+    "CONTACT",
     "DESIGN",
     "MATERIAL",
+    "OBSTACLES",
     "ROUTING",
     "SECTIONS",
     "SIMULATE",
@@ -61,6 +66,7 @@ __all__ = [
     "Schema",
     "Table",
     "arm_to_dict",
+    "contact_to_dict",
     "loads_to_dict",
     "solve_to_dict",
     "sweep_to_dict",
@@ -180,6 +186,23 @@ ROUTING: dict[str, Schema] = {
         Field("y", "numbers", "m/m^k"), Field("z", "numbers", "m/m^k"))),
 }
 
+#: One ``[[obstacle]]`` table by its ``kind`` (:data:`softarm.contact.OBSTACLE_KINDS`; each
+#: obstacle's ``to_case`` writes the same keys).
+OBSTACLES: dict[str, Schema] = {
+    "plane": Schema("plane", OBSTACLE_KINDS["plane"], (
+        Key("point", "vector", _LENGTH, required=True),
+        Key("normal", "vector", "(dimensionless, any length)", required=True))),
+    "sphere": Schema("sphere", OBSTACLE_KINDS["sphere"], (
+        Key("center", "vector", _LENGTH, required=True),
+        Key("radius", "number", _LENGTH, required=True))),
+    "capsule": Schema("capsule", OBSTACLE_KINDS["capsule"], (
+        Key("a", "vector", _LENGTH, required=True), Key("b", "vector", _LENGTH, required=True),
+        Key("radius", "number", _LENGTH, required=True))),
+}
+
+#: ``[contact]``: the contact law of the case's obstacles (:class:`softarm.Contact`'s own keys).
+CONTACT = Schema("", Contact, Contact.schema)
+
 #: ``[solve]``: the keys of :class:`softarm.case.SolveOptions` (which checks the values).
 SOLVE = (Field("method", "text", choices=("auto", "numeric")),
          Field("stations", "integer"),
@@ -255,8 +278,29 @@ def arm_to_dict(arm: Arm | SegmentedArm) -> dict:
 
 
 def loads_to_dict(loads) -> list[dict]:
-    """The ``[[load]]`` tables describing ``loads`` (batched vectors become nested lists)."""
-    return [load.to_case() for load in as_loads(loads)]
+    """The ``[[load]]`` tables describing ``loads`` (batched vectors become nested lists); a
+    :class:`softarm.Contact` is not a ``[[load]]`` table but :func:`contact_to_dict`'s."""
+    return [load.to_case() for load in as_loads(loads) if not isinstance(load, Contact)]
+
+
+def contact_to_dict(loads) -> dict:
+    """The ``[[obstacle]]`` tables and the ``[contact]`` table of the :class:`softarm.Contact`
+    among ``loads`` (``{}`` without one): ``{"obstacle": [...], "contact": {...}}``, the
+    contact table only when it holds a value."""
+    contacts = [load for load in as_loads(loads) if isinstance(load, Contact)]
+    if not contacts:
+        return {}
+    if len(contacts) > 1:
+        raise ValueError(f"loads must hold at most one softarm.Contact (it takes every "
+                         f"obstacle), got {len(contacts)}")
+    contact = contacts[0]
+    out = {"obstacle": [obstacle.to_case() for obstacle in contact.obstacles]}
+    law = CONTACT.write(contact)
+    if law.get("friction") == 0.0:
+        del law["friction"]  # the default
+    if law:
+        out["contact"] = law
+    return out
 
 
 def solve_to_dict(options) -> dict:

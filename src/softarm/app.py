@@ -44,7 +44,7 @@ import numpy as np
 from ._validate import format_value
 from .case import Case, CaseError
 from .errors import ConvergenceError
-from .geometry import cube_limits, station_radii
+from .geometry import contacts, cube_limits, station_radii
 from .statics import Solver
 from .view import axis_ticks, figure, plotly_js_path, scene_traces, to_json
 
@@ -272,12 +272,16 @@ def _headings(case: Case, values: dict) -> dict:
 
 def _with_all_loads(result, loads, values):
     """``result`` with its loads in the case's order, so that arrow keys (load index, field)
-    stay the same whichever loads are switched off (switched-off loads as zero vectors)."""
+    stay the same whichever loads are switched off (switched-off loads as zero vectors);
+    a contact as solved (with the contact law the solver chose, which its forces need)."""
     import dataclasses
 
+    solved = contacts(result.loads)
     full = []
     for i, load in enumerate(loads):
         fields = _fields(load, i, values, values[f"l{i + 1}.on"])
+        if load.kind == "contact" and solved:
+            load = solved[0]
         full.append(load.replace(**fields) if fields else load)
     return dataclasses.replace(result, loads=tuple(full))
 

@@ -39,9 +39,10 @@ from ._schema import Schema, Table, arm_to_dict, loads_to_dict
 from ._simulate_table import BaseMotion, Schedule, Simulation
 from ._sweep_table import DESIGNS, Design, Parameter, Sweep
 from ._validate import check_allocation, count, format_value
+from .contact import Contact
 from .dynamics import Damping, Simulator, Trajectory
 from .equilibrium import Equilibrium, Stability
-from .errors import CaseError, CaseTypeError
+from .errors import CaseError, CaseTypeError, ConvergenceError
 from .loads import LOAD_KINDS
 from .model import Arm, SegmentedArm, StiffnessMatrix
 from .statics import Solver
@@ -165,7 +166,9 @@ class Case:
         The case's name (the file's ``name`` key, else the file name without suffix).
     arm : Arm or SegmentedArm
     loads : tuple
-        The loads as written (a sweep is not applied; see :attr:`batched_loads`).
+        The loads as written (a sweep is not applied; see :attr:`batched_loads`): the
+        ``[[load]]`` tables in file order, then one :class:`softarm.Contact` holding the
+        ``[[obstacle]]`` tables if there are any.
     solve : SolveOptions
     sweep : Sweep or None
         A one-parameter ``[sweep]`` (``load``, ``field``, ``component``).
@@ -254,10 +257,40 @@ def _build(table: Table, schema: _schema.Schema):
     return table.build(schema.keys, lambda: schema.cls(**values))
 
 
+#: The kinds of a ``[[load]]`` table: every load but the contact, which the ``[[obstacle]]``
+#: and ``[contact]`` tables give (:func:`_contact`).
+_LOAD_TABLE_KINDS = tuple(kind for kind in LOAD_KINDS if kind != Contact.kind)
+
+
 def _load(table: Table):
     """A ``[[load]]`` table, read by the load class's own schema (:class:`softarm.loads.Key`)."""
-    cls = LOAD_KINDS[table.string("kind", tuple(LOAD_KINDS))]
+    if table.data.get("kind") == Contact.kind:
+        raise table.error("kind", "contact is given by [[obstacle]] tables (kind = \"plane\", "
+                          "\"sphere\" or \"capsule\") and an optional [contact] table, not "
+                          "by a [[load]] (docs/case-files.md)")
+    cls = LOAD_KINDS[table.string("kind", _LOAD_TABLE_KINDS)]
     return _build(table, _schema.Schema(cls.kind, cls, cls.schema))
+
+
+def _contact(top: Table, arm) -> Contact | None:
+    """The ``[[obstacle]]`` tables and the ``[contact]`` table as one :class:`Contact`, or
+    None without obstacles. A fault names the obstacle's table (``obstacle[2].radius``) or
+    the contact table's key."""
+    rows = top.tables("obstacle")
+    if not rows:
+        if top.has("contact"):
+            raise top.error("contact", "a [contact] table needs one or more [[obstacle]] "
+                            "tables (kind = \"plane\", \"sphere\" or \"capsule\")")
+        return None
+    obstacles = []
+    for row in rows:
+        schema = _schema.OBSTACLES[row.string("kind", tuple(_schema.OBSTACLES))]
+        obstacles.append(_build(row, schema))
+    table = top.table("contact") if top.has("contact") else Table({}, "contact", top.where)
+    values = _schema.CONTACT.read(table)
+    contact = table.build(_schema.CONTACT.keys, lambda: Contact(tuple(obstacles), **values))
+    table.build(_schema.CONTACT.keys, lambda: contact.check(arm))  # a radius for the arm
+    return contact
 
 
 def _solve_options(table: Table) -> SolveOptions:
@@ -403,7 +436,8 @@ def parse_case(data: dict, source: str | os.PathLike | None = None, *,
     ----------
     data : dict
         Top-level keys ``name``, ``description``, ``arm`` or ``segment``, ``load``,
-        ``solve``, ``sweep`` (see ``docs/case-files.md``).
+        ``obstacle``, ``contact``, ``solve``, ``sweep``, ``inverse``, ``simulate`` (see
+        ``docs/case-files.md``).
     source : path, optional
         The file the dict came from, for messages and :attr:`Case.source`.
     name : str, optional
@@ -465,6 +499,7 @@ def _parse(data, source, *, name=None, batched=False) -> Case:
     loads = tuple(_load(t) for t in tables)
     for table, load in zip(tables, loads, strict=True):
         table.build(load.schema, lambda load=load: load.check(arm))  # the model's own rule
+    contact = _contact(top, arm)
     options = _solve_options(top.table("solve")) if top.has("solve") else SolveOptions()
     sweep = design = None
     if top.has("sweep"):
@@ -477,6 +512,8 @@ def _parse(data, source, *, name=None, batched=False) -> Case:
         if top.has("inverse") else None
     simulation = _simulation(top.table("simulate"), loads) if top.has("simulate") else None
     top.done()
+    if contact is not None:  # after the [[load]] tables, which [sweep] and [simulate] count
+        loads = (*loads, contact)
     clean = dict(data)
     clean.setdefault("name", case_name)
     return Case(case_name, arm, loads, options, sweep,
@@ -587,14 +624,28 @@ def solve_case(case: Case, *, method: str | None = None, stations: int | None = 
     if case.sweep is None:
         return solve(case.arm, case.loads, **kwargs)
     loads = case.batched_loads
+    total = len(case.sweep.values)
     if options.branch == "stable":
         parts = []
-        for k in range(len(case.sweep.values)):
-            parts.append(_batched(solve(case.arm, _take(loads, k, k + 1), **kwargs)))
+        for k in range(total):
+            parts.append(_batched(solve(case.arm, _step(loads, k), **kwargs)))
+            loads = _with_contact(loads, parts[-1].loads)  # its law for the next steps
             if progress is not None:
-                progress(k + 1, len(case.sweep.values))
+                progress(k + 1, total)
+        law = _contact_of(loads)
+        if law is not None:  # a step that raised the penalty: the steps before it again
+            parts = [part if _contact_of(part.loads).stiffness == law.stiffness else
+                     _batched(solve(case.arm, _step(loads, k), **kwargs))
+                     for k, part in enumerate(parts)]
         return _concatenate(parts, loads)
-    total = len(case.sweep.values)
+    if _contact_of(loads) is not None:
+        # One call: the solver chooses one contact law (the penalty stiffness, from the
+        # loads of the whole batch) for every step, as softarm.solve of the batch does;
+        # chunks would each choose their own, and the sweep's answer would depend on them.
+        parts = [solve(case.arm, loads, **kwargs)]
+        if progress is not None:
+            progress(total, total)
+        return _concatenate(parts, loads)
     start = time.perf_counter()
     parts = [solve(case.arm, _take(loads, 0, 1), **kwargs)]
     first = time.perf_counter() - start
@@ -610,6 +661,19 @@ def solve_case(case: Case, *, method: str | None = None, stations: int | None = 
         if progress is not None:
             progress(done, total)
     return _concatenate(parts, loads)
+
+
+def _contact_of(loads) -> Contact | None:
+    return next((load for load in loads if isinstance(load, Contact)), None)
+
+
+def _with_contact(loads: tuple, solved: tuple) -> tuple:
+    """``loads`` with their Contact replaced by the one among ``solved`` (an equilibrium's
+    loads: the Contact with the penalty stiffness the solver used)."""
+    contact = _contact_of(solved)
+    if contact is None:
+        return loads
+    return tuple(contact if isinstance(load, Contact) else load for load in loads)
 
 
 def _batched(eq: Equilibrium) -> Equilibrium:
@@ -628,12 +692,27 @@ def _batched(eq: Equilibrium) -> Equilibrium:
                    tendon_slack=None)
 
 
+def _step(loads: tuple, k: int) -> tuple:
+    """Case k of the batched loads, unbatched (branch='stable' takes one case)."""
+    return tuple(load.take(k) if load.batch_shape else load for load in loads)
+
+
 def _take(loads: tuple, start: int, stop: int) -> tuple:
     """Cases start..stop-1 of the batched loads (unbatched loads as they are)."""
     return tuple(load.take(slice(start, stop)) if load.batch_shape else load for load in loads)
 
 
 def _concatenate(parts: list[Equilibrium], loads: tuple) -> Equilibrium:
+    """The parts of a sweep as one equilibrium with the sweep's ``loads`` (and the contact
+    law the parts were solved with: the same in every part, else a ConvergenceError)."""
+    laws = {_contact_of(part.loads).stiffness for part in parts
+            if _contact_of(part.loads) is not None}
+    if len(laws) > 1:
+        raise ConvergenceError(
+            f"the steps of the sweep were solved with different contact stiffnesses "
+            f"({', '.join(f'{k:.3g}' for k in sorted(laws))} N/m²): give one, "
+            "[contact] stiffness = ...", float("nan"))
+    loads = _with_contact(loads, parts[0].loads)
     if len(parts) == 1:
         return replace(parts[0], loads=loads)
     first = parts[0]

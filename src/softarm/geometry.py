@@ -1,6 +1,7 @@
 """Geometry of a drawn equilibrium, shared by every front end (matplotlib pictures, the HTML
 viewer, the live app): the tube of the arm's real radius, its planar outlines, cube axis limits
-with equal scaling, the tip frame and arrows for the loads.
+with equal scaling, the tip frame, arrows for the loads, and the obstacles of a contact with
+the arrows of its forces.
 
 numpy only: no plotting library is imported here. Positions are in m, in the spatial frame.
 """
@@ -13,8 +14,14 @@ import numpy as np
 
 __all__ = [
     "Arrow",
+    "contact_arrows",
+    "contact_scale",
+    "contacts",
     "cube_limits",
+    "grid_mesh",
     "load_arrows",
+    "obstacle_outline",
+    "obstacle_surface",
     "silhouette",
     "station_radii",
     "sweep_axis",
@@ -237,3 +244,123 @@ def sweep_axis(steps: int, sweep=None, values=None, label=None) -> tuple[np.ndar
     if label is None:
         label = sweep.label if sweep is not None else "step"
     return values, label
+
+
+# --------------------------------------------------------------------------------------------
+# Obstacles and contact forces (softarm.Contact)
+# --------------------------------------------------------------------------------------------
+
+
+def contacts(loads) -> list:
+    """The :class:`softarm.Contact` loads among ``loads`` (found by their kind)."""
+    return [load for load in loads if getattr(load, "kind", "") == "contact"]
+
+
+def _across(direction) -> tuple[np.ndarray, np.ndarray]:
+    """Two unit vectors that make a right-handed orthonormal frame with the unit
+    ``direction`` (3,)."""
+    d = np.asarray(direction, dtype=float)
+    helper = np.eye(3)[int(np.argmin(np.abs(d)))]
+    u = np.cross(d, helper)
+    u /= np.linalg.norm(u)
+    return u, np.cross(d, u)
+
+
+def obstacle_surface(obstacle, centre, half: float, sides: int = 24) -> np.ndarray:
+    """A drawable surface of ``obstacle`` (a :class:`softarm.Plane`, ``Sphere`` or ``Capsule``,
+    m, spatial), shape (3, rows, columns): the x, y and z grids, as :func:`tube_surface`.
+
+    A plane is drawn as the square of side 2 ``half`` on it centred where ``centre`` (3,)
+    projects onto it (the drawn scene's cube: planes are infinite); a sphere as a grid of
+    meridians and parallels; a capsule as its cylinder and end caps, one surface of
+    revolution about its axis."""
+    if obstacle.kind == "plane":
+        n = obstacle.normal
+        u, v = _across(n)
+        middle = centre - ((centre - obstacle.point) @ n) * n
+        t = np.linspace(-half, half, 2)
+        return np.moveaxis(middle + t[:, None, None] * u + t[None, :, None] * v, -1, 0)
+    phi = np.linspace(0.0, 2.0 * np.pi, sides + 1)
+    if obstacle.kind == "sphere":
+        polar = np.linspace(0.0, np.pi, sides // 2 + 1)
+        axis, (u, v) = np.array([0.0, 0.0, 1.0]), (np.eye(3)[0], np.eye(3)[1])
+        along, across = -np.cos(polar), np.sin(polar)
+        base = obstacle.center
+    else:  # a capsule: a profile (along the axis, distance from it) turned about the axis
+        span = obstacle.b - obstacle.a
+        length = float(np.linalg.norm(span))
+        axis = span / length
+        u, v = _across(axis)
+        cap = np.linspace(-0.5 * np.pi, 0.0, sides // 4 + 1)
+        along = np.concatenate([np.sin(cap), length / obstacle.radius + np.sin(-cap[::-1])])
+        across = np.concatenate([np.cos(cap), np.cos(cap[::-1])])
+        base = obstacle.a
+    r = obstacle.radius
+    ring = np.cos(phi)[None, :, None] * u + np.sin(phi)[None, :, None] * v
+    points = base + r * (along[:, None, None] * axis + across[:, None, None] * ring)
+    return np.moveaxis(points, -1, 0)
+
+
+def grid_mesh(surface) -> tuple[np.ndarray, np.ndarray]:
+    """A surface grid (3, rows, columns) as a triangle mesh: vertices (rows·columns, 3) and
+    triangles (2·(rows-1)·(columns-1), 3) of vertex indices."""
+    rows, columns = surface.shape[1:]
+    vertices = np.moveaxis(np.asarray(surface, dtype=float), 0, -1).reshape(-1, 3)
+    a = (np.arange(rows - 1)[:, None] * columns + np.arange(columns - 1)[None, :]).ravel()
+    b, c, d = a + 1, a + columns, a + columns + 1
+    return vertices, np.concatenate([np.stack([a, c, b], -1), np.stack([b, c, d], -1)])
+
+
+def obstacle_outline(obstacle, axes: tuple[int, int], centre, half: float,
+                     sides: int = 48) -> np.ndarray | None:
+    """The outline of ``obstacle`` seen along the third axis in the side view of the
+    spatial ``axes`` (i, j): (k, 2) points, a closed polygon (a sphere's circle, a capsule's
+    stadium), or None where the view shows no edge of it (a plane not seen edge-on, whose
+    projection covers the whole view). A plane seen edge-on is its line across the view's
+    square of side 2 ``half`` about ``centre`` (two points)."""
+    i, j = axes
+    if obstacle.kind == "plane":
+        n = obstacle.normal[[i, j]]
+        if abs(np.linalg.norm(n) - 1.0) > 1e-9:  # the normal has a component along the view
+            return None
+        direction = np.array([-n[1], n[0]])
+        middle = np.asarray(centre, dtype=float)[[i, j]]
+        middle = middle - ((middle - obstacle.point[[i, j]]) @ n) * n
+        return middle + np.array([-half, half])[:, None] * direction
+    phi = np.linspace(0.0, 2.0 * np.pi, sides + 1)
+    circle = np.stack([np.cos(phi), np.sin(phi)], -1) * obstacle.radius
+    if obstacle.kind == "sphere":
+        return obstacle.center[[i, j]] + circle
+    a, b = obstacle.a[[i, j]], obstacle.b[[i, j]]
+    span = b - a
+    if not np.linalg.norm(span) > 0.0:  # seen along its axis: a circle
+        return a + circle
+    direction = span / np.linalg.norm(span)
+    side = np.arctan2(direction[1], direction[0])
+    half_turn = np.linspace(-0.5 * np.pi, 0.5 * np.pi, sides // 2 + 1)
+    ends = [b + obstacle.radius * np.stack([np.cos(side + half_turn),
+                                            np.sin(side + half_turn)], -1),
+            a + obstacle.radius * np.stack([np.cos(side + np.pi + half_turn),
+                                            np.sin(side + np.pi + half_turn)], -1)]
+    return np.concatenate([*ends, ends[0][:1]])
+
+
+def contact_arrows(result) -> Arrow | None:
+    """The contact forces per length (N/m, spatial) of an unbatched equilibrium as arrows at
+    the stations where they are nonzero (``result.contact_forces``), or None without a
+    contact (or without a force: a contact law the solver did not set)."""
+    if not contacts(result.loads):
+        return None
+    forces = np.asarray(result.contact_forces, dtype=float)
+    on = np.linalg.norm(forces, axis=-1) > 0.0
+    positions = np.asarray(result.poses, dtype=float)[:, :3, 3]
+    return Arrow("contact force per length", positions[on], forces[on], "N/m",
+                 key=("contact", "force"))
+
+
+def contact_scale(arrows, length: float) -> float:
+    """m per N/m for contact arrows (:func:`contact_arrows`, one per drawn case): the
+    largest force per length is drawn 0.15 L long (0 without a force)."""
+    largest = max((float(np.max(np.linalg.norm(a.vectors, axis=-1), initial=0.0))
+                   for a in arrows if a is not None), default=0.0)
+    return 0.15 * length / largest if largest > 0 else 0.0

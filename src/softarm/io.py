@@ -22,8 +22,9 @@ import numpy as np
 
 from . import __version__
 from ._files import write_atomic
-from ._schema import arm_to_dict, loads_to_dict
+from ._schema import arm_to_dict, contact_to_dict, loads_to_dict
 from .case import Case, CaseError, _parse
+from .contact import Contact
 from .dynamics import Energy
 from .dynamics._results import Trajectories
 from .equilibrium import Equilibrium, Stability
@@ -83,7 +84,8 @@ def _table(result: Equilibrium) -> np.ndarray:
 def _case_dict(result: Equilibrium, case: Case | None) -> dict:
     if case is not None:
         return case.to_dict()
-    return {"name": "result", **arm_to_dict(result.arm), "load": loads_to_dict(result.loads)}
+    return {"name": "result", **arm_to_dict(result.arm), "load": loads_to_dict(result.loads),
+            **contact_to_dict(result.loads)}
 
 
 def _sweep_values(result: Equilibrium, case: Case | None):
@@ -110,7 +112,33 @@ def _meta(result: Equilibrium, case: Case | None) -> dict:
         "stability": _verdict(result.stability),
         "rotation": _ROTATION_NOTE,
         "case": _case_dict(result, case),
+        "contact": _contact_law(result.loads),
     }
+
+
+def _contact_law(loads) -> dict | None:
+    """The contact law the solver used (``stiffness`` N/m², ``distance`` m) of the
+    :class:`softarm.Contact` among ``loads``, or None: a result read back draws the contact
+    forces of that law (its case may leave them to the solver)."""
+    for load in loads:
+        if isinstance(load, Contact) and load.stiffness is not None:
+            return {"stiffness": load.stiffness, "distance": load.distance}
+    return None
+
+
+def _with_contact_law(loads: tuple, law, path) -> tuple:
+    """``loads`` with the Contact's law set to ``law`` (:func:`_contact_law`'s, read from the
+    file ``path``: CaseError if it is not one)."""
+    if law is None:
+        return loads
+    try:
+        if not (isinstance(law, dict) and set(law) == {"stiffness", "distance"}):
+            raise ValueError(f"must be an object with stiffness and distance, got {law!r}")
+        return tuple(load.replace(**law) if isinstance(load, Contact) else load
+                     for load in loads)
+    except (TypeError, ValueError) as error:
+        raise CaseError(f"{path}: not a softarm result file ('contact' {_brief(error)})"
+                        ) from None
 
 
 def _verdict(stability: Stability | None) -> dict | None:
@@ -321,7 +349,8 @@ def load_saved(path: str | os.PathLike) -> SavedResult:
     result = Equilibrium(
         s=s, poses=poses.reshape(*batch, s.size, 4, 4),
         strains=strains.reshape(*batch, s.size, 6), stresses=stresses.reshape(*batch, s.size, 6),
-        arm=case.arm, loads=case.batched_loads, method=meta["method"], exact=meta["exact"],
+        arm=case.arm, loads=_with_contact_law(case.batched_loads, meta.get("contact"), path),
+        method=meta["method"], exact=meta["exact"],
         residual=residual.reshape(batch) if batch else float(residual),
         error_estimate=estimate.reshape(batch) if batch else float(estimate),
         stability=None if verdict is None else Stability.of(verdict["index"],

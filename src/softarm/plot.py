@@ -7,7 +7,10 @@ display and no GUI backend (it renders with Agg), and no figure is left open beh
 back. Pass ``fig`` to draw into a figure of your own (e.g. ``plt.figure()`` in a notebook).
 
 The arm is drawn as a translucent tube of its real radius (built from the material frames) when
-the cross-section is known, else as its centreline.
+the cross-section is known, else as its centreline. The obstacles of a :class:`softarm.Contact`
+are drawn as grey translucent surfaces (a plane as a square about the drawing, spheres,
+capsules) and, in the side views, as outlines (a plane only where it is seen edge-on); the
+contact forces per length as magenta arrows at the stations where they act.
 """
 
 from __future__ import annotations
@@ -20,7 +23,12 @@ import numpy as np
 from ._files import write_atomic
 from .geometry import (
     actuator_paths,
+    contact_arrows,
+    contact_scale,
+    contacts,
     cube_limits,
+    obstacle_outline,
+    obstacle_surface,
     silhouette,
     station_radii,
     sweep_axis,
@@ -40,6 +48,8 @@ _LINE_COLOR = "tab:blue"
 _PATH_STYLE = {"tendon": dict(color="0.15", linewidth=1.0),
                "chamber": dict(color="tab:blue", linewidth=3.0, alpha=0.6)}
 _PLANES = (("x", 0), ("z", 2)), (("x", 0), ("y", 1))  # side views: x–z and x–y
+_OBSTACLE_COLOR = "0.55"
+_CONTACT_COLOR = "#d6009a"  # magenta: no other drawn thing shares it
 
 
 def _matplotlib():
@@ -185,12 +195,18 @@ def plot_equilibrium(result, *, fig=None, path: str | os.PathLike | None = None,
                          linewidth=0, antialiased=True, shade=True)
         extent = np.concatenate([p, surface.reshape(3, -1).T])
     ax3.plot(*p.T, color=_LINE_COLOR if radii is None else "tab:red", linewidth=1.5)
+    arrows = contact_arrows(result)
+    scale = contact_scale([arrows], float(result.arm.length))
+    if arrows is not None:
+        extent = np.concatenate([extent, arrows.origins + scale * arrows.vectors])
+    extent = _with_obstacles(extent, result.loads)
     routes = actuator_paths(result.loads, poses, result.s)
     for route in routes:
         ax3.plot(*route.points.T, **_PATH_STYLE[route.kind])
     ax3.scatter(*p[-1], color="k", s=12, depthshade=False)
     ax3.scatter([0.0], [0.0], [0.0], color="0.3", marker="s", s=20, depthshade=False)
     _equal_3d(ax3, extent)
+    note = _draw_contact(ax3, side, result.loads, extent, arrows, scale)
     for ax, ((_, i), (_, j)) in zip(side, _PLANES, strict=True):
         if radii is not None:
             outline = silhouette(p[:, [i, j]], radii)
@@ -206,9 +222,64 @@ def plot_equilibrium(result, *, fig=None, path: str | os.PathLike | None = None,
                  _wrapped(f"{name or 'softarm'}: {describe_loads(result.loads)}"), fontsize=11)
     verdict = "" if result.stability is None else f"; {result.stability.describe()}"
     fig.text(0.02, 0.02, f"tip at {_fmt(tip, 'm')}; method {result.method}"
-             f"{'' if result.exact else ' (approximate)'}{verdict}", fontsize=8,
+             f"{'' if result.exact else ' (approximate)'}{verdict}{note}", fontsize=8,
              color="0.1" if "UNSTABLE" in verdict else "0.3")
     return _finish(fig, path)
+
+
+def _with_obstacles(extent: np.ndarray, loads) -> np.ndarray:
+    """``extent`` (k, 3) and the points of the loads' spheres and capsules that lie within
+    the cube of twice the half side about ``extent``'s (the drawing shows the obstacles
+    near the arm, not a whole large one; planes are drawn to fit)."""
+    centre, half = cube_limits(extent, margin=1.0)
+    points = [extent]
+    for contact in contacts(loads):
+        for obstacle in contact.obstacles:
+            if obstacle.kind == "plane":
+                continue
+            surface = obstacle_surface(obstacle, centre, half).reshape(3, -1).T
+            points.append(np.clip(surface, centre - 2.0 * half, centre + 2.0 * half))
+    return np.concatenate(points)
+
+
+def _draw_contact(ax3, side, loads, extent, arrows=None, scale: float = 0.0) -> str:
+    """The obstacles of the loads' Contact and its force arrows (:func:`contact_arrows`,
+    m per N/m ``scale``) in the 3D view and the side views; returns a note on the arrows'
+    scale for the caption ("" without). Every artist has a ``gid``: "obstacle K kind" (K
+    from 1, in the Contact's order) or "contact forces"."""
+    centre, half = cube_limits(extent)
+    for contact in contacts(loads):
+        for k, obstacle in enumerate(contact.obstacles):
+            gid = f"obstacle {k + 1} {obstacle.kind}"
+            surface = obstacle_surface(obstacle, centre, half / 1.1)
+            artist = ax3.plot_surface(*surface, rstride=1, cstride=1, color=_OBSTACLE_COLOR,
+                                      alpha=0.25 if obstacle.kind == "plane" else 0.3,
+                                      linewidth=0, shade=obstacle.kind != "plane")
+            artist.set_gid(gid)
+            for ax, ((_, i), (_, j)) in zip(side, _PLANES, strict=True):
+                outline = obstacle_outline(obstacle, (i, j), centre, half / 1.1)
+                if outline is None:
+                    continue
+                if obstacle.kind == "plane":
+                    line, = ax.plot(*outline.T, color=_OBSTACLE_COLOR, linewidth=2.5)
+                else:
+                    line, = ax.fill(*outline.T, color=_OBSTACLE_COLOR, alpha=0.35,
+                                    linewidth=0.8, edgecolor="0.35")
+                line.set_gid(gid)
+    if arrows is None or not len(arrows.origins):
+        return ""
+    tips = arrows.vectors * scale
+    artist = ax3.quiver(*arrows.origins.T, *tips.T, color=_CONTACT_COLOR, linewidth=1.0,
+                        arrow_length_ratio=0.25)
+    artist.set_gid("contact forces")
+    for ax, ((_, i), (_, j)) in zip(side, _PLANES, strict=True):
+        artist = ax.quiver(arrows.origins[:, i], arrows.origins[:, j], tips[:, i], tips[:, j],
+                           color=_CONTACT_COLOR, angles="xy", scale_units="xy", scale=1.0,
+                           width=0.004, zorder=4)
+        artist.set_gid("contact forces")
+    largest = float(np.max(np.linalg.norm(arrows.vectors, axis=-1)))
+    return (f"; contact force per length (magenta) up to {largest:.3g} N/m, drawn "
+            f"{largest * scale:.3g} m long")
 
 
 def plot_sweep(result, values=None, *, label: str | None = None, fig=None,
@@ -254,7 +325,9 @@ def plot_sweep(result, values=None, *, label: str | None = None, fig=None,
         for ax, ((_, i), (_, j)) in zip(side, _PLANES, strict=True):
             ax.plot(p[k, :, i], p[k, :, j], color=color, linewidth=1.2)
     ax3.scatter([0.0], [0.0], [0.0], color="0.3", marker="s", s=20, depthshade=False)
-    _equal_3d(ax3, p)
+    extent = _with_obstacles(p.reshape(-1, 3), result.loads)
+    _equal_3d(ax3, extent)
+    _draw_contact(ax3, side, result.loads, extent)  # the obstacles (the forces per step: view)
     _side_axes(side)
     mappable = matplotlib.cm.ScalarMappable(norm=norm, cmap=colormap)
     bar = fig.colorbar(mappable, ax=[ax3, *side], fraction=0.03, pad=0.02, aspect=30)

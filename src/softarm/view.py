@@ -19,7 +19,9 @@ Drawn: the arm as a tube of its real radius (its centreline when the sections ar
 the arm and its centreline with hover read-outs (s, position, strains and stresses in the
 material frame), the tip's material frame (e1 red, e2 green, e3 blue: no other legend entry
 shares their colours), arrows for the loads (forces solid, moments dashed; each load's arrows
-are scaled to its own largest value, the hover gives the value) and the clamped base. A sweep
+are scaled to its own largest value, the hover gives the value), the clamped base, and the
+obstacles of a :class:`softarm.Contact` (grey translucent meshes: a plane as a square about the
+drawing) with the contact forces per length (magenta arrows where they act). A sweep
 gets a slider over its parameter, a play button and a plot of the tip coordinates against
 the parameter.
 """
@@ -37,8 +39,13 @@ import numpy as np
 from ._files import write_atomic
 from .geometry import (
     actuator_paths,
+    contact_arrows,
+    contact_scale,
+    contacts,
     cube_limits,
+    grid_mesh,
     load_arrows,
+    obstacle_surface,
     station_radii,
     sweep_axis,
     tip_frame,
@@ -65,6 +72,10 @@ _FORCE = "rgb(100,100,100)"
 _MOMENT = "rgb(148,103,189)"
 _TENDON = "rgb(30,30,30)"
 _CHAMBER = "rgb(23,190,207)"
+_OBSTACLE = "rgb(160,160,175)"
+_CONTACT = "rgb(214,0,154)"
+#: The key of the contact forces' arrow scale (m per N/m) in a figure's ``scales``.
+CONTACT_KEY = ("contact", "force")
 # The tube's mesh: software WebGL (headless or GPU-less browsers) spends its time per vertex,
 # so the tube has at most about _RINGS rings of _SIDES vertices whatever the number of
 # stations (1616 vertices at 101 stations before; the look is the same, see tube_rings).
@@ -141,6 +152,50 @@ def _arrow_traces(arrows, scales, length: float) -> list[dict]:
     return traces
 
 
+def _contact_traces(arrow, scales, length: float) -> list[dict]:
+    """The contact forces per length (:func:`softarm.geometry.contact_arrows`) as magenta
+    shafts and cones, scaled by ``scales[CONTACT_KEY]`` (m per N/m; absent: this
+    equilibrium's own, :func:`softarm.geometry.contact_scale`). Two traces, empty where no
+    force acts, so that a sweep's frames and the app's updates keep their number."""
+    scale = scales.get(CONTACT_KEY) or contact_scale([arrow], length)
+    origins, vectors = arrow.origins, arrow.vectors
+    ends = origins + scale * vectors
+    xs = [np.stack([origins[:, k], ends[:, k], np.full(len(origins), np.nan)], -1).ravel()
+          for k in range(3)]
+    norms = np.linalg.norm(vectors, axis=-1)
+    text = [f"contact force per length<br>{_vec(v)} N/m (|f| = {n:.3g} N/m)"
+            for v, n in zip(vectors, norms, strict=True)]
+    heads = vectors / np.where(norms > 0, norms, 1.0)[:, None] * 0.03 * length
+    return [{"type": "scatter3d", "mode": "lines", "x": xs[0], "y": xs[1], "z": xs[2],
+             "text": [t for t in text for _ in range(3)],
+             "hovertemplate": "%{text}<extra></extra>",
+             "line": {"color": _CONTACT, "width": 4}, "name": "contact forces",
+             "legendgroup": "contact forces", "showlegend": True},
+            {"type": "cone", "x": ends[:, 0], "y": ends[:, 1], "z": ends[:, 2],
+             "u": heads[:, 0], "v": heads[:, 1], "w": heads[:, 2], "anchor": "tip",
+             "sizemode": "raw", "sizeref": 1.0, "colorscale": [[0, _CONTACT], [1, _CONTACT]],
+             "showscale": False, "hoverinfo": "skip", "legendgroup": "contact forces",
+             "name": "contact forces"}]
+
+
+def _obstacle_traces(loads, centre, half: float) -> list[dict]:
+    """The obstacles of the loads' Contact as grey translucent meshes (a plane: the square
+    of the axis cube's side about ``centre``), one trace each, named "obstacle K: kind"."""
+    traces = []
+    for contact in contacts(loads):
+        for k, obstacle in enumerate(contact.obstacles):
+            vertices, triangles = grid_mesh(obstacle_surface(obstacle, centre, half / 1.1))
+            traces.append({"type": "mesh3d", "x": vertices[:, 0], "y": vertices[:, 1],
+                           "z": vertices[:, 2], "i": triangles[:, 0], "j": triangles[:, 1],
+                           "k": triangles[:, 2], "color": _OBSTACLE,
+                           "opacity": 0.35 if obstacle.kind == "plane" else 0.5,
+                           "flatshading": False, "name": f"obstacle {k + 1}: {obstacle.kind}",
+                           "legendgroup": "obstacles", "showlegend": True,
+                           "hovertemplate": f"obstacle {k + 1}: {obstacle.kind}"
+                                            "<extra></extra>"})
+    return traces
+
+
 def _arrow_scales(arrows_per_frame, length: float) -> dict[str, float]:
     """m per load unit for each load: its largest arrow over all frames is 0.25 L long (tip
     and point loads) or 0.12 L (distributed loads and gravity, drawn as several arrows)."""
@@ -200,6 +255,8 @@ def _scene_traces(result, arrows, scales, rings) -> list[dict]:
                        "legendgroup": "tip frame", "legendgrouptitle": {"text": "tip frame"},
                        "showlegend": True, "hovertemplate": f"tip frame {axis}<extra></extra>"})
     traces += _arrow_traces(arrows, scales, length)
+    if contacts(result.loads):
+        traces += _contact_traces(contact_arrows(result), scales, length)
     traces.append({"type": "scatter3d", "mode": "markers", "x": p[:1, 0], "y": p[:1, 1],
                    "z": p[:1, 2],
                    "marker": {"symbol": "square", "size": 5, "color": "rgb(80,80,80)"},
@@ -226,6 +283,21 @@ def _extent(result, radii, arrows, scales) -> np.ndarray:
     for frame_arrows in arrows:
         for arrow in frame_arrows:
             points.append(arrow.origins + arrow.vectors * scales.get(arrow.key, 0.0))
+    return _with_obstacles(np.concatenate(points), result.loads)
+
+
+def _with_obstacles(extent, loads) -> np.ndarray:
+    """``extent`` (k, 3) and the points of the spheres and capsules of the loads' Contact
+    within the cube of twice the half side about it (a large obstacle is shown near the
+    arm; planes are drawn to fit the cube)."""
+    centre, half = cube_limits(extent, margin=1.0)
+    points = [extent]
+    for contact in contacts(loads):
+        for obstacle in contact.obstacles:
+            if obstacle.kind != "plane":
+                surface = obstacle_surface(obstacle, centre, half, sides=12)
+                points.append(np.clip(surface.reshape(3, -1).T, centre - 2.0 * half,
+                                      centre + 2.0 * half))
     return np.concatenate(points)
 
 
@@ -277,8 +349,14 @@ def figure(result, *, name: str | None = None, values=None, label: str | None = 
     length = float(result.arm.length)
     radii = station_radii(result.arm, result.s)
     arrows = [load_arrows(case.loads, case.poses, case.s, case.arm) for case in cases]
-    scales = _arrow_scales(arrows, length) if scales is None else scales
-    centre, half = cube_limits(_extent(result, radii, arrows, scales)) if limits is None \
+    scales = _arrow_scales(arrows, length) if scales is None else dict(scales)
+    drawn = arrows
+    if contacts(result.loads):
+        forces = [contact_arrows(case) for case in cases]
+        if CONTACT_KEY not in scales:  # one scale for every frame
+            scales[CONTACT_KEY] = contact_scale(forces, length)
+        drawn = [[*frame, force] for frame, force in zip(arrows, forces, strict=True)]
+    centre, half = cube_limits(_extent(result, radii, drawn, scales)) if limits is None \
         else limits
     scene = _cube_scene(centre, half, 0.66 if batch else 1.0)
     head = name or "softarm"
@@ -297,6 +375,8 @@ def figure(result, *, name: str | None = None, values=None, label: str | None = 
 
     layout["title"] = {"text": caption(cases[0]), "x": 0.02, "font": {"size": 14}}
     fig = {"data": data, "layout": layout}
+    n_scene = len(data)  # the traces that change with the equilibrium; the obstacles stay
+    data += _obstacle_traces(result.loads, centre, half)
     if not batch:
         data.append(_cube_anchor(centre, half))
         return fig
@@ -304,7 +384,6 @@ def figure(result, *, name: str | None = None, values=None, label: str | None = 
     steps = batch[0]
     values, label = sweep_axis(steps, sweep, values, label)
     tips = np.asarray(result.tip_position)
-    n_scene = len(data)
     data.append(_cube_anchor(centre, half))
     # The tip against the parameter is a figure of its own (fig["tips"]), drawn in a second
     # <div> laid over the right-hand part of the 3D figure's (where its own axes used to be):
