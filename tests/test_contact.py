@@ -288,7 +288,7 @@ def test_an_arm_starting_inside_an_obstacle_is_refused(soft_arm):
 
 def test_an_arm_without_a_section_needs_a_radius():
     arm = sa.Arm.from_stiffness(1.0, EA=1e4, GAy=1e4, GAz=1e4, GJ=1.0, EIy=1.0, EIz=1.0)
-    with pytest.raises(ValueError, match="Contact.radius is required"):
+    with pytest.raises(ValueError, match=r"Contact\.radius is required"):
         sa.solve(arm, [sa.TipLoad(force=(0, 0, -1.0)), _table()])
 
 
@@ -308,5 +308,6 @@ def test_friction_in_statics_returns_the_frictionless_equilibrium(soft_arm):
 
 def test_a_given_stiffness_that_lets_the_arm_penetrate_is_an_error(soft_arm):
     soft = _table(distance=1e-4 * L, stiffness=1e5)  # k δ/2 = 2.5 N/m < the weight, 3.1 N/m
-    with pytest.raises(sa.ConvergenceError, match=r"penetrates an obstacle by [1-9]\.\d+e-05 m .* Contact\(stiffness=1e\+05\)"):
+    with pytest.raises(sa.ConvergenceError,
+                       match=r"penetrates an obstacle by [1-9]\.\d+e-05 m .* stiffness=1e\+05"):
         sa.solve(soft_arm, [sa.Gravity(), soft])

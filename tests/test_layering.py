@@ -101,6 +101,7 @@ LAYERS = (
     ("model",),
     ("routing",),
     ("loads",),
+    ("contact",),
     ("geometry", "view"),  # pictures from arrays: numpy (plotly when a page is written)
     ("equilibrium", "_admissible"),  # the result type both routes build, and the model's
     # limits both routes check it against

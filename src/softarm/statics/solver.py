@@ -441,8 +441,9 @@ class _Channels:
     def _contact_stiffness(self, band: float) -> np.ndarray:
         """Each case's penalty stiffness k (N/m², (B,)) that carries the largest pressure
         expected within the band (k δ/2, contact.md): the loads' size W (forces, and
-        moments over L/2, the actuators' tension times their offset counted as a moment) spread over the width of the arm's shear zone √(EI/GA), where a shearable
-        rod carries what an unshearable one would carry as a point reaction."""
+        moments over L/2, the actuators' tension times their offset counted as a moment)
+        spread over the width of the arm's shear zone √(EI/GA), where a shearable rod
+        carries what an unshearable one would carry as a point reaction."""
         k, lengths = self.k, self.lengths
         piece, tip = np.abs(self.piece), np.abs(self.tip_loads)
         forces = ((piece[..., k.FD:k.FD + 6].sum(-1) @ lengths)
