@@ -294,10 +294,13 @@ def contact_to_dict(loads) -> dict:
         raise ValueError(f"loads must hold at most one softarm.Contact (it takes every "
                          f"obstacle), got {len(contacts)}")
     contact = contacts[0]
+    if np.ndim(contact.stiffness):  # the solver's per case: solved again, it chooses them
+        contact = contact.replace(stiffness=None)
     out = {"obstacle": [obstacle.to_case() for obstacle in contact.obstacles]}
     law = CONTACT.write(contact)
-    if law.get("friction") == 0.0:
-        del law["friction"]  # the default
+    for key, default in (("friction", 0.0), ("slip_velocity", Contact.slip_velocity)):
+        if law.get(key) == default:
+            del law[key]  # the default
     if law:
         out["contact"] = law
     return out

@@ -42,7 +42,7 @@ from ._validate import check_allocation, count, format_value
 from .contact import Contact
 from .dynamics import Damping, Simulator, Trajectory
 from .equilibrium import Equilibrium, Stability
-from .errors import CaseError, CaseTypeError, ConvergenceError
+from .errors import CaseError, CaseTypeError
 from .loads import LOAD_KINDS
 from .model import Arm, SegmentedArm, StiffnessMatrix
 from .statics import Solver
@@ -629,22 +629,8 @@ def solve_case(case: Case, *, method: str | None = None, stations: int | None = 
         parts = []
         for k in range(total):
             parts.append(_batched(solve(case.arm, _step(loads, k), **kwargs)))
-            loads = _with_contact(loads, parts[-1].loads)  # its law for the next steps
             if progress is not None:
                 progress(k + 1, total)
-        law = _contact_of(loads)
-        if law is not None:  # a step that raised the penalty: the steps before it again
-            parts = [part if _contact_of(part.loads).stiffness == law.stiffness else
-                     _batched(solve(case.arm, _step(loads, k), **kwargs))
-                     for k, part in enumerate(parts)]
-        return _concatenate(parts, loads)
-    if _contact_of(loads) is not None:
-        # One call: the solver chooses one contact law (the penalty stiffness, from the
-        # loads of the whole batch) for every step, as softarm.solve of the batch does;
-        # chunks would each choose their own, and the sweep's answer would depend on them.
-        parts = [solve(case.arm, loads, **kwargs)]
-        if progress is not None:
-            progress(total, total)
         return _concatenate(parts, loads)
     start = time.perf_counter()
     parts = [solve(case.arm, _take(loads, 0, 1), **kwargs)]
@@ -667,13 +653,18 @@ def _contact_of(loads) -> Contact | None:
     return next((load for load in loads if isinstance(load, Contact)), None)
 
 
-def _with_contact(loads: tuple, solved: tuple) -> tuple:
-    """``loads`` with their Contact replaced by the one among ``solved`` (an equilibrium's
-    loads: the Contact with the penalty stiffness the solver used)."""
-    contact = _contact_of(solved)
-    if contact is None:
+def _with_contact(loads: tuple, parts: list[Equilibrium]) -> tuple:
+    """``loads`` with their Contact replaced by the law the parts were solved with: each
+    case's penalty stiffness (the solver's choice per case, softarm.Contact), one array
+    over the sweep's steps, or one number where they are all the same."""
+    laws = [_contact_of(part.loads) for part in parts]
+    if laws[0] is None:
         return loads
-    return tuple(contact if isinstance(load, Contact) else load for load in loads)
+    stiffness = np.concatenate([np.broadcast_to(law.stiffness, part.batch_shape).ravel()
+                                for law, part in zip(laws, parts, strict=True)])
+    law = laws[0].replace(stiffness=float(stiffness[0]) if np.all(stiffness == stiffness[0])
+                          else stiffness)
+    return tuple(law if isinstance(load, Contact) else load for load in loads)
 
 
 def _batched(eq: Equilibrium) -> Equilibrium:
@@ -704,15 +695,8 @@ def _take(loads: tuple, start: int, stop: int) -> tuple:
 
 def _concatenate(parts: list[Equilibrium], loads: tuple) -> Equilibrium:
     """The parts of a sweep as one equilibrium with the sweep's ``loads`` (and the contact
-    law the parts were solved with: the same in every part, else a ConvergenceError)."""
-    laws = {_contact_of(part.loads).stiffness for part in parts
-            if _contact_of(part.loads) is not None}
-    if len(laws) > 1:
-        raise ConvergenceError(
-            f"the steps of the sweep were solved with different contact stiffnesses "
-            f"({', '.join(f'{k:.3g}' for k in sorted(laws))} N/m²): give one, "
-            "[contact] stiffness = ...", float("nan"))
-    loads = _with_contact(loads, parts[0].loads)
+    law the parts were solved with, :func:`_with_contact`)."""
+    loads = _with_contact(loads, parts)
     if len(parts) == 1:
         return replace(parts[0], loads=loads)
     first = parts[0]

@@ -122,7 +122,8 @@ def _contact_law(loads) -> dict | None:
     forces of that law (its case may leave them to the solver)."""
     for load in loads:
         if isinstance(load, Contact) and load.stiffness is not None:
-            return {"stiffness": load.stiffness, "distance": load.distance}
+            return {"stiffness": np.asarray(load.stiffness).tolist(),
+                    "distance": load.distance}
     return None
 
 

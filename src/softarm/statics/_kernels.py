@@ -3032,6 +3032,9 @@ _STIFF_STEPS = 0.6  # coarse RK4 steps per unit of kL at least: hk <= 1.7 (RK4 i
 # sharply near λ = 0 (k grows like √λ: the predicted lateral motion at λ = 0 is that of an
 # arm without tension), so steps far below _DLAM_MIN are needed there, doubling from then on.
 _DLAM_MIN_STIFF = 1e-12
+# The corrector's contraction test with contact: Newton on a penalty contracts slowly until
+# it is within the band of the answer (a contact that closes between prediction and answer).
+_CONTRACTION_CONTACT = 0.9
 # The Richardson estimate |p_2N - p_N| / 15 times this: at hk near 1 (a boundary layer of
 # width 1/k resolved by a few steps) RK4 is not yet in its asymptotic regime, and the fine
 # solution's error against the separatrix was measured up to 2.2 times |p_2N - p_N| / 15
@@ -3455,7 +3458,8 @@ def _ms_corrector(x, Z, M, lam, nt, chunks, first, csteps, base, arm, act, case,
         if k == 0:
             if size > first_limit:
                 return False, 0.0, travelled
-        elif size > _CONTRACTION_MAX * previous:
+        elif size > (_CONTRACTION_MAX if act is None or act[5].shape[0] == 0
+                     else _CONTRACTION_CONTACT) * previous:
             return res <= _STALL * threshold, sign, travelled
         previous = size
         travelled += size
@@ -3467,6 +3471,19 @@ def _ms_corrector(x, Z, M, lam, nt, chunks, first, csteps, base, arm, act, case,
                 tip[i] += motion[i]
             return True, sign, travelled
     return False, 0.0, travelled
+
+
+@_jit
+def _loose(act, length):
+    """The corrector's tolerance on the way (a step no larger ends it): _LOOSE, or with
+    contact a tenth of the thinnest contact distance (over L): a point on the way left
+    _LOOSE L from the path lies far outside the band, and the next corrector, started
+    there, does not find its way back into it."""
+    loose = _LOOSE
+    if act is not None and act[5].shape[0] > 0:
+        for j in range(act[6].shape[0]):
+            loose = min(loose, 0.1 * act[6][j, 1] / length)
+    return loose
 
 
 @_jit
@@ -3501,6 +3518,7 @@ def _ms_follow(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, co
     _ms_motion(scratch[1], M, t, colscale, 1.0, motion_prev)
     moved = np.empty(n)
     lam = lam0
+    loose = _loose(act, length)
     size = _ms_distance(t, n, scratch[1], M, colscale, w, length, motion)
     dl = max_load_step if size <= 0.0 else min(max_load_step, _FIRST_MOTION / size)
     while lam < end:
@@ -3515,15 +3533,17 @@ def _ms_follow(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, co
         ok, new_sign, dist = _ms_corrector(x, Z, M, target, nt, chunks, first, csteps, base,
                                            arm, act, case, scratch, colscale, rowscale, work, w,
                                            length, threshold, max_iterations, _DIST_MAX,
-                                           final if target == 1.0 else _LOOSE, tip, counter)
+                                           final if target == 1.0 else loose, tip, counter)
         if ok:
             for i in range(n):
                 du[i] = -G[i]
             ok = _band_solve(B, n, np.int64(_BAND), piv, Lm, du)
         if ok:
             _ms_motion(scratch[1], M, du, colscale, 1.0, motion_new)
-            ok = dl <= _DLAM_CROSS or (new_sign == sign
-                                       and _cosine(motion_prev, motion_new) >= 0.5)
+            # (with contact the tip turns where it touches: only det's sign guards)
+            ok = dl <= _DLAM_CROSS or (new_sign == sign and (
+                _cosine(motion_prev, motion_new) >= 0.5
+                or (act is not None and act[5].shape[0] > 0)))
         if ok:
             sign = new_sign
             reached[1] = sign
@@ -3621,7 +3641,8 @@ def _ms_path(x, Z, M, levels, kl, N, n_fixed, arm, act, base, case, scratch, w, 
                         case[1], scratch)
         if not _ms_follow(x, Zl, Ml, g_chunks, g_first, g_csteps, base, arm, act, case, scratch,
                           g_colscale, g_rowscale, g_work, w, length, threshold, max_iterations,
-                          max_load_step, budget, final_step if final else _LOOSE, tip, counter,
+                          max_load_step, budget, final_step if final else _loose(act, length),
+                          tip, counter,
                           reached, lam, end):
             return False
         lam = end

@@ -11,6 +11,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
+import warnings
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -29,7 +30,7 @@ from .._validate import (
     stations,
 )
 from ..equilibrium import Equilibrium, Stability
-from ..errors import ConvergenceError, InadmissibleStateError
+from ..errors import ApproximationWarning, ConvergenceError, InadmissibleStateError
 from ..lie import se3
 from ..loads import Gravity, Tendon, as_loads, batch_shape, check_magnitudes, path_tangent
 from ..model import Arm, Circle, Material, SegmentedArm
@@ -229,6 +230,34 @@ def _penetration(solver, contact, poses, s, attempt: int, given: bool) -> np.nda
             f"Contact(stiffness=...) or distance=", residual=float(depth[worst]))
     peak = np.linalg.norm(forces, axis=-1).max(axis=-1)
     return np.where(deep, np.maximum(2.5 * peak / contact.distance, 2.0 * k), k)
+
+
+#: Widenings of a default contact distance (×_WIDER each) after a loading path that failed.
+_WIDENINGS = 3
+_WIDER = 4.0
+
+
+def _widened_contact(solver, loads, contact, widened: int) -> tuple | None:
+    """``loads`` with the Contact's distance δ widened _WIDER times, or None: where the
+    loading path failed in contact with the default δ (the user gave none) and it has been
+    widened fewer than _WIDENINGS times. A band of a few µm that a free tip enters edge-on
+    is narrower than the steps resolve, and the path fails there (docs/contact.md); the
+    answer then lies within the wider δ of the hard-contact one, which the warning says
+    (the whole batch takes the wider band: each case's law is then that of the batch)."""
+    if contact is None or widened >= _WIDENINGS:
+        return None
+    given = next(load for load in loads if load.kind == "contact")
+    if given.distance is not None and not widened:
+        return None
+    distance = contact.distance * _WIDER
+    warnings.warn(
+        f"softarm: the loading path could not be followed in contact with the contact "
+        f"distance {contact.distance:.3g} m; solved with {distance:.3g} m "
+        f"({distance / solver.length:.1e} L): the shape is within about that of the "
+        f"hard-contact one "
+        f"(docs/contact.md)", ApproximationWarning, stacklevel=4)
+    wider = given.replace(distance=distance)
+    return tuple(wider if load.kind == "contact" else load for load in loads)
 
 
 def unloaded_poses(arm, s, base) -> np.ndarray:
@@ -1197,12 +1226,13 @@ class Solver:
 
     def _solve(self, loads, *, chained: bool, jacobians: bool, near: bool = False,
                outputs: bool = True, checked: bool = False,
-               contact_retry: tuple[np.ndarray, int] | None = None) -> Equilibrium | None:
+               contact_retry: tuple | None = None) -> Equilibrium | None:
         """``near``: a single case whose path starts at its own loads, from the memory
         :meth:`solve_near` wrote (λ = 0 and λ = 1 the same loads); ``outputs=False``: only
         the memory of a chained solve (the tip its one station, no verdict), None;
         ``checked``: ``loads`` is what :meth:`check_loads` returned; ``contact_retry``:
-        (each case's penalty stiffness, attempt) after a penetration (:func:`_penetration`)."""
+        (each case's penalty stiffness or None, attempt, widenings) after a penetration
+        (:func:`_penetration`) or a path that failed in contact (:func:`_widened_contact`)."""
         if not isinstance(jacobians, (bool, np.bool_)):
             raise TypeError(f"jacobians must be True or False, got {jacobians!r}")
         if not checked:
@@ -1241,9 +1271,10 @@ class Solver:
             # other actuators than the last case's: no continuous path from it
             self.reset()
             last = None
-        attempt = 0 if contact_retry is None else contact_retry[1]
-        contact = channels.resolve_contact(None if contact_retry is None else contact_retry[0]) \
+        stiffness, attempt, widened = contact_retry or (None, 0, 0)
+        contact = channels.resolve_contact(stiffness) \
             if channels.contact_load is not None else None
+        given_loads = loads  # (a retry starts from them: their Contact as the user gave it)
         if contact is not None:
             _check_outside(self, channels.contact_load.replace(stiffness=None), loads)
             loads = tuple(contact if load.kind == "contact" else load for load in loads)
@@ -1309,6 +1340,11 @@ class Solver:
         if len(failed):
             if chained:
                 self.reset()
+            wider = _widened_contact(self, given_loads, contact, widened)
+            if wider is not None:  # a path the band was too thin to follow: a wider band
+                return self._solve(wider, chained=chained, jacobians=jacobians, near=near,
+                                   outputs=outputs, checked=True,
+                                   contact_retry=(None, 0, widened + 1))
             error = _failure(k, failed[0], shape, status, info, self, near)
             if status[failed[0]] == k.PATH_FAILED and not near:
                 error = _tendon_limit(self, loads, shape, int(failed[0]),
@@ -1321,9 +1357,9 @@ class Solver:
             if stiffer is not None:  # raise the penalty until the pressure fits the band
                 if chained:
                     self.reset()
-                return self._solve(loads, chained=chained, jacobians=jacobians, near=near,
-                                   outputs=outputs, checked=True,
-                                   contact_retry=(stiffer, attempt + 1))
+                return self._solve(given_loads, chained=chained, jacobians=jacobians,
+                                   near=near, outputs=outputs, checked=True,
+                                   contact_retry=(stiffer, attempt + 1, widened))
         _admissible(self, strains, stresses, s_kernel, shape, info[:, 0], chained)
         if chained and count:
             self._last = (pieces[0], channels.piece[-1].copy(), channels.tip_loads[-1].copy(),
