@@ -836,7 +836,8 @@ def join_trajectories(parts, start: int = 0) -> Trajectory:
         strains=cat([p.strains for p in parts]), stresses=cat([p.stresses for p in parts]),
         energy=energy, errors=cat([p.errors for p in parts]),
         iterations=cat([p.iterations for p in parts]), tendon_lengths=lengths,
-        final=parts[-1].final, failed=parts[-1].failed)
+        final=parts[-1].final, failed=parts[-1].failed, contact=parts[0].contact,
+        contact_radii=parts[0].contact_radii)
 
 
 def simulate_case(case: Case, *, progress: Callable[[int, int], None] | None = None

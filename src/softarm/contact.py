@@ -31,7 +31,8 @@ import numpy as np
 from ._validate import as_array, format_value, real
 from .loads import Key, Load
 
-__all__ = ["Capsule", "Contact", "Obstacle", "Plane", "Sphere", "pressure"]
+__all__ = ["Capsule", "Contact", "Obstacle", "Plane", "Sphere", "along_the_arm",
+           "penalty_energy", "pressure", "resultant"]
 
 # The kernel's obstacle kinds (statics/_kernels.py: PLANE, SPHERE, CAPSULE, one row of 8).
 _PLANE, _SPHERE, _CAPSULE = 0, 1, 2
@@ -234,6 +235,16 @@ def _stiffness(value):
     return array
 
 
+def penalty_energy(gap, distance: float, stiffness) -> np.ndarray:
+    """The law's stored energy per unit length Φ(g) = ∫_g^δ φ (J/m) at gaps ``gap`` (m):
+    k δ² (t⁴/4 - t⁵/10) in the band, 0.15 k δ² + k (g²/2 - δ g/2) inside (−Φ' = φ)."""
+    g = np.asarray(gap, dtype=np.float64)
+    t = np.clip((distance - g) / distance, 0.0, 1.0)
+    band = stiffness * distance**2 * (t**4 / 4.0 - t**5 / 10.0)
+    inside = 0.15 * stiffness * distance**2 + stiffness * (0.5 * g * g - 0.5 * distance * g)
+    return np.where(g <= 0.0, inside, band)
+
+
 def _obstacles(value) -> tuple[Obstacle, ...]:
     items = (value,) if isinstance(value, Obstacle) else value
     try:
@@ -334,6 +345,13 @@ class Contact(Load):
         return self.replace(obstacles=tuple(o.moved(np.asarray(R), origin)
                                             for o in self.obstacles))
 
+    def _with_checked_stiffness(self, stiffness) -> Contact:
+        """A copy with ``stiffness`` (an array of any shape) set without validation."""
+        new = object.__new__(type(self))
+        new.__dict__.update(self.__dict__)
+        object.__setattr__(new, "stiffness", stiffness)
+        return new
+
     def take(self, index) -> Contact:
         if np.ndim(self.stiffness) == 0:
             return self
@@ -392,3 +410,28 @@ class Contact(Load):
             if k is not None:
                 force += pressure(g, self.distance, k)[..., None] * n
         return gap, force
+
+
+def along_the_arm(contact, radii, positions, batch_ndim: int, inner: int = 0):
+    """(gaps (..., S), forces (..., S, 3)) of the arm at ``positions`` (B..., [T...,] S, 3)
+    with surface ``radii`` (S,): the distance to the nearest obstacle (m; inf without a
+    Contact) and the contact force per length (N/m, spatial; zero without one). The law's
+    stiffness is one per case (B..., ``batch_ndim`` axes) or one number; ``inner`` axes
+    (time) lie between the batch axes and the stations."""
+    p = np.asarray(positions)
+    if contact is None:
+        return np.full(p.shape[:-1], np.inf), np.zeros(p.shape)
+    if np.ndim(contact.stiffness) and inner:  # k (B...) against (B..., T..., S)
+        k = np.asarray(contact.stiffness).reshape(
+            np.shape(contact.stiffness) + (1,) * inner)
+        contact = contact._with_checked_stiffness(k)
+    return contact.gaps(p, radii)
+
+
+def resultant(s, positions, forces) -> np.ndarray:
+    """(..., 6): the force (N) and its moment about the origin (N m) of forces per length
+    (..., S, 3) at ``positions`` (..., S, 3) on stations s (S,), by the trapezoidal rule
+    (stations fine enough to resolve the contact zones: about √(EI/GA) wide)."""
+    wrench = np.concatenate([forces, np.cross(positions, forces)], axis=-1)
+    ds = np.diff(np.asarray(s))[:, None]
+    return (0.5 * (wrench[..., 1:, :] + wrench[..., :-1, :]) * ds).sum(-2)

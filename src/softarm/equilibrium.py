@@ -7,6 +7,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .contact import along_the_arm, resultant
+
 __all__ = ["Equilibrium", "Stability"]
 
 
@@ -283,17 +285,12 @@ class Equilibrium:
         (N m) on the arm: :attr:`contact_forces` and p × them integrated over the stations
         (trapezoidal rule: pass stations fine enough to resolve the contact zones, whose
         width is about √(EI/GA); docs/contact.md)."""
-        forces = self.contact_forces
-        moments = np.cross(self.positions, forces)
-        wrench = np.concatenate([forces, moments], axis=-1)
-        ds = np.diff(self.s)[:, None]
-        return (0.5 * (wrench[..., 1:, :] + wrench[..., :-1, :]) * ds).sum(-2)
+        return resultant(self.s, self.positions, self.contact_forces)
 
     def _contact_state(self) -> tuple[np.ndarray, np.ndarray]:
         contact = self._contact()
-        if contact is None:
-            return (np.full(self.poses.shape[:-2], np.inf), np.zeros(self.positions.shape))
-        return contact.gaps(self.positions, contact.station_radii(self.arm, self.s))
+        radii = None if contact is None else contact.station_radii(self.arm, self.s)
+        return along_the_arm(contact, radii, self.positions, len(self.batch_shape))
 
     def show(self, path=None, *, browser: bool = True, **options):
         """Write an interactive 3D view (:func:`softarm.view.figure`, ``options`` as there) to

@@ -209,6 +209,9 @@ class Simulator:
         if contact is not None:  # (the law the steps use, on the trajectory's loads)
             self.loads = tuple(contact if load.kind == "contact" else load
                                for load in self.loads)
+        #: the contact law of the steps, and the arm's surface radius at the stations
+        self._contact = contact
+        self._contact_radii = None
         self.shape = shape
         self._channels = channels
         self._act = channels.arm_tuple()[1]
@@ -228,6 +231,8 @@ class Simulator:
         self.length = self._solver.length
         s, h, node_piece, at, s_out = _grid(self.length, pieces[0], stations)
         self.s = s_out
+        if self._contact is not None:
+            self._contact_radii = self._contact.station_radii(self.arm, self.s)
         self.s.setflags(write=False)
         self._nodes, self._h, self._node_piece, self._at = s, h, node_piece, at
         # A start at rest knows no acceleration: its first step is backward Euler (BDF-α's
@@ -801,7 +806,8 @@ class Simulator:
             energy=Energy(*(_frozen(energies[..., i]) for i in range(4))),
             errors=_frozen(errors.reshape(*shape, T)),
             iterations=iterations.astype(np.int64).reshape(*shape, T),
-            tendon_lengths=lengths, final=self.state, failed=self._failed.copy())
+            tendon_lengths=lengths, final=self.state, failed=self._failed.copy(),
+            contact=self._contact, contact_radii=self._contact_radii)
 
 
 def simulate(arm, loads=(), *, duration, dt, actuators=(), inputs=None, damping=None,

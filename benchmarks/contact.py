@@ -1,0 +1,146 @@
+"""Contact (issue 33): what a solve in contact costs, against the issue's targets and the
+alternatives.
+
+- the heavy soft arm lying on a table (tol 1e-6 L), against the hard-contact free-boundary
+  ``solve_bvp`` reference of tests/_table_reference.py (the alternative: a free-boundary
+  solve written for this one geometry) and against the same arm without the table;
+- the arm pressed onto a pin (a Capsule) by gravity and a tip force;
+- a tendon finger closing on a cylinder, tracked over 100 tension steps (a prepared
+  ForwardSolver, as a control loop calls it);
+- a dynamic drop onto the table at Δt = 1 ms: the cost of a step against the same step
+  without the table.
+
+Wall time (``perf_counter``) and CPU time (``process_time``), best of ``--repeats`` after a
+warm-up call. Times are printed, never asserted. Run::
+
+    python benchmarks/contact.py [--repeats 3]
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+
+from _table_reference import table_reference
+
+import softarm
+
+L, RADIUS, DROP = 0.5, 0.01, 0.02
+
+
+def _soft_arm(length=L):
+    return softarm.Arm(length, softarm.Circle(RADIUS),
+                       softarm.Material(youngs_modulus=1e6, poisson_ratio=0.5, density=1000.0))
+
+
+def _timed(call, repeats):
+    """(result, best wall s, best CPU s) after one warm-up call."""
+    result = call()
+    walls, cpus = [], []
+    for _ in range(repeats):
+        wall, cpu = time.perf_counter(), time.process_time()
+        result = call()
+        walls.append(time.perf_counter() - wall)
+        cpus.append(time.process_time() - cpu)
+    return result, min(walls), min(cpus)
+
+
+def table(repeats):
+    arm = _soft_arm()
+    loads = [softarm.Gravity(),
+             softarm.Contact(softarm.Plane((0.0, 0.0, -DROP - RADIUS), (0.0, 0.0, 1.0)))]
+    rows = []
+    eq, wall, cpu = _timed(lambda: softarm.solve(arm, loads, tol=1e-6, s=201), repeats)
+    k = arm.rigidities
+    ref, rwall, rcpu = _timed(lambda: table_reference(L, k.EA, k.GAy, k.EIy, RADIUS,
+                                                      arm.linear_density * 9.81, DROP), 1)
+    error = np.abs(eq.positions - ref.positions(eq.s)).max() / L
+    rows.append(("table, softarm (tol 1e-6 L)", wall, cpu, f"{error:.1e} L", "5 ms"))
+    rows.append(("table, solve_bvp free boundary (hard contact)", rwall, rcpu, "reference",
+                 ""))
+    for distance in (1e-4, 1e-3):
+        wide = [loads[0], loads[1].replace(distance=distance * L)]
+        eq, wall, cpu = _timed(lambda wide=wide: softarm.solve(arm, wide, tol=1e-6, s=201),
+                               repeats)
+        error = np.abs(eq.positions - ref.positions(eq.s)).max() / L
+        rows.append((f"table, softarm, contact distance {distance:g} L", wall, cpu,
+                     f"{error:.1e} L", ""))
+    _, wall, cpu = _timed(lambda: softarm.solve(arm, loads[:1], tol=1e-6, s=201,
+                                                method="numeric"), repeats)
+    rows.append(("the same arm without the table", wall, cpu, "", ""))
+    return rows
+
+
+def pin(repeats):
+    arm = _soft_arm()
+    pin_radius = 0.005
+    obstacle = softarm.Capsule((0.3, -0.1, -RADIUS - pin_radius - 0.002),
+                               (0.3, 0.1, -RADIUS - pin_radius - 0.002), pin_radius)
+    loads = [softarm.Gravity(), softarm.TipLoad(force=(0.0, 0.0, -0.05)),
+             softarm.Contact(obstacle)]
+    eq, wall, cpu = _timed(lambda: softarm.solve(arm, loads, tol=1e-6, s=201), repeats)
+    force = np.linalg.norm(eq.contact_wrench[:3])
+    return [(f"pin (contact force {force:.3f} N)", wall, cpu, "", "3 ms")]
+
+
+def finger(repeats):
+    arm = softarm.Arm(0.12, softarm.Circle(0.01),
+                      softarm.Material(youngs_modulus=1e6, poisson_ratio=0.49, density=1070.0))
+    tendon = softarm.Tendon(1.0, softarm.routing.Straight(0.0, -0.007))
+    cylinder = softarm.Contact(softarm.Capsule((0.06, -0.05, -0.045), (0.06, 0.05, -0.045),
+                                               0.03))
+    tensions = np.linspace(0.15, 15.0, 100)
+    model = softarm.ForwardSolver(arm, [tendon], [cylinder])
+
+    def track():
+        return [model.solve([q]) for q in tensions]
+
+    _, wall, cpu = _timed(track, max(1, repeats // 2))
+    last = softarm.solve(arm, [tendon.with_tension(tensions[-1]), cylinder])
+    force = float(np.linalg.norm(last.contact_wrench[:3]))
+    return [(f"finger: 100 tension steps to 15 N (contact force at the end {force:.2f} N)",
+             wall, cpu, "", "0.5 s")]
+
+
+def drop(repeats):
+    arm = _soft_arm()
+    table_ = softarm.Contact(softarm.Plane((0.0, 0.0, -0.05), (0.0, 0.0, 1.0)))
+    damping = softarm.Damping(retardation=0.02)
+    steps = 300
+    rows = []
+    for name, loads in (("dynamic drop onto the table", [softarm.Gravity(), table_]),
+                        ("the same drop without the table", [softarm.Gravity()])):
+        _, wall, cpu = _timed(lambda loads=loads: softarm.simulate(
+            arm, loads, duration=steps * 1e-3, dt=1e-3, damping=damping), 1)
+        rows.append((f"{name}: a step (Δt = 1 ms, 101 stations, {steps} steps)",
+                     wall / steps, cpu / steps, "", "2× without" if "onto" in name else ""))
+    return rows
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeats", type=int, default=3)
+    args = parser.parse_args(argv)
+    warnings.simplefilter("ignore")  # (stability and approximation notes)
+    rows = [*table(args.repeats), *pin(args.repeats), *finger(args.repeats),
+            *drop(args.repeats)]
+    print("| case | wall | CPU | shape error | target |")
+    print("|---|---|---|---|---|")
+    for name, wall, cpu, error, target in rows:
+        unit, scale = ("ms", 1e3) if wall < 1.0 else ("s", 1.0)
+        print(f"| {name} | {wall * scale:.3g} {unit} | {cpu * scale:.3g} {unit} | {error} | "
+              f"{target} |")
+    base = rows[-1][1]
+    print(f"\ncontact step / plain step: {rows[-2][1] / base:.2f}× wall, "
+          f"{rows[-2][2] / rows[-1][2]:.2f}× CPU")
+
+
+if __name__ == "__main__":
+    main()
