@@ -35,7 +35,8 @@ print(repr(eq.tip_position.tolist()))
 _NOT_PASSIVE = ("_law", "_dipole", "_actuator_rates", "_ldl_substitute", "_implicit_function",
                 "inverse_newton", "box_least_squares", "shoot", "sweep_point",
                 "solve_stiff_cases", "_band_factor", "_ms_evaluate", "dynamic_steps",
-                "_node_rates", "_dyn_newton")
+                "_node_rates", "_dyn_newton", "_contact", "_nearest", "_pressure",
+                "_moving_contact")
 
 
 def _python(code: str, *args: str, cache: Path, notice: bool = True, prefetch: bool = False):

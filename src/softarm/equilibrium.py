@@ -205,6 +205,9 @@ class Equilibrium:
     tendon_length_jacobian: np.ndarray | None = None
     tendon_slack: np.ndarray | None = None
     stability: Stability | None = None
+    #: the solver's total contact wrench (B..., 6), integrated on its own fine stations
+    #: (:attr:`contact_wrench`), or None
+    contact_resultant: np.ndarray | None = None
 
     def __post_init__(self):
         for name in ("s", "poses", "strains", "stresses"):
@@ -282,9 +285,13 @@ class Equilibrium:
     @property
     def contact_wrench(self) -> np.ndarray:
         """(B..., 6): the total contact force (N) and its moment about the spatial origin
-        (N m) on the arm: :attr:`contact_forces` and p × them integrated over the stations
-        (trapezoidal rule: pass stations fine enough to resolve the contact zones, whose
-        width is about √(EI/GA); docs/contact.md)."""
+        (N m) on the arm: the contact forces and p × them integrated along the arm. The
+        solver integrates them on stations of its own, at least 2001 (a contact zone is
+        about √(EI/GA) wide, a few mm: the stations asked for may miss it); an Equilibrium
+        without them (read from a file) integrates :attr:`contact_forces` over its stations
+        (docs/contact.md)."""
+        if self.contact_resultant is not None:
+            return self.contact_resultant
         return resultant(self.s, self.positions, self.contact_forces)
 
     def _contact_state(self) -> tuple[np.ndarray, np.ndarray]:

@@ -29,6 +29,7 @@ from .._validate import (
     rigid_transform,
     stations,
 )
+from ..contact import resultant
 from ..equilibrium import Equilibrium, Stability
 from ..errors import ApproximationWarning, ConvergenceError, InadmissibleStateError
 from ..lie import se3
@@ -258,6 +259,18 @@ def _widened_contact(solver, loads, contact, widened: int) -> tuple | None:
         f"(docs/contact.md)", ApproximationWarning, stacklevel=4)
     wider = given.replace(distance=distance)
     return tuple(wider if load.kind == "contact" else load for load in loads)
+
+
+#: Stations of a solve in contact at the least (uniform, with the ones asked for): the
+#: contact's total and the penetration check need its zones resolved (about √(EI/GA)).
+CONTACT_STATIONS = 2001
+
+
+def _contact_stations(s: np.ndarray, length: float) -> tuple[np.ndarray, np.ndarray]:
+    """(the solver's stations: ``s`` and CONTACT_STATIONS uniform ones, the index of each
+    of ``s`` among them)."""
+    fine = np.union1d(s, np.linspace(0.0, length, CONTACT_STATIONS))
+    return fine, np.searchsorted(fine, s)
 
 
 def unloaded_poses(arm, s, base) -> np.ndarray:
@@ -1292,6 +1305,9 @@ class Solver:
                 self._memory = np.zeros(k.MEMORY)
             memory = self._memory
         s_kernel = self._s_kernel if outputs else np.array([self.length])
+        asked = None  # with contact: the stations asked for, among the solver's finer ones
+        if contact is not None and outputs:
+            s_kernel, asked = _contact_stations(s_kernel, self.length)
         S = s_kernel.size
         poses = np.empty((count, S, 4, 4))
         strains = np.empty((count, S, 6))
@@ -1361,6 +1377,18 @@ class Solver:
                                    near=near, outputs=outputs, checked=True,
                                    contact_retry=(stiffer, attempt + 1, widened))
         _admissible(self, strains, stresses, s_kernel, shape, info[:, 0], chained)
+        contact_resultant = None
+        if asked is not None:  # the contact's total on the fine stations, then the asked
+            contact_resultant = resultant(s_kernel, poses[..., :3, 3], channels.contact_load
+                                          .gaps(poses[..., :3, 3],
+                                                channels.contact_load.station_radii(
+                                                    self.arm, s_kernel))[1])
+            contact_resultant = contact_resultant.reshape(*shape, 6)
+            poses, strains, stresses = (np.ascontiguousarray(a[:, asked])
+                                        for a in (poses, strains, stresses))
+            if jacobians:
+                motion = np.ascontiguousarray(motion[:, asked])
+            S = asked.size
         if chained and count:
             self._last = (pieces[0], channels.piece[-1].copy(), channels.tip_loads[-1].copy(),
                           channels.signature())
@@ -1399,6 +1427,7 @@ class Solver:
             error_estimate=estimate.reshape(shape) if shape else float(estimate[0]),
             tip_compliance=tip_compliance,
             compliance=compliance,
+            contact_resultant=contact_resultant,
             **actuation,
         )
 
