@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import analytic
+from .contact import Contact, Plane
 from .control import ForwardSolver, inverse
 from .dispatch import solve
 from .dynamics import simulate
@@ -107,6 +108,12 @@ def _stiff():
     solve(arm, [TipLoad(force=[1e3, 0.0, 1.0]), DistributedForce([0.0, 0.0, 0.0])])
 
 
+def _contact():
+    arm = Arm.from_stiffness(1.0, EA=1e4, GAy=1e4, GAz=1e4, GJ=1.0, EIy=1.0, EIz=1.0)
+    solve(arm, [TipLoad(force=[0.0, 0.0, -10.0]),
+                Contact(Plane((0.0, 0.0, -0.1), (0.0, 0.0, 1.0)), radius=0.01)])
+
+
 def _dynamics():
     arm = Arm.from_stiffness(1.0, EA=1e3, GAy=1e3, GAz=1e3, GJ=1.0, EIy=1.0, EIz=1.0,
                              mass_per_length=1.0, inertia_per_length=(1e-4, 5e-5, 5e-5))
@@ -153,6 +160,8 @@ STEPS: tuple[Step, ...] = (
     Step("critical", "critical loads and continuation", ("shoot", "branch"), _critical),
     Step("stiff", "multiple shooting (arms in strong tension: kL >= 15)", ("stiff+verdict",),
          _stiff),
+    Step("contact", "contact with obstacles (softarm.Contact: multiple shooting)",
+         ("stiff+actuated+verdict",), _contact),
     Step("dynamics", "dynamics of passive arms (softarm.simulate, Simulator)", ("dynamics",),
          _dynamics),
     Step("actuated dynamics", "dynamics of actuated and magnetic arms",

@@ -90,7 +90,8 @@ def _solver(args):
     actuated, chained, jacobians = _given(args[2]), _given(args[7]), _given(args[8])
     key = "+".join(["actuated" if actuated else "solve"] + ["chained"] * chained
                    + ["jacobians"] * jacobians)
-    text = "the solver for " + ("actuated or magnetic arms" if actuated else "passive arms")
+    text = "the solver for " + ("actuated, magnetic or touching arms" if actuated
+                                else "passive arms")
     text += " (quasi-static, chained)" * chained + " with Jacobians" * jacobians
     return key, text
 
@@ -101,7 +102,8 @@ def _per_arm(key: str, text: str, act: int):
     def capability(args):
         actuated = _given(args[act])
         return (key + "+actuated" * actuated,
-                text + (" for actuated or magnetic arms" if actuated else " for passive arms"))
+                text + (" for actuated, magnetic or touching arms" if actuated
+                        else " for passive arms"))
     return capability
 
 
@@ -4563,6 +4565,18 @@ def _dyn_apply(Z, dx, S):
 
 
 @_jit
+def _set_base(Zw, row):
+    """The base node of a step's guess: its pose and velocities from the base's row (18:
+    p, R row-major, q, ω material)."""
+    for i in range(3):
+        Zw[0, _DP + i] = row[i]
+        Zw[0, _DQ + i] = row[12 + i]
+        Zw[0, _DW + i] = row[15 + i]
+    for i in range(9):
+        Zw[0, _DR + i] = row[3 + i]
+
+
+@_jit
 def _sum_squares(r):
     total = 0.0
     for i in range(r.size):
@@ -4709,7 +4723,8 @@ def _dynamics(args):
     """dynamic_steps' capability: passive, or with actuators or magnets (``act``)."""
     actuated = _given(args[26])
     return ("dynamics" + "+actuated" * actuated,
-            "the dynamics (implicit time steps)" + " for actuated or magnetic arms" * actuated)
+            "the dynamics (implicit time steps)"
+            + " for actuated, magnetic or touching arms" * actuated)
 
 
 @_entry(_dynamics, nogil=True)
@@ -4801,12 +4816,7 @@ def dynamic_steps(Z, Zold, H, aux, props, loads, tip, grid, coef, S, options, ba
             for k in range(G):
                 for i in range(3):
                     Zp[k, i] = Zw[k, _DP + i]  # (the predicted centreline)
-            for i in range(3):
-                Zw[0, _DP + i] = base[bb, t, i]
-                Zw[0, _DQ + i] = base[bb, t, 12 + i]
-                Zw[0, _DW + i] = base[bb, t, 15 + i]
-            for i in range(9):
-                Zw[0, _DR + i] = base[bb, t, 3 + i]
+            _set_base(Zw, base[bb, t])
             code, res, its, nf = _dyn_newton(Zw, grid, props, coef, S, now, tip_now, hh, act,
                                              actuation, tol, max_iter, fac, kl, work)
             if code != DYN_OK and act is not None and act[5].shape[0] > 0:
@@ -4816,12 +4826,7 @@ def dynamic_steps(Z, Zold, H, aux, props, loads, tip, grid, coef, S, options, ba
                 for k in range(G):
                     for i in range(DYN):
                         Zw[k, i] = Z[b, k, i]
-                for i in range(3):
-                    Zw[0, _DP + i] = base[bb, t, i]
-                    Zw[0, _DQ + i] = base[bb, t, 12 + i]
-                    Zw[0, _DW + i] = base[bb, t, 15 + i]
-                for i in range(9):
-                    Zw[0, _DR + i] = base[bb, t, 3 + i]
+                _set_base(Zw, base[bb, t])
                 fac[3][0] = 0
                 code, res, again, nf2 = _dyn_newton(Zw, grid, props, coef, S, now, tip_now, hh,
                                                     act, actuation, tol, max_iter, fac, kl,
