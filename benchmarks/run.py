@@ -721,10 +721,15 @@ def main(argv=None) -> int:
     else:
         dynamics_lines = dynamics.measure(False, with_pyelastica=not args.no_pyelastica)
         dynamics_lines = dynamics_lines.rstrip("\n").split("\n")
+    import contact  # (benchmarks/contact.py, beside this script)
+
+    contact_lines = ["## Contact", "", "Skipped with --quick: `python benchmarks/contact.py`."] \
+        if quick else contact.measure(2)
     elapsed = time.perf_counter() - t_start
     text = report(env, comp, rows, ref_notes, pyel_note, (closed, closed_principal, closed_serial),
                   batch, verdict, quick, elapsed,
-                  [*stiff.markdown(stiff_rows, stiff_repeats), "", *dynamics_lines])
+                  [*stiff.markdown(stiff_rows, stiff_repeats), "", *dynamics_lines, "",
+                   *contact_lines])
     print()
     print(table(rows))
     print()
