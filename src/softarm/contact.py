@@ -412,11 +412,11 @@ class Contact(Load):
         return gap, force
 
 
-def along_the_arm(contact, radii, positions, batch_ndim: int, inner: int = 0):
+def along_the_arm(contact, radii, positions, inner: int = 0):
     """(gaps (..., S), forces (..., S, 3)) of the arm at ``positions`` (B..., [T...,] S, 3)
     with surface ``radii`` (S,): the distance to the nearest obstacle (m; inf without a
     Contact) and the contact force per length (N/m, spatial; zero without one). The law's
-    stiffness is one per case (B..., ``batch_ndim`` axes) or one number; ``inner`` axes
+    stiffness is one per case (the batch axes B...) or one number; ``inner`` axes
     (time) lie between the batch axes and the stations."""
     p = np.asarray(positions)
     if contact is None:

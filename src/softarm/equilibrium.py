@@ -297,7 +297,7 @@ class Equilibrium:
     def _contact_state(self) -> tuple[np.ndarray, np.ndarray]:
         contact = self._contact()
         radii = None if contact is None else contact.station_radii(self.arm, self.s)
-        return along_the_arm(contact, radii, self.positions, len(self.batch_shape))
+        return along_the_arm(contact, radii, self.positions)
 
     def show(self, path=None, *, browser: bool = True, **options):
         """Write an interactive 3D view (:func:`softarm.view.figure`, ``options`` as there) to

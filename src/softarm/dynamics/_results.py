@@ -192,8 +192,7 @@ class Trajectory(Trajectories):
         return (0.5 * (per_length[..., 1:] + per_length[..., :-1]) * ds).sum(-1)
 
     def _contact_state(self):
-        return along_the_arm(self.contact, self.contact_radii, self.positions,
-                             len(self.batch_shape), inner=1)
+        return along_the_arm(self.contact, self.contact_radii, self.positions, inner=1)
 
     def show(self, path=None, *, arm=None, browser: bool = True, **options):
         """Write the motion's page (:func:`softarm.view.trajectory_figure`: the arm moving

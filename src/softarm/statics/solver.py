@@ -352,6 +352,7 @@ class _Channels:
         self.actuators = []  # (kind code, routing, active rows, span) per actuator column
         #: the Contact load, if any (:meth:`contact`); its arrays for the kernel, made once
         self.contact_load = self._contact_given = None  # (as resolved, as given)
+        self.contact_given_stiffness = False  # (the user's k: never raised, resolve_contact)
         self._contact_arrays = None
 
     def _rows(self, span):
