@@ -101,3 +101,23 @@ def test_far_obstacles_change_nothing_in_motion():
     assert np.abs(near.positions - free.positions).max() < 1e-12
     assert np.all(near.contact_forces == 0.0)
     assert np.isinf(free.gaps).all() and near.gaps.min() > 4.0
+
+
+def test_friction_holds_a_pushed_arm_below_the_cone():
+    """Sticking: an arm lying on a table (μ = 0.5) pushed sideways at its tip by 0.02 N, a
+    tenth of what friction can hold (μ N = 0.23 N): after 0.2 s it creeps at most at the
+    regularising speed w_ε (the law's sticking), where the frictionless arm still swings at
+    10⁻² m/s."""
+    arm = _arm(0.3, modulus=1e7)
+    push = sa.TipLoad(force=(0.0, 0.02, 0.0))
+    speeds = {}
+    for mu in (0.0, 0.5):
+        plane = sa.Contact(sa.Plane((0.0, 0.0, -0.012), (0.0, 0.0, 1.0)), friction=mu,
+                           slip_velocity=1e-3)
+        path = sa.simulate(arm, [sa.Gravity(), push, plane], duration=0.4, dt=1e-3,
+                           stations=61, damping=sa.Damping(retardation=0.01))
+        speeds[mu] = np.abs(path.velocities[200:, :, 1]).max()
+        if mu:
+            assert 0.5 * path.contact_wrench[-1, 2] > 10 * 0.02  # μ N: ten times the push
+    assert speeds[0.5] < 1e-3  # at most w_ε: stuck (measured 1.3e-4 m/s)
+    assert speeds[0.0] > 1e-2  # (measured 2.8e-2 m/s)
