@@ -286,7 +286,7 @@ def unloaded_poses(arm, s, base) -> np.ndarray:
     return np.stack(starts)[segment] @ se3.exp(along)
 
 
-def _check_outside(solver, contact, loads) -> None:
+def _check_outside(solver, contact) -> None:
     """ValueError if the unloaded arm (clamped at the solver's base) is inside an obstacle
     at some station: no path from it leads out."""
     s = np.linspace(0.0, solver.length, 201)
@@ -1290,7 +1290,8 @@ class Solver:
             if channels.contact_load is not None else None
         given_loads = loads  # (a retry starts from them: their Contact as the user gave it)
         if contact is not None:
-            _check_outside(self, channels.contact_load.replace(stiffness=None), loads)
+            if contact_retry is None:  # (a retry solves the same arm from the same start)
+                _check_outside(self, channels.contact_load.replace(stiffness=None))
             loads = tuple(contact if load.kind == "contact" else load for load in loads)
         # unchained: no first loads, no memory (that code is not even compiled, _kernels)
         first = memory = None
