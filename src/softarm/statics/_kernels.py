@@ -120,6 +120,7 @@ PATH_FAILED = 3  # the loading path could not be followed past a load factor (a 
 BUDGET = 4  # the shooting budget ran out
 NOT_FINITE = 5  # the state became non-finite at an accepted point
 SINGULAR = 6  # jacobians: ∂r/∂x is singular at the solution (no compliance exists there)
+PATH_STUCK = 7  # the loading path could not be followed past a load factor, not a fold there
 
 # Layout of the state y (18) and of each tangent row (12).
 _P, _R, _N, _M = 0, 3, 12, 15
@@ -173,7 +174,7 @@ MSTEP, MPREDICTED = _MSTEP, _MPREDICTED
 _DIST_MAX = 0.15
 _DIST_AIM = 0.05
 _CONTRACTION_MAX = 0.5
-_DLAM_MIN = 1e-5
+_DLAM_FLOOR = 1e-13
 # Corrector steps no larger than this end a corrector on the way (not at λ = 1), and the
 # first load step predicts a tip motion of about _FIRST_MOTION (L or rad).
 _LOOSE = 1e-2
@@ -181,8 +182,27 @@ _FIRST_MOTION = 0.15
 # A residual that stops decreasing is accepted within this factor of the threshold (round-off
 # of an ill-conditioned shooting map; still 1e-9 of the case's own load).
 _STALL = 1e3
-# A step across which det ∂r/∂x changes sign is accepted only when no longer than this.
-_DLAM_CROSS = 1e-3
+# The branch guard (_follow, _ms_follow; docs/solver.md, "Branch guard"). A step across
+# which a singular point is detected (_crossings: an eigenvalue of J_before⁻¹ J_after with a
+# negative real part, so that a double root, as a round section's two bending planes
+# buckling at one load, counts too) is accepted only when no longer than _CROSS_REL times
+# the load factor's scale: only a singular point that the path itself passes (a perfect
+# bifurcation, like a column compressed exactly along its axis) is crossed; the sharp turn
+# of an imperfect one (a load a hair off the axis) is resolved by steps this short.
+_CROSS_REL = 1e-7
+# A step may not advance the path's phase Φ = ∫ √(F/EI) ds + ½ ∫ M/EI ds (F, M: bounds of
+# the loads' forces and moments; Jacobi fields oscillate with about that phase under
+# compression or torsion, and a singular point lies about every π of it) by more than
+# _PHASE_STEP: at most one crossing per bending direction in a step, which the eigenvalue
+# test then sees. Both apply while Φ <= _PHASE_TESTED; beyond, the arm is in strong
+# tension (its growing Jacobi fields make J's eigenvalues ill-conditioned), and det's sign
+# and the tip's direction of motion guard the path.
+_PHASE_STEP = 0.5 * math.pi
+_PHASE_TESTED = 12.0
+# A path that cannot pass a load factor is a fold (the path turns) when the tip's motion
+# per unit load factor there, times the load factor's scale, exceeds this (nondimensional:
+# L and rad); otherwise it is a point the solver cannot resolve.
+_FOLD_RATE = 1e3
 # Refinement of a solution under a change of step count: distances are of the order of the
 # discretisation error, far below this.
 _REFINE_MAX = 0.05
@@ -1350,28 +1370,155 @@ def _grown(dl, moved, max_load_step):
 
 
 @_jit
+def _sizes(arm, act, loads, tip):
+    """(F, M): bounds of the total force (N) and moment (N m) that one set of load channels
+    (``loads`` (P, W) per piece, ``tip`` (TIP_LOADS,)) applies to the arm, each the sum of
+    its components' magnitudes: tip, distributed (times the piece length) and point forces
+    and moments, and the magnets' forces and torques (|m| |G| and |m| |B| per length, |B|
+    bounded as in :func:`_load_size`). Not the actuators': a tendon's tension or a chamber's
+    pressure is internal to the arm (it bends it without buckling it)."""
+    piece_len = arm[1]
+    L = arm[6]
+    force = moment = 0.0
+    for i in range(3):
+        force += abs(tip[_TD + i]) + abs(tip[_TF + i])
+        moment += abs(tip[_TD + 3 + i]) + abs(tip[_TF + 3 + i])
+    for j in range(piece_len.size):
+        f = m = 0.0
+        for i in range(3):
+            f += abs(loads[j, _FD + i]) + abs(loads[j, _FF + i])
+            m += abs(loads[j, _LD + i]) + abs(loads[j, _LF + i])
+            force += abs(loads[j, _JD + i]) + abs(loads[j, _JF + i])
+            moment += abs(loads[j, _JD + 3 + i]) + abs(loads[j, _JF + 3 + i])
+        if act is not None:
+            mag, dipoles = act[3], act[4]
+            field = gradient = 0.0
+            for i in range(3):
+                field += abs(loads[j, _FB + i])
+            for i in range(9):
+                gradient += abs(loads[j, _FG + i])
+            field += gradient * 2.0 * L
+            strength = abs(mag[j, 0]) + abs(mag[j, 1]) + abs(mag[j, 2])
+            dipole = abs(dipoles[j, 0]) + abs(dipoles[j, 1]) + abs(dipoles[j, 2])
+            if j == piece_len.size - 1:
+                dipole += (abs(dipoles[j + 1, 0]) + abs(dipoles[j + 1, 1])
+                           + abs(dipoles[j + 1, 2]))
+            f += strength * gradient
+            m += strength * field
+            force += dipole * gradient
+            moment += dipole * field
+        force += f * piece_len[j]
+        moment += m * piece_len[j]
+    return force, moment
+
+
+@_jit
+def _path_bounds(arm, act, case, scale, out):
+    """What the branch guard needs to know of a case's homotopy, loads(λ) = start + λ rate
+    (``case``), in ``out`` (7,): Q = ∫ √(1/EI) ds and ∫ ds/EI (each piece's softest
+    bending), the force bounds (N) of the start loads and of the rate, the moment bounds
+    (N m) likewise (:func:`_sizes`; the phase is Φ(λ) = Q √(F(λ)) + ½ ∫ds/EI M(λ)), and the
+    load factor's offset: the start loads' size over the rate's (0 from the unloaded arm),
+    so that λ + offset measures the loads on the path's own scale (a chained Solver's
+    small step from large loads)."""
+    piece_len, C = arm[1], arm[2]
+    Q = flex = 0.0
+    for j in range(piece_len.size):
+        c = max(C[j, 4, 4], C[j, 5, 5])
+        Q += piece_len[j] * math.sqrt(c)
+        flex += piece_len[j] * c
+    start, rate, tip_start, tip_rate = case
+    fs, ms = _sizes(arm, act, start, tip_start)
+    fr, mr = _sizes(arm, act, rate[0], tip_rate[0])
+    ws, _ = _load_size(arm, act, scale, start, start, tip_start, tip_start)
+    wr, _ = _load_size(arm, act, scale, rate[0], rate[0], tip_rate[0], tip_rate[0])
+    out[0], out[1], out[2], out[3], out[4], out[5] = Q, flex, fs, fr, ms, mr
+    out[6] = 0.0 if ws == 0.0 else (ws / wr if wr > 0.0 else np.inf)
+
+
+@_jit
+def _phase(bounds, lam):
+    """The path's phase Φ at load factor λ (:func:`_path_bounds`)."""
+    return (bounds[0] * math.sqrt(bounds[2] + lam * bounds[3])
+            + 0.5 * bounds[1] * (bounds[4] + lam * bounds[5]))
+
+
+@_jit
+def _phase_limited(bounds, lam, dl):
+    """Δλ, shortened so that the step from λ advances the phase by at most _PHASE_STEP
+    (half of it by the forces, half by the moments), while Φ <= _PHASE_TESTED."""
+    if not _phase(bounds, lam) <= _PHASE_TESTED:
+        return dl
+    Q, flex, fs, fr, mr = bounds[0], bounds[1], bounds[2], bounds[3], bounds[5]
+    if fr > 0.0 and Q > 0.0:
+        u0 = math.sqrt(fs + lam * fr)
+        u1 = u0 + 0.5 * _PHASE_STEP / Q
+        dl = min(dl, (u1 * u1 - u0 * u0) / fr)
+    if mr > 0.0 and flex > 0.0:
+        dl = min(dl, _PHASE_STEP / (flex * mr))
+    return dl
+
+
+@_jit
+def _crossed(J_before, J_after, scale, guard):
+    """How many singular points the path passed between two of its points: the
+    :func:`_crossings` of ∂r/∂x there (columns in units of the bending scale), -1 if the
+    first is singular. ``guard``: work arrays (:func:`_guard_work`)."""
+    A, B, work, M = guard
+    for i in range(6):
+        for k in range(6):
+            A[i, k] = J_before[i, k] * scale[k]
+            B[i, k] = J_after[i, k] * scale[k]
+    return _crossings(A, B, np.int64(6), work, M, 0.0)
+
+
+@_jit
+def _guard_work():
+    """The branch guard's work arrays: two 6 × 6 matrices, the elimination's 6 × 12, the
+    product's 6 × 6."""
+    return (np.empty((6, 6)), np.empty((6, 6)), np.empty((6, 12)), np.empty((6, 6)))
+
+
+@_jit
+def _cross_step(bounds, lam):
+    """The longest step accepted across a singular point at load factor λ."""
+    return _CROSS_REL * (lam + bounds[6])
+
+
+@_jit
 def _follow(x, steps, base, arm, act, case, scratch, scale, dscale, length, threshold,
             max_iterations, max_load_step, max_shootings, open_end, final, r, J, tip,
-            counter, reached):
+            counter, reached, J_path):
     """Follow the equilibrium path from λ = 0 (x: the solution there, exact or close) to
     λ = 1 by predictor–corrector continuation. True on success, with x, r, J (7 columns) and
     the tip position at λ = 1, converged as the caller's own corrector would leave them (a
     last step no larger than ``final``, or the threshold: no refinement is needed on these
     steps); otherwise ``reached[0]`` is the last load factor reached (a fold, or a point the
-    path cannot be followed past). Points on the way are converged to ``_LOOSE``.
+    path cannot be followed past) and ``reached[2]`` the tip's motion per unit load factor
+    there times the load factor's scale (large at a fold, where the path turns). Points on
+    the way are converged to ``_LOOSE``. ``J_path`` receives ∂r/∂x at the last point
+    accepted (the caller checks its own last correction against it).
 
     Predictor: the tangent dx/dλ = -J_x⁻¹ J_λ from the variational equations for the first
     step, then the cubic Hermite extrapolation of the last two points and their tangents.
     Corrector: :func:`_corrector` (distance and contraction tests). Step control: the first
     Δλ makes the predicted motion ``_FIRST_MOTION``; then Δλ ← Δλ (aim/δ)^(1/3) within
     [Δλ/2, 2Δλ], δ the corrector's distance from the predictor; Δλ × 0.4 after a failure; a
-    step that would leave less than half a step to λ = 1 is stretched to reach it.
+    step that would leave less than half a step to λ = 1 is stretched to reach it; no step
+    advances the phase by more than _PHASE_STEP (:func:`_phase_limited`).
+
+    Branch guard: a step is refused when a singular point lies in it (det ∂r/∂x changes
+    sign, or :func:`_crossed` counts a crossing: a double root too) or the tip's direction of
+    motion turns by more than 60°, unless the step is no longer than :func:`_cross_step`: a
+    singular point of the path itself (a perfect bifurcation) is crossed; the sharp turn
+    beside an imperfect one is followed in steps short enough to see it.
 
     With ``open_end``, the last step (to λ = 1) is predicted but not corrected: x is the
     prediction, for the caller's corrector on a finer grid (with the same first-step limit
     ``_DIST_MAX`` and contraction test, so the last step is checked as any other).
     """
     reached[0] = 0.0
+    reached[2] = 0.0
     end = 1.0
     nt = J.shape[1]  # all 7 columns (a variable, not a literal: one compiled version)
     if not _corrector(x, 0.0, nt, steps, base, arm, act, case, scratch, scale, dscale, length,
@@ -1385,6 +1532,10 @@ def _follow(x, steps, base, arm, act, case, scratch, scale, dscale, length, thre
     dx = np.empty(6)
     if not _tangent(J, t):
         return False
+    bounds = np.empty(7)
+    _path_bounds(arm, act, case, scale, bounds)
+    guard = _guard_work()
+    _copy_jx(J, J_path)
     sign = _det_sign(J)
     reached[1] = sign
     motion_prev = np.empty(3)
@@ -1397,7 +1548,7 @@ def _follow(x, steps, base, arm, act, case, scratch, scale, dscale, length, thre
     while lam < 1.0:
         if counter[0] > max_shootings:
             return False
-        dl, target = _load_step(lam, dl, end)
+        dl, target = _load_step(lam, _phase_limited(bounds, lam, dl), end)
         for i in range(6):
             x0[i] = x[i]
         h = lam - lam_p
@@ -1425,15 +1576,11 @@ def _follow(x, steps, base, arm, act, case, scratch, scale, dscale, length, thre
                 dx[i] = x[i] - dx[i]  # the corrector's distance from the prediction
             ok = _tangent(J, t_new)
         if ok:
-            # det ∂r/∂x changed sign: a singular point lies in this step. Newton may have
-            # landed on another branch across it (an imperfect bifurcation): refuse the step
-            # until it is short enough that the singular point itself is being crossed.
-            # The same when the tip's direction of motion turns by more than 60° in one step
-            # (a double root, as on a round section, keeps the sign of det but not this).
             new_sign = _det_sign(J)
             _tip_motion(scratch[1], t_new, motion_new)
-            ok = dl <= _DLAM_CROSS or (new_sign == sign
-                                       and _cosine(motion_prev, motion_new) >= 0.5)
+            crossing = new_sign != sign or _crossed(J_path, J, scale, guard) != 0
+            ok = dl <= _cross_step(bounds, lam) or (
+                not crossing and _cosine(motion_prev, motion_new) >= 0.5)
             if ok:
                 sign = new_sign
                 reached[1] = sign
@@ -1444,17 +1591,43 @@ def _follow(x, steps, base, arm, act, case, scratch, scale, dscale, length, thre
                 xp[i] = x0[i]
                 tp[i] = t[i]
                 t[i] = t_new[i]
+            _copy_jx(J, J_path)
             lam_p = lam
             lam = target
             reached[0] = lam
+            reached[2] = _distance(t, scratch[1], dscale, length) * (lam + bounds[6])
             dl = _grown(dl, _distance(dx, scratch[1], dscale, length), max_load_step)
         else:
             for i in range(6):
                 x[i] = x0[i]
             dl *= 0.4
-            if dl < _DLAM_MIN:
+            if dl < _smallest_step(bounds, lam):
                 return False
     return True
+
+
+@_jit
+def _path_failure(reached):
+    """The status of a path that could not be followed past reached[0]: PATH_FAILED (a fold)
+    where it was turning (the tip's motion per unit load factor, times the load factor's
+    scale, reached[2], above _FOLD_RATE: dx/dλ grows without bound at a limit point), else
+    PATH_STUCK."""
+    return PATH_FAILED if reached[2] > _FOLD_RATE else PATH_STUCK
+
+
+@_jit
+def _copy_jx(J, out):
+    """out = J[:, :6] (∂r/∂x of a Jacobian with more columns)."""
+    for i in range(6):
+        for k in range(6):
+            out[i, k] = J[i, k]
+
+
+@_jit
+def _smallest_step(bounds, lam):
+    """The shortest load step tried before a path is given up at λ (a fold, or a point it
+    cannot pass): below any step that crosses a singular point (:func:`_cross_step`)."""
+    return max(_DLAM_FLOOR, 0.01 * _cross_step(bounds, lam))
 
 
 @_jit
@@ -1884,7 +2057,10 @@ def solve_cases(base, arm, act, loads, first, options, s_out, memory, inputs, ou
     dx_f = np.empty(6)
     # a Newton step of this size at N leaves an error of about its square: far below tol
     final_step = min(1e-3, math.sqrt(0.01 * tol / length)) if math.isfinite(tol) else 1e-9
-    reached = np.zeros(2)  # the load factor reached, the sign of det ∂r/∂x there
+    # the load factor reached, the sign of det ∂r/∂x there, the motion rate there (_follow)
+    reached = np.zeros(3)
+    J_path = np.empty((6, 6))  # ∂r/∂x at the path's last point
+    guard = _guard_work()
     steps = np.empty(npieces, dtype=np.int64)
     counter = np.zeros(1, dtype=np.int64)
     for b in range(nb):
@@ -2020,7 +2196,7 @@ def solve_cases(base, arm, act, loads, first, options, s_out, memory, inputs, ou
                 coarse = n_path < N  # the last step is corrected on the grid of N
                 if not _follow(x, steps, base, arm, act, case, scratch, scale, dscale, length,
                                threshold, max_iterations, max_load_step, budget, coarse,
-                               final_step, r, J, tip_c, counter, reached):
+                               final_step, r, J, tip_c, counter, reached, J_path):
                     if counter[0] > budget:
                         status[b] = BUDGET
                         break
@@ -2032,16 +2208,18 @@ def solve_cases(base, arm, act, loads, first, options, s_out, memory, inputs, ou
                         failed_at = reached[0]
                         N = 2 * N
                         continue
-                    status[b] = PATH_FAILED
+                    status[b] = _path_failure(reached)
                     break
                 # the coarse solution at N: the end of a path on N steps; from the last
-                # prediction of a path on a coarser grid, a checked Newton
+                # prediction of a path on a coarser grid, a checked Newton, which must not
+                # cross a singular point either (the path's last step)
                 _fill_steps(length, arm[1], N, np.int64(1), steps)
                 if coarse and (not _corrector(x, 1.0, six, steps, base, arm, act, case, scratch,
                                               scale, dscale, length, threshold,
                                               max_iterations, _DIST_MAX, final_step, r, J,
                                               tip_c, counter)
-                               or _det_sign(J) != reached[1]):
+                               or _det_sign(J) != reached[1]
+                               or _crossed(J_path, J, scale, guard) != 0):
                     fine_path = True
                     continue
                 _copy(J, J_c)
@@ -3032,7 +3210,8 @@ _STIFF_STEPS = 0.6  # coarse RK4 steps per unit of kL at least: hk <= 1.7 (RK4 i
 #                    decaying mode e^{-ks} up to hk = 2.78; the error estimate then decides)
 # The smallest load-factor step of the stiff path: the path from the unloaded arm bends
 # sharply near λ = 0 (k grows like √λ: the predicted lateral motion at λ = 0 is that of an
-# arm without tension), so steps far below _DLAM_MIN are needed there, doubling from then on.
+# arm without tension), so steps far below a single-shooting path's are needed there,
+# doubling from then on.
 _DLAM_MIN_STIFF = 1e-12
 # The corrector's contraction test with contact: Newton on a penalty contracts slowly until
 # it is within the band of the answer (a contact that closes between prediction and answer).
@@ -3489,24 +3668,53 @@ def _loose(act, length):
 
 
 @_jit
+def _ms_condensed(B, n, piv, Lm, v, P):
+    """P (6 × 6): the block of B⁻¹ from the tip residual's rows to the base reaction's
+    columns, i.e. the inverse of ∂r/∂x condensed onto the base reaction (single shooting's
+    Jacobian, in the band's scaled units), by six band solves with B's factors. False if
+    they fail. (Its eigenvalues' ratios between two points are the branch guard's
+    :func:`_crossings`; formed only where the arm is not in strong tension, whose growing
+    Jacobi fields make it ill-conditioned.)"""
+    for k in range(6):
+        for i in range(n):
+            v[i] = 0.0
+        v[n - 6 + k] = 1.0
+        if not _band_solve(B, n, np.int64(_BAND), piv, Lm, v):
+            return False
+        for i in range(6):
+            P[i, k] = v[i]
+    return True
+
+
+@_jit
 def _ms_follow(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, colscale, rowscale,
                work, w, length, threshold, max_iterations, max_load_step, max_shootings, final,
                tip, counter, reached, lam0, end):
     """:func:`_follow` on the block system: the path from λ = lam0 (x, Z: the solution there,
     exact or close) to λ = ``end``, predicted along the tangent -J⁻¹ ∂F/∂λ, corrected by
-    :func:`_ms_corrector`, with the same step control and branch guards (the sign of the
-    whole banded Jacobian's determinant, the tip's direction of motion). True on success
+    :func:`_ms_corrector`, with the same step control and branch guards: the sign of the
+    whole banded Jacobian's determinant, the tip's direction of motion and, while the
+    path's phase is at most _PHASE_TESTED (:func:`_phase`), the crossings of the condensed
+    Jacobian (:func:`_ms_condensed`) and the phase's advance per step. True on success
     (x, Z at λ = end, the band factors there); else reached[0] is the last load factor
-    reached."""
+    reached and reached[2] the motion rate there (:func:`_follow`)."""
     B, G, piv, Lm, du, motion = work[1], work[2], work[5], work[6], work[7], work[8]
     n = 12 * M - 6
     nt = M - M + _COLS  # (a variable: one compiled version of the callees)
     reached[0] = lam0
+    reached[2] = 0.0
     ok, sign, dist = _ms_corrector(x, Z, M, lam0, nt, chunks, first, csteps, base, arm, act, case,
                              scratch, colscale, rowscale, work, w, length, threshold,
                              max_iterations, _REFINE_MAX, _LOOSE, tip, counter)
     if not ok:
         return False
+    bounds = np.empty(7)
+    _path_bounds(arm, act, case, arm[7], bounds)
+    guard = _guard_work()
+    P_prev = np.empty((6, 6))
+    P_new = np.empty((6, 6))
+    v = np.empty(n)
+    tested = _phase(bounds, lam0) <= _PHASE_TESTED and _ms_condensed(B, n, piv, Lm, v, P_prev)
     t = np.empty(n)
     for i in range(n):
         t[i] = -G[i]
@@ -3526,7 +3734,7 @@ def _ms_follow(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, co
     while lam < end:
         if counter[0] > max_shootings:
             return False
-        dl, target = _load_step(lam, dl, end)
+        dl, target = _load_step(lam, _phase_limited(bounds, lam, dl), end)
         _copy(x, x_keep)
         _copy(Z, Z_keep)
         for i in range(n):
@@ -3540,15 +3748,23 @@ def _ms_follow(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, co
             for i in range(n):
                 du[i] = -G[i]
             ok = _band_solve(B, n, np.int64(_BAND), piv, Lm, du)
+        check = False  # the condensed Jacobian's crossings: only where it is well conditioned
         if ok:
+            check = (tested and _phase(bounds, target) <= _PHASE_TESTED
+                     and _ms_condensed(B, n, piv, Lm, v, P_new))
             _ms_motion(scratch[1], M, du, colscale, 1.0, motion_new)
-            # (with contact the tip turns where it touches: only det's sign guards)
-            ok = dl <= _DLAM_CROSS or (new_sign == sign and (
+            crossing = new_sign != sign or (
+                check and _crossings(P_new, P_prev, np.int64(6), guard[2], guard[3], 0.0) != 0)
+            # (with contact the tip turns where it touches: only the singular points guard)
+            ok = dl <= _cross_step(bounds, lam) or (not crossing and (
                 _cosine(motion_prev, motion_new) >= 0.5
                 or (act is not None and act[5].shape[0] > 0)))
         if ok:
             sign = new_sign
             reached[1] = sign
+            tested = check
+            if check:
+                _copy(P_new, P_prev)
             for i in range(3):
                 motion_prev[i] = motion_new[i]
             # (dist: the corrector's distance from the prediction, the step control's measure)
@@ -3556,12 +3772,14 @@ def _ms_follow(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, co
                 t[i] = du[i]
             lam = target
             reached[0] = lam
+            reached[2] = _ms_distance(t, n, scratch[1], M, colscale, w, length,
+                                      motion) * (lam + bounds[6])
             dl = _grown(dl, dist, max_load_step)
         else:
             _copy(x_keep, x)
             _copy(Z_keep, Z)
             dl *= 0.4
-            if dl < _DLAM_MIN_STIFF:
+            if dl < min(_DLAM_MIN_STIFF, _smallest_step(bounds, lam)):
                 return False
     return True
 
@@ -3872,7 +4090,7 @@ def solve_stiff_cases(base, arm, act, loads, options, s_out, out, verdicts, inpu
     tip_rate = np.zeros((7, TIP_LOADS))
     case = (start, rate, tip_start, tip_rate)
     final_step = min(1e-3, math.sqrt(0.01 * tol / length)) if math.isfinite(tol) else 1e-9
-    reached = np.zeros(2)
+    reached = np.zeros(3)
     counter = np.zeros(1, dtype=np.int64)
     x = np.zeros(6)
     x_f = np.zeros(6)
@@ -3927,7 +4145,7 @@ def solve_stiff_cases(base, arm, act, loads, options, s_out, out, verdicts, inpu
                         failed_at = reached[0]
                         N = 2 * N
                         continue
-                    status[b] = PATH_FAILED
+                    status[b] = _path_failure(reached)
                     break
                 path = False
             if counter[0] > budget:

@@ -845,7 +845,7 @@ class PreparedSolve:
             solver.reset()
             self._last = None
             error = _failure(k, 0, (), status, self._outs[3], solver, near is not None)
-            if status[0] == k.PATH_FAILED and near is None:
+            if status[0] in (k.PATH_FAILED, k.PATH_STUCK) and near is None:
                 error = _tendon_limit(solver, self.loads_at(self.inputs), (), 0, None,
                                       error.residual) or error
             raise error
@@ -1364,7 +1364,7 @@ class Solver:
                                    outputs=outputs, checked=True,
                                    contact_retry=(None, 0, widened + 1))
             error = _failure(k, failed[0], shape, status, info, self, near)
-            if status[failed[0]] == k.PATH_FAILED and not near:
+            if status[failed[0]] in (k.PATH_FAILED, k.PATH_STUCK) and not near:
                 error = _tendon_limit(self, loads, shape, int(failed[0]),
                                       None if chained else info[failed[0], 2],
                                       error.residual) or error
@@ -1752,7 +1752,7 @@ def _failure(k, b, shape, status, info, solver, near=False) -> ConvergenceError:
     residual, estimate, reached, shootings, N = info[b]
     code = int(status[b])
     tried = f"{int(shootings)} shootings, {2 * int(N)} RK4 steps"
-    if near and code in (k.PATH_FAILED, k.NEWTON_FAILED):
+    if near and code in (k.PATH_FAILED, k.PATH_STUCK, k.NEWTON_FAILED):
         return ConvergenceError(
             "Solver.solve_near found no equilibrium of these loads near the given base "
             "reaction (neither the correction from it nor the path from its own loads "
@@ -1766,9 +1766,15 @@ def _failure(k, b, shape, status, info, solver, near=False) -> ConvergenceError:
     if code == k.PATH_FAILED:
         return ConvergenceError(
             f"the loading path could not be followed beyond load factor λ = {reached:.6g}"
-            f"{where}: a limit point (fold) where the arm would snap to another shape, or a "
-            "point where the equilibrium is not unique", residual, tried,
-            load_factor=float(reached))
+            f"{where}: a limit point (fold), where the path turns back and the arm would snap "
+            "to another shape (softarm.continuation follows the branch around it)", residual,
+            tried, load_factor=float(reached))
+    if code == k.PATH_STUCK:
+        return ConvergenceError(
+            f"the loading path could not be followed beyond load factor λ = {reached:.6g}"
+            f"{where}, where it does not turn (not a fold): the solver cannot resolve the arm "
+            "there (Newton's method does not converge however short the load step)",
+            residual, tried, load_factor=float(reached))
     if code == k.BUDGET:
         return ConvergenceError(
             f"the shooting budget max_shootings={solver.max_shootings} ran out{where} with the "
