@@ -7,7 +7,6 @@ this module is the only place that knows both.
 from __future__ import annotations
 
 import dataclasses
-import math
 import warnings
 
 import numpy as np
@@ -176,9 +175,11 @@ def solve_stable(solver: Solver, loads, imperfection=None, *, max_switches=4):
         indices, critical = new.index, new.critical
         points = np.column_stack([np.asarray(new.x) / path.xscale, new.lam])
     if indices[-1] != 0 or abs(points[-1, 6] - 1.0) > 1e-12:
+        # (the residual of the branch's last point, in N and N m: an equilibrium, unstable)
+        residual = float(np.max(np.abs(path.residual(points[-1])[0] * path.xscale)))
         raise ConvergenceError(
             f"no stable equilibrium was reached under the full load (the branch followed has "
-            f"Morse index {int(indices[-1])} at λ = {points[-1, 6]:.6g})", math.nan)
+            f"Morse index {int(indices[-1])} at λ = {points[-1, 6]:.6g})", residual)
     return solver.solve_near(loads, path.x(points[-1]), path.n)
 
 

@@ -172,6 +172,16 @@ def _tip_residual(rho, ca, sa, sqrt_k, e):
 
 
 @_jit
+def _newton_step(residual, slope):
+    """residual / slope, or inf (a bisection step, never a converged one) where the slope is
+    not a positive finite number: at ρ near ±700 an underflowed cos χ can make it inf, and
+    the step then came out 0 (taken as converged, far from the root)."""
+    if slope > 0.0 and math.isfinite(slope):
+        return residual / slope
+    return math.inf
+
+
+@_jit
 def _solve_tip(ca, sa, sqrt_k, e):
     """ρ_0 of the tip condition by ``_elastica_math._newton``'s safeguarded iteration."""
     tol = 4.0 * _EPS
@@ -183,7 +193,7 @@ def _solve_tip(ca, sa, sqrt_k, e):
             lo = x
         else:
             hi = x
-        step = residual / slope
+        step = _newton_step(residual, slope)
         newton = x - step
         size, scale = abs(step), tol * max(1.0, abs(x))
         last = size <= scale
@@ -211,7 +221,7 @@ def _station(target, mc, rho_tip, start):
             lo = x
         else:
             hi = x
-        step = residual / slope
+        step = _newton_step(residual, slope)
         newton = x - step
         size, scale = abs(step), tol * max(1.0, abs(x))
         last = size <= scale or size * size <= scale

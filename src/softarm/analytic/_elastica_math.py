@@ -228,7 +228,10 @@ def _newton(residual_and_slope, x, lo, hi, curvature=None):
             below = residual < 0.0
             lo = np.where(below, x, lo)
             hi = np.where(below, hi, x)
-            step = residual / slope
+            # (a slope that is not a positive finite number, e.g. inf from an underflowed
+            # cos χ, gives an infinite step: a bisection, never a converged step of 0)
+            usable = (slope > 0.0) & np.isfinite(slope)
+            step = np.where(usable, residual / np.where(usable, slope, 1.0), np.inf)
             newton = x - step
             size, scale = np.abs(step), tol * np.maximum(1.0, np.abs(x))
             last = size <= scale
