@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
 import mpmath as mp
 import numpy as np
 import pytest
@@ -402,3 +405,20 @@ def test_invalid_inputs(kwargs, match):
     args = {"k": 1.0, "phi": 1.0, "s_over_L": [0.0, 1.0], **kwargs}
     with pytest.raises(ValueError, match=match):
         planar_elastica(args.pop("k"), args.pop("phi"), args.pop("s_over_L"), **args)
+
+
+def test_a_slope_that_overflows_is_bisected_not_taken_as_converged():
+    """k = 30 at 179.95° (issue 42's grid): the tip condition's first Newton step lands at
+    ρ ≈ 378, where the slope comes out infinite; the step residual/slope = 0 was taken as
+    converged and every position was NaN. Both routes now agree with the pseudo-arclength
+    reference of that grid (tests/data/near_axial_paths.json, the planar path followed from
+    the unloaded arm, with EA = GA = 1e12 EI/L²: inextensible to 1e-11)."""
+    cases = json.loads((Path(__file__).parents[1] / "data" / "near_axial_paths.json")
+                       .read_text())["cases"]
+    stored = next(c for c in cases if c["angle_deg"] == 179.95 and c["magnitude"] == 30.0)
+    phi = np.radians(179.95)
+    lone = planar_elastica(30.0, phi, np.array([0.0, 1.0]))
+    batch = planar_elastica(np.array([30.0]), np.array([phi]), np.array([0.0, 1.0]))
+    for sol in (lone, batch):
+        tip = np.array([np.ravel(sol.x)[-1], np.ravel(sol.z)[-1]])
+        np.testing.assert_allclose(tip, stored["tip"], rtol=0, atol=1e-9)
