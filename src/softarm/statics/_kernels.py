@@ -2436,6 +2436,23 @@ def _small_solve(A, B, n, work, out):
 
 
 @_jit
+def _discs_right_of(M, n, edge):
+    """True if every eigenvalue of M (n × n) has a real part >= ``edge`` by Gershgorin's
+    theorem: every row's disc (centre M_ii, radius Σ_j≠i |M_ij|) lies right of it, or every
+    column's. A cheap sufficient test, before the eigenvalues."""
+    rows = cols = True
+    for i in range(n):
+        r = c = 0.0
+        for j in range(n):
+            if j != i:
+                r += abs(M[i, j])
+                c += abs(M[j, i])
+        rows = rows and M[i, i] - r >= edge
+        cols = cols and M[i, i] - c >= edge
+    return rows or cols
+
+
+@_jit
 def _crossings(old, new, n, work, M, floor):
     """How many zeros of det Θ lie between two consecutive points of the sweep, with their
     multiplicity: the eigenvalues of Θ_old⁻¹ Θ_new with a negative real part. Away from a
@@ -2452,7 +2469,7 @@ def _crossings(old, new, n, work, M, floor):
         for k in range(n):
             e = M[i, k] - (1.0 if i == k else 0.0)
             dist += e * e
-    if dist < _NEAR_IDENTITY * _NEAR_IDENTITY:
+    if dist < _NEAR_IDENTITY * _NEAR_IDENTITY or _discs_right_of(M, n, -floor):
         return 0
     C = np.empty((n, n), dtype=np.complex128)
     for i in range(n):
