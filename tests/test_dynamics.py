@@ -62,6 +62,34 @@ def test_a_base_accelerating_upwards_is_gravity_downwards():
     assert np.abs(carried - heavy.positions).max() < 1e-5 * HEAVY.length
 
 
+def test_a_base_function_is_never_called_before_the_start():
+    """Issue 42: the base's velocity at the start was a central difference, calling the
+    user's function at t = -1e-6 s, before the motion exists (a trajectory read from a
+    table, a spline). The start's is one-sided now: every call at t >= the start, with a
+    Python float. The reference: the base accelerating from rest at t = 0 moves the tip as
+    gravity -a does (test_a_base_accelerating_upwards_is_gravity_downwards, 1e-5 L)."""
+    a, calls = 3.0, []
+
+    def base(t):
+        calls.append(t)
+        if t < 0.0:
+            raise ValueError("no motion before t = 0")
+        pose = np.eye(4)
+        pose[2, 3] = 0.5 * a * t * t
+        return pose
+
+    moving = simulate(HEAVY, [], duration=0.05, dt=1e-3, stations=21, base=base, tol=1e-10)
+    assert min(calls) == 0.0 and all(type(t) is float for t in calls)
+    heavy = simulate(HEAVY, [Gravity([0.0, 0.0, -a])], duration=0.05, dt=1e-3, stations=21,
+                     tol=1e-10)
+    carried = moving.positions - (0.5 * a * moving.times**2)[:, None, None] * [0, 0, 1]
+    assert np.abs(carried - heavy.positions).max() < 1e-5 * HEAVY.length
+    calls.clear()  # continued from a state at t = 0.05 s: nothing before it either
+    simulate(HEAVY, [], duration=0.002, dt=1e-3, stations=21, base=base, tol=1e-10,
+             initial=moving.final)
+    assert min(calls) >= 0.05
+
+
 @pytest.mark.parametrize("damped", [False, True])
 def test_the_energy_of_a_released_arm_is_kept_over_20_periods(damped):
     period = _first_period(SHORT)

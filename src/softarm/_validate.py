@@ -256,15 +256,16 @@ def nonnegative(value, name: str, unit: str) -> float:
 
 def _not_below_zero(value, name: str, unit: str, *, zero: bool) -> float:
     what = "a finite value >= 0" if zero else "a positive finite value"
+    in_unit = f" in {unit}" if unit else ""
     try:
         number = real(value, name, unit)
     except TypeError:
-        raise TypeError(f"{name} must be {'a number >= 0' if zero else 'a positive number'} "
-                        f"in {unit}, got {_kind(value)} ({format_value(value, 40)})") from None
+        raise TypeError(f"{name} must be {'a number >= 0' if zero else 'a positive number'}"
+                        f"{in_unit}, got {_kind(value)} ({format_value(value, 40)})") from None
     except ValueError:
         number = math.nan
     if not (number >= 0 if zero else number > 0):
-        raise ValueError(f"{name} must be {what} in {unit}, got {format_value(value)}")
+        raise ValueError(f"{name} must be {what}{in_unit}, got {format_value(value)}")
     return number
 
 

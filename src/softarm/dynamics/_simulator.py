@@ -54,12 +54,12 @@ class Damping:
     def __post_init__(self):
         if (self.retardation is None) == (self.matrix is None):
             raise ValueError("Damping takes exactly one of retardation= (τ in s) or matrix= "
-                             f"(6 × 6 B), got retardation={self.retardation!r}, "
+                             f"(6 × 6 B), got retardation={format_value(self.retardation)}, "
                              f"matrix={format_value(self.matrix)}")
         if self.retardation is not None:
             tau = real(self.retardation, "Damping.retardation", "s")
             if not tau >= 0.0:
-                raise ValueError(f"Damping.retardation must be >= 0 s, got {tau!r}")
+                raise ValueError(f"Damping.retardation must be >= 0 s, got {format_value(tau)}")
             object.__setattr__(self, "retardation", tau)
         else:
             B = as_matrices(self.matrix, "Damping.matrix", 6, 6)
@@ -189,7 +189,7 @@ class Simulator:
         self.dt = positive(dt, "dt", "s")
         self.alpha = real(alpha, "alpha")
         if not -0.5 <= self.alpha <= 0.0:
-            raise ValueError(f"alpha must lie in [-0.5, 0] (BDF-α), got {alpha!r}")
+            raise ValueError(f"alpha must lie in [-0.5, 0] (BDF-α), got {format_value(alpha)}")
         self.tol = check_tol(tol)
         stations = count(stations, "stations", 3)
         if damping is not None and not isinstance(damping, Damping):
@@ -286,8 +286,8 @@ class Simulator:
                     "dynamics needs the arm's mass and rotary inertia: give the material a "
                     "density, or mass_per_length and inertia_per_length to an arm built "
                     f"from its stiffnesses (segment {int(pieces[12][j])} has "
-                    f"mass_per_length={mu!r}, inertia_per_length="
-                    f"{None if inertia is None else inertia.tolist()!r})")
+                    f"mass_per_length={format_value(mu)}, inertia_per_length="
+                    f"{format_value(None if inertia is None else inertia.tolist())})")
             B = (self.damping.matrix_for(K) if self.damping is not None
                  else np.zeros((6, 6)))
             props[j, k._PK:k._PK + 36] = K.ravel()
@@ -331,23 +331,30 @@ class Simulator:
             return rows
         d = _BASE_DIFFERENCE * self.dt
         for i, t in enumerate(times):
+            t = float(t)
             pose = self._base_at(t)
-            before, after = self._base_at(t - d), self._base_at(t + d)
+            if t - d >= self.t0:  # a central difference
+                rate = (self._base_at(t + d) - self._base_at(t - d)) / (2 * d)
+            else:  # at the start: one-sided, of second order too (never called before it)
+                rate = (4.0 * self._base_at(t + d) - self._base_at(t + 2 * d)
+                        - 3.0 * pose) / (2 * d)
             R = pose[:3, :3]
             rows[0, i, :3] = pose[:3, 3]
             rows[0, i, 3:12] = R.ravel()
-            rows[0, i, 12:15] = R.T @ ((after[:3, 3] - before[:3, 3]) / (2 * d))
-            W = R.T @ ((after[:3, :3] - before[:3, :3]) / (2 * d))
+            rows[0, i, 12:15] = R.T @ rate[:3, 3]
+            W = R.T @ rate[:3, :3]
             rows[0, i, 15:18] = 0.5 * np.array([W[2, 1] - W[1, 2], W[0, 2] - W[2, 0],
                                                 W[1, 0] - W[0, 1]])
         return rows
 
     def _base_at(self, t: float) -> np.ndarray:
+        """The user's base pose at time ``t`` (s, a Python float, never before the start)."""
         try:
             pose = self._motion(t)
         except Exception as error:
-            raise ValueError(f"base({t!r}) raised {type(error).__name__}: {error}") from None
-        return rigid_transform(pose, f"base({t!r})")
+            raise ValueError(f"base({format_value(t)}) raised {type(error).__name__}: "
+                             f"{error}") from None
+        return rigid_transform(pose, f"base({format_value(t)})")
 
     def _initial_arrays(self, initial) -> tuple:
         """(Z, Zold, H, aux) of the initial state: a State's own; or at rest: the unloaded
@@ -604,7 +611,7 @@ class Simulator:
         values after it are NaN, ``Trajectory.failed`` marks it and :attr:`failures` says
         when and with what residual (later runs skip it)."""
         if failures not in ("raise", "keep"):
-            raise ValueError(f"failures must be 'raise' or 'keep', got {failures!r}")
+            raise ValueError(f"failures must be 'raise' or 'keep', got {format_value(failures)}")
         steps = count(steps, "steps", 1)
         B = int(np.prod(self.shape))
         first = self.state
@@ -690,7 +697,7 @@ class Simulator:
                 try:
                     rows.append(self._checked_inputs(inputs(float(t)), 1))
                 except ValueError as error:
-                    raise ValueError(f"inputs({float(t)!r}): {error}") from None
+                    raise ValueError(f"inputs({format_value(float(t))}): {error}") from None
             widest = max(row.shape[0] for row in rows)
             return np.concatenate([np.broadcast_to(row, (widest, 1, row.shape[2]))
                                    for row in rows], axis=1)
