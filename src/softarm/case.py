@@ -792,6 +792,7 @@ def simulation_parts(case: Case, *, seconds: float = 0.25) -> Iterator[Trajector
     """
     simulator, inputs = _simulator(case)
     total = case.simulation.steps
+    simulator._check_run(total, "simulate")  # (the chunks are joined: the whole trajectory)
     done, chunk = 0, 1
     while done < total:
         steps = min(chunk, total - done)

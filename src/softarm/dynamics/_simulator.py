@@ -10,6 +10,7 @@ import numpy as np
 from .._threads import in_threads, threads_for
 from .._validate import (
     as_matrices,
+    check_allocation,
     count,
     format_value,
     positive,
@@ -101,6 +102,20 @@ def _actuator_loads(actuators) -> tuple:
     return actuators
 
 
+def _node_bytes() -> tuple[int, int]:
+    """(the state of one case, the step's factorisation) per node, bytes: the node's state
+    Z, its two past states and its history H, float64, held up to nine times over a step
+    (the initial state, the current one, a step's working copy, the last and the new
+    State's, their stacks and temporaries) with the outputs at the stations (30 numbers,
+    twice); the banded Jacobian's rows (DUNK a node: 3 KL + 1 columns of the band, KL of
+    the multipliers, a pivot). Measured (tracemalloc and the peak resident memory): 24.5 kB
+    a node over the steps of one case, 1.8 kB after construction (tests/test_memory.py)."""
+    k = _kernels()
+    state = 8 * (9 * (3 * k.DYN + k.DHIST) + 2 * 30)
+    storage = 8 * k.DUNK * ((3 * k._DKL + 1) + k._DKL + 1)
+    return state, storage
+
+
 def _check_base(base):
     """(callable t -> (4, 4) pose or None, the fixed pose)."""
     if base is None:
@@ -119,17 +134,24 @@ def _grid(length: float, starts: np.ndarray, count_: int):
     ends = np.append(starts[1:], length)
     nodes, piece = [], []
     for j, (a, b) in enumerate(zip(starts, ends, strict=True)):
-        inside = s_out[(s_out > a) & (s_out < b)]
+        # the stations strictly inside (a, b): s_out is sorted (a search, not a scan per piece)
+        inside = s_out[np.searchsorted(s_out, a, "right"):np.searchsorted(s_out, b, "left")]
         here = np.concatenate([[a], inside, [b]])
         nodes.append(here)
         piece.append(np.full(here.size, j))
-    s = np.concatenate(nodes)
+    s = np.concatenate(nodes)  # (non-decreasing: a joint's node twice)
     node_piece = np.concatenate(piece).astype(np.int64)
     h = np.diff(s)
     h[h < 1e-12 * length] = 0.0
-    at = np.array([np.flatnonzero(np.abs(s - x) <= 1e-12 * length)[0] for x in s_out],
-                  dtype=np.int64)
-    return s, h, node_piece, at, s_out
+    # each station's node: the first within 1e-12 L of it, found by bisection in O(S log G)
+    # (a scan of every node per station was quadratic: 17 s at 1e5 stations)
+    tol = 1e-12 * length
+    at = np.searchsorted(s, s_out - tol, "left")
+    earlier = (at > 0) & (np.abs(s[np.maximum(at - 1, 0)] - s_out) <= tol)  # (rounding)
+    at = np.where(earlier, at - 1, at)
+    if not np.all(np.abs(s[np.minimum(at, s.size - 1)] - s_out) <= tol):
+        raise AssertionError("a station without its node")  # pragma: no cover
+    return s, h, node_piece, at.astype(np.int64), s_out
 
 
 class Simulator:
@@ -229,6 +251,14 @@ class Simulator:
                             channels.tip_loads - self.inputs @ unit_tip[-n:])
         self._motion, self._pose = _check_base(base)
         self.length = self._solver.length
+        # the memory of the state and of a run's factorisations (a thread's each), before
+        # anything of the stations' size is allocated (10⁹ stations: a ValueError, not an OOM)
+        cases = int(np.prod(shape))
+        state, storage = _node_bytes()
+        threads = threads_for(cases, 1)
+        check_allocation(cases, stations + 2 * pieces[0].size, "stations",
+                         per_station=state + storage * threads / cases, per_case=0.0,
+                         hint="simulate fewer cases or stations at a time")
         s, h, node_piece, at, s_out = _grid(self.length, pieces[0], stations)
         self.s = s_out
         if self._contact is not None:
@@ -455,17 +485,18 @@ class Simulator:
         k = _kernels()
         routes, active = self._act[0], self._act[2]
         out = np.zeros((H.shape[0], self._tendon_columns.size))
-        eps = H[..., 0:6]
+        v, u = H[..., 0:3], H[..., 3:6]
         for i, a in enumerate(self._tendon_columns):
+            on = np.flatnonzero(active[self._node_piece, a] != 0.0)
+            # the path's offset and slope at the nodes where it runs (the kernel's own route
+            # function, node by node), then |w| for every node and case at once
+            y, z, dy, dz = np.array([k._route(routes, np.int64(a), float(s))
+                                     for s in self._nodes[on]]).reshape(-1, 4).T
+            vn, un = v[:, on], u[:, on]
             w = np.zeros((H.shape[0], self._nodes.size))
-            for n, (s, j) in enumerate(zip(self._nodes, self._node_piece, strict=True)):
-                if active[j, a] == 0.0:
-                    continue
-                y, z, dy, dz = k._route(routes, np.int64(a), float(s))
-                v, u = eps[:, n, :3], eps[:, n, 3:]
-                w[:, n] = np.sqrt((v[:, 0] + u[:, 1] * z - u[:, 2] * y) ** 2
-                                  + (v[:, 1] - u[:, 0] * z + dy) ** 2
-                                  + (v[:, 2] + u[:, 0] * y + dz) ** 2)
+            w[:, on] = np.sqrt((vn[..., 0] + un[..., 1] * z - un[..., 2] * y) ** 2
+                               + (vn[..., 1] - un[..., 0] * z + dy) ** 2
+                               + (vn[..., 2] + un[..., 0] * y + dz) ** 2)
             out[:, i] = np.sum(0.5 * self._h * (w[:, :-1] + w[:, 1:]), axis=1)
         return out
 
@@ -581,7 +612,11 @@ class Simulator:
         solved: the simulator's state (and inputs) are then unchanged."""
         q = self._q if inputs is None else self._checked_inputs(inputs, 1)[:, 0]
         if self._factors is None:  # (kept between steps: the chord iteration's factors)
-            self._factors = [*self._storage(True, int(np.prod(self.shape))), None]
+            cases = int(np.prod(self.shape))
+            check_allocation(cases, self._nodes.size, "step", per_station=_node_bytes()[1],
+                             per_case=0.0, hint="step fewer cases at a time, or run() them "
+                             "(its threads share their factorisations)")
+            self._factors = [*self._storage(True, cases), None]
         arrays = tuple(a.copy() for a in self._arrays)
         times, out, _, info, done = self._advance(
             1, self._factors, arrays=arrays, inputs=None if q is None else q[:, None])
@@ -613,6 +648,7 @@ class Simulator:
         if failures not in ("raise", "keep"):
             raise ValueError(f"failures must be 'raise' or 'keep', got {format_value(failures)}")
         steps = count(steps, "steps", 1)
+        self._check_run(steps, "run")
         B = int(np.prod(self.shape))
         first = self.state
         threads = threads_for(B, 1)
@@ -642,6 +678,19 @@ class Simulator:
         self._state = None  # (the final state is made from the new arrays)
         start = self._record_now(initial=first)
         return self._trajectory(first, times, out, energy, info, start)
+
+    def _check_run(self, steps: int, name: str) -> int:
+        """ValueError (check_allocation's) if the trajectory of ``steps`` steps cannot fit in
+        memory: per case, step and station the kernel's outputs (30 numbers), joined to the
+        first step's (a start at rest) and copied into the trajectory (three copies at
+        most); per case and step its energies, errors, iterations, tendon lengths and
+        inputs (several copies). Else the bytes."""
+        tendons = 0 if self._act is None else max(1, self._act[0].shape[0])
+        per_step = 8 * (2 * 4 + 4 + 2 + 3 * tendons + 2 * self.inputs.size + 1)
+        return check_allocation(int(np.prod(self.shape)), self._at.size, f"{name}({steps} steps)",
+                         per_station=3 * 30 * 8 * float(steps),
+                         per_case=float(per_step) * steps,
+                         hint="run fewer steps at a time (each run continues from the last)")
 
     def _case(self, b: int) -> tuple[int, ...]:
         """The batch index of flat case ``b``."""
