@@ -139,6 +139,13 @@ def test_the_table_defaults_are_softarm_simulate_s():
     ("[simulate]\nduration = 0.02\ndt = 0.001\n[[simulate.input]]\nload = 2\n"
      "times = [0, 1]\nvalues = [[1, 2], [3, 4]]", "simulate.input[1].values: load 2 (tendon) "
      "has 1 input (tension); give one number per time, got 2"),
+    # issue 42: a schedule's values obey the load's own rules (the words of Tendon(-1.5))
+    ("[simulate]\nduration = 0.02\ndt = 0.001\n[[simulate.input]]\nload = 2\n"
+     "times = [0, 0.01]\nvalues = [0, -1.5]", "simulate.input[1].values: at t = 0.01 s: "
+     "Tendon.tension must be >= 0 N (a tendon cannot push), got -1.5"),
+    ("[simulate]\nduration = 0.02\ndt = 0.001\n[[simulate.input]]\nload = 2\n"
+     "times = [0, 0.01]\nvalues = [0, 1e200]", "simulate.input[1].values: at t = 0.01 s: "
+     "Tendon.tension: a load of 1e+200 N is not representable on this arm"),
     ("[simulate]\nduration = 0.02\ndt = 0.001\n[[simulate.input]]\nload = 2\ntimes = [0]\n"
      "values = [1]\n[[simulate.input]]\nload = 2\ntimes = [0]\nvalues = [2]",
      "simulate.input[2].load: load 2 has a schedule already (simulate.input[1])"),

@@ -19,7 +19,7 @@ from .._validate import (
 )
 from ..equilibrium import Equilibrium, _frozen
 from ..errors import ConvergenceError
-from ..loads import Gravity, as_actuators, as_loads
+from ..loads import Gravity, InputRules, as_actuators, as_loads
 from ..statics import Solver
 from ..statics.solver import _kernels, check_tol
 from ._results import Energy, State, Trajectory
@@ -221,6 +221,8 @@ class Simulator:
         self.actuators = _actuator_loads(actuators)
         self._solver = Solver(arm, s=2, stability=False)
         self.arm = self._solver.arm
+        #: the inputs' rules: the statics' (a tendon cannot push) and their size limit
+        self._rules = InputRules(self.arm, self.actuators)
         everything = [*as_loads(loads), *self.actuators]
         cuts = ()  # (an initial equilibrium's loads over part of the arm cut it there too)
         if isinstance(initial, Equilibrium) and initial.arm == self._solver.arm:
@@ -712,9 +714,11 @@ class Simulator:
             info[b, first:, 1] = 0.0
         self._failed = failed.reshape(self.shape)
 
-    def _checked_inputs(self, values, rows: int) -> np.ndarray:
+    def _checked_inputs(self, values, rows: int, name: str = "inputs") -> np.ndarray:
         """``values`` as (C, rows, n) finite floats, C = 1 (the same for every case) or the
-        batch's case count (batch axes first), else ValueError naming ``inputs``."""
+        batch's case count (batch axes first), admissible (the loads' own rules and size
+        limit, :class:`~softarm.loads.InputRules`: a tension >= 0, ...), else ValueError
+        naming ``inputs`` (``name``: where they come from, ``inputs(0.002)``)."""
         n = self.inputs.size
         if not n:
             raise ValueError("inputs: these loads have no actuators (give them as "
@@ -735,6 +739,7 @@ class Simulator:
                              + f"got {format_value(values)}")
         if not np.all(np.isfinite(q)):
             raise ValueError(f"inputs must be finite, got {format_value(values)}")
+        self._rules.check(q, name)  # (q as given: the message indexes the user's array)
         cases = 1 if q.shape in one else int(np.prod(self.shape))
         return q.reshape(cases, rows, n)
 
@@ -743,10 +748,12 @@ class Simulator:
         if callable(inputs):
             rows = []
             for t in times:
+                at = f"inputs({format_value(float(t))})"
                 try:
-                    rows.append(self._checked_inputs(inputs(float(t)), 1))
+                    rows.append(self._checked_inputs(inputs(float(t)), 1, at))
                 except ValueError as error:
-                    raise ValueError(f"inputs({format_value(float(t))}): {error}") from None
+                    text = str(error)
+                    raise ValueError(text if text.startswith(at) else f"{at}: {text}") from None
             widest = max(row.shape[0] for row in rows)
             return np.concatenate([np.broadcast_to(row, (widest, 1, row.shape[2]))
                                    for row in rows], axis=1)
