@@ -800,6 +800,10 @@ def simulation_parts(case: Case, *, seconds: float = 0.25) -> Iterator[Trajector
     simulator, inputs = _simulator(case)
     total = case.simulation.steps
     simulator._check_run(total, "simulate")  # (the chunks are joined: the whole trajectory)
+    if inputs is not None:  # one contact law for every chunk, sized for the schedules'
+        # largest inputs (at their knots: piecewise linear) as simulate's for its whole run
+        knots = sorted({0.0, *(t for schedule in case.simulation.inputs for t in schedule.times)})
+        simulator._follow_contact(np.array([inputs(t) for t in knots])[None])
     done, chunk = 0, 1
     while done < total:
         steps = min(chunk, total - done)

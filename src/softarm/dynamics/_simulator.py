@@ -236,6 +236,11 @@ class Simulator:
         #: the contact law of the steps, and the arm's surface radius at the stations
         self._contact = contact
         self._contact_radii = None
+        # the law's estimated stiffness per case before the time step's cap (B,), sized
+        # for the largest inputs given so far (_follow_contact); None: a law of the user's
+        given = channels._contact_given
+        self._contact_sized = None if given is None or given.stiffness is not None else \
+            channels._contact_stiffness(given.band(channels.length))
         self.shape = shape
         self._channels = channels
         self._act = channels.arm_tuple()[1]
@@ -345,6 +350,42 @@ class Simulator:
                    pieces[6], pieces[7], stiffness)
         A = max(1, act[0].shape[0])
         return law_arm, (np.empty((6, 7)), np.zeros((A, 8)), np.zeros((6, 6)), np.zeros((6, 6)))
+
+    def _follow_contact(self, inputs) -> None:
+        """The contact law sized for ``inputs`` (C, ..., n) too, C = 1 or the batch's cases:
+        the penalty's estimated stiffness (the statics' estimate from the loads' size,
+        resolve_contact) of the loads at those inputs, bounded above by |loads at zero
+        inputs| + Σ max|qᵢ| |unit channel i| over the rows, and the law remade (its stiffness
+        and, past the time step's cap μ/Δt², its band: contact.md, "Dynamics") where that
+        is above the law's now. The law only grows: sized at construction for the inputs
+        the actuators had, a law for 0 N let a finger pulled to 15 N pass 34 mm through
+        the cylinder it closes on (issue 42)."""
+        if self._contact_sized is None or not self.actuators:
+            return
+        q = np.abs(np.asarray(inputs, dtype=np.float64))
+        largest = q.reshape(q.shape[0], -1, q.shape[-1]).max(axis=1)  # (C, n)
+        unit, unit_tip = self._unit
+        B = int(np.prod(self.shape))
+        piece = np.broadcast_to(np.abs(self._loads0[0]) + np.einsum(
+            "cn,npw->cpw", largest, np.abs(unit)), self._loads0[0].shape)
+        tip = np.broadcast_to(np.abs(self._loads0[1]) + largest @ np.abs(unit_tip),
+                              self._loads0[1].shape)
+        channels = self._channels
+        band = channels._contact_given.band(channels.length)
+        needed = channels._contact_stiffness(band, piece.reshape(B, *piece.shape[1:]),
+                                             tip.reshape(B, -1))
+        if np.all(needed <= self._contact_sized):
+            return
+        self._contact_sized = np.maximum(self._contact_sized, needed)
+        contact = channels.resolve_contact(self._contact_sized.copy(), dt=self.dt)
+        self.loads = tuple(contact if load.kind == "contact" else load for load in self.loads)
+        self._contact = contact
+        k = _kernels()
+        for array in (self._loads, self._loads0[0]):  # (each case's k in its channel CT)
+            array[:, :, k.CT] = channels.piece[:, :, k.CT]
+        self._act = channels.arm_tuple()[1]  # (the obstacles' rows and the law's band)
+        if self._factors is not None:
+            self._factors[3][:] = 0  # (the step's kept Jacobian is another law's)
 
     @staticmethod
     def _gravity_of(loads, shape) -> np.ndarray:
@@ -613,6 +654,8 @@ class Simulator:
         Raises ConvergenceError (with the step's residual) if a case's step cannot be
         solved: the simulator's state (and inputs) are then unchanged."""
         q = self._q if inputs is None else self._checked_inputs(inputs, 1)[:, 0]
+        if inputs is not None:
+            self._follow_contact(q)
         if self._factors is None:  # (kept between steps: the chord iteration's factors)
             cases = int(np.prod(self.shape))
             check_allocation(cases, self._nodes.size, "step", per_station=_node_bytes()[1],
@@ -659,6 +702,8 @@ class Simulator:
         if self.actuators:
             q = (np.broadcast_to(self._q[:, None], (len(self._q), steps, self.inputs.size))
                  if inputs is None else self._schedule(inputs, times))
+            if inputs is not None:
+                self._follow_contact(q)
         elif inputs is not None:
             raise ValueError("inputs: these loads have no actuators (give them as "
                              f"actuators=...), got {format_value(inputs)}")
