@@ -175,3 +175,32 @@ def test_a_finger_pulled_from_0_to_15_n_stays_outside_the_cylinder():
     # (the chunks restart the chord iteration: the same to the steps' tolerance, 1e-6 L)
     np.testing.assert_allclose(filed.positions, path.positions, rtol=0, atol=1e-6 * 0.12)
     assert filed.contact.distance == pytest.approx(at_15.distance, rel=1e-12)
+
+
+def test_an_arm_starting_inside_an_obstacle_is_refused_as_the_statics_refuse_it():
+    """Issue 42: the dynamics said "a section turned inside out" (a ConvergenceError) for
+    an arm whose start is inside an obstacle. The reference is the statics' refusal of the
+    same arm and obstacle (softarm.solve's ValueError naming the station), and for an
+    initial equilibrium solved without the obstacle, the first of its stations whose
+    surface is inside, found here from softarm.solve's positions by hand."""
+    arm = _arm()  # 0.5 m, radius 10 mm
+    ball = sa.Contact(sa.Sphere((0.3, 0.0, 0.0), 0.05))
+    with pytest.raises(ValueError) as statics:
+        sa.solve(arm, [sa.Gravity(), ball])
+    assert "starts inside an obstacle" in str(statics.value)
+    for make in (lambda: sa.Simulator(arm, [], [sa.Gravity(), ball], dt=1e-3, stations=21),
+                 lambda: sa.simulate(arm, [sa.Gravity(), ball], duration=2e-3, dt=1e-3,
+                                     stations=21)):
+        with pytest.raises(ValueError) as dynamics:
+            make()
+        assert str(dynamics.value) == str(statics.value)
+    # sagging under gravity into a table that the straight arm clears
+    hanging = sa.solve(arm, [sa.Gravity()], s=21, tol=1e-10)
+    table = sa.Contact(sa.Plane((0.0, 0.0, -0.05), (0.0, 0.0, 1.0)))
+    gaps = hanging.positions[:, 2] - 0.01 + 0.05  # (the surface's lowest point)
+    first = int(np.flatnonzero(gaps < -1e-6 * arm.length)[0])
+    with pytest.raises(ValueError) as start:
+        sa.Simulator(arm, [], [sa.Gravity(), table], dt=1e-3, stations=21, initial=hanging)
+    assert str(start.value).startswith(
+        f"Contact: the initial equilibrium starts inside an obstacle (its surface "
+        f"{-gaps[first]:.3g} m deep at station s = {hanging.s[first]:.6g} m)")

@@ -7,6 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._admissible import load_case
 from .._threads import in_threads, threads_for
 from .._validate import (
     as_matrices,
@@ -21,7 +22,7 @@ from ..equilibrium import Equilibrium, _frozen
 from ..errors import ConvergenceError
 from ..loads import Gravity, InputRules, as_actuators, as_loads
 from ..statics import Solver
-from ..statics.solver import _kernels, check_tol
+from ..statics.solver import _check_outside, _kernels, check_tol
 from ._results import Energy, State, Trajectory
 
 __all__ = ["Damping", "Simulator", "simulate"]
@@ -452,8 +453,13 @@ class Simulator:
         pose0 = np.eye(4)
         pose0[:3, 3], pose0[:3, :3] = base0[:3], base0[3:12].reshape(3, 3)
         unique = np.unique(self._nodes)
+        if initial is None and self._contact is not None:  # (the statics' rule and words)
+            _check_outside(Solver(self.arm, s=2, base=pose0, stability=False, tol=self.tol),
+                           self._contact.replace(stiffness=None))
         solver = Solver(self.arm, s=unique, base=pose0, stability=False, tol=1e-10)
         eq = solver.solve_from_unloaded([] if initial is None else initial.loads)
+        if initial is not None and self._contact is not None:
+            self._check_start(eq, unique)
         S = unique.size
         poses = np.broadcast_to(eq.poses, (*self.shape, S, 4, 4)).reshape(B, S, 4, 4)
         stresses = np.broadcast_to(eq.stresses, (*self.shape, S, 6)).reshape(B, S, 6)
@@ -476,6 +482,24 @@ class Simulator:
         H[..., 12:24] = H[..., 0:12]
         H[..., 24:36] = 0.0
         return Z, np.stack([Z, Z], axis=1), H, np.zeros((B, 2))
+
+    def _check_start(self, eq, s) -> None:
+        """ValueError, as the statics' for the unloaded arm (statics.solver._check_outside),
+        if the initial equilibrium ``eq`` (on the nodes ``s``) is inside an obstacle beyond
+        tol·L at some node: a step from there has no answer (Newton fails, and once said
+        "a section turned inside out")."""
+        contact = self._contact._with_checked_stiffness(None)  # (its geometry only)
+        gaps, _ = contact.gaps(eq.positions, contact.station_radii(self.arm, s))
+        inside = gaps < -self.tol * self.length
+        if not inside.any():
+            return
+        flat = int(np.argmax(inside.reshape(-1)))
+        case, station = divmod(flat, s.size)
+        raise ValueError(
+            f"Contact: the initial equilibrium{load_case(case, gaps.shape[:-1])} starts "
+            f"inside an obstacle (its surface {-float(gaps.reshape(-1)[flat]):.3g} m deep at "
+            f"station s = {float(s[station]):.6g} m): no motion from it is defined; move the "
+            "obstacles or the base, or start from another shape")
 
     def _settle(self, initial, Z, H, base0) -> None:
         """Z, H ← the equilibrium of ``initial``'s loads at rest on this grid: the equations
