@@ -758,10 +758,10 @@ class Simulator:
         inputs (several copies). Else the bytes."""
         tendons = 0 if self._act is None else max(1, self._act[0].shape[0])
         per_step = 8 * (2 * 4 + 4 + 2 + 3 * tendons + 2 * self.inputs.size + 1)
-        return check_allocation(int(np.prod(self.shape)), self._at.size, f"{name}({steps} steps)",
-                         per_station=3 * 30 * 8 * float(steps),
-                         per_case=float(per_step) * steps,
-                         hint="run fewer steps at a time (each run continues from the last)")
+        return check_allocation(
+            int(np.prod(self.shape)), self._at.size, f"{name}({steps} steps)",
+            per_station=3 * 30 * 8 * float(steps), per_case=float(per_step) * steps,
+            hint="run fewer steps at a time (each run continues from the last)")
 
     def _case(self, b: int) -> tuple[int, ...]:
         """The batch index of flat case ``b``."""
