@@ -230,15 +230,16 @@ def markdown(steps, swings, peers, batch, theirs, builds=()) -> str:
         lines.append(f"| PyElastica | {setting}, Δt = {dt:.1e} s | {error:.1e} L | "
                      f"{wall:.2f} s | {cpu:.2f} s |")
     b = batch
+    whole = 720 * b["cases"] * b["steps"] * b["stations"] / 1e9  # GB (Simulator._check_run)
     lines += ["", f"Throughput: {b['cases']} trajectories of {b['steps']} steps "
-              f"({b['stations']} stations) in one call: {b['wall_s']:.1f} s wall, "
+              f"({b['stations']} stations), every case in each call: {b['wall_s']:.1f} s wall, "
               f"{b['cpu_s']:.1f} s CPU on {b['threads']} threads "
               f"({b['cpu_per_trajectory_s']:.3f} s CPU a trajectory). A Dask cluster of W "
               f"single-threaded workers would take about {b['cpu_per_trajectory_s']:.3f} × "
               f"cases / W seconds (10⁶ trajectories on 100 workers: "
               f"{b['cpu_per_trajectory_s'] * 1e6 / 100 / 3600:.1f} h), the scheduler's "
-              "overhead aside (docs/scaling.md). The batch runs 50 steps at a time, keeping "
-              "the tips only (all of it at once would hold 30 GB)."]
+              f"overhead aside (docs/scaling.md). The batch runs {CHUNK_STEPS} steps a call, "
+              f"keeping the tips only (the whole trajectories would hold up to {whole:.3g} GB)."]
     if builds:
         lines += ["", "Building a Simulator (a tendon, gravity, a plane) and its first state:",
                   "", "| stations | wall | CPU |", "|---|---|---|"]

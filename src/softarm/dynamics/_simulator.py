@@ -675,8 +675,11 @@ class Simulator:
         in N, pressures in Pa, field components in T, in the order of the actuators' inputs,
         as :class:`~softarm.ForwardSolver`'s; batch axes first to give each case its own),
         kept for the next steps; None: as before (at first, the actuators' own values).
-        Raises ConvergenceError (with the step's residual) if a case's step cannot be
-        solved: the simulator's state (and inputs) are then unchanged."""
+        They obey the statics' rules (:class:`~softarm.loads.InputRules`: finite, a tension
+        >= 0, within the loads' size limit), else ValueError naming the input. Raises
+        ConvergenceError (with the step's residual) if a case's step cannot be solved: the
+        simulator's state (and inputs) are then unchanged. The contact law, if the loads
+        hold one, grows with the inputs (docs/contact.md, "Dynamics")."""
         q = self._q if inputs is None else self._checked_inputs(inputs, 1)[:, 0]
         if inputs is not None:
             self._follow_contact(q)
@@ -707,7 +710,9 @@ class Simulator:
         ``inputs``: the actuators' inputs over time, a callable t -> (n,) or an array
         (steps + 1, n) at the trajectory's times (row 0, the current time, is not used),
         the batch axes first ((B..., n), (B..., steps + 1, n)) to give each case its own;
-        None: constant (as the last step left them).
+        None: constant (as the last step left them). The statics' rules hold for every row
+        (:meth:`step`); the contact law is sized for the largest. A run whose trajectory
+        cannot fit in memory is refused first (ValueError: run fewer steps at a time).
 
         ``failures``: "raise" (default): a case whose step cannot be solved raises a
         ConvergenceError and the simulator's state is unchanged. "keep" (a long batch, a
@@ -948,7 +953,9 @@ def simulate(arm, loads=(), *, duration, dt, actuators=(), inputs=None, damping=
 
     The parameters are :class:`Simulator`'s; ``duration`` (s) must be a whole number of
     steps (to 1e-9). Returns a :class:`Trajectory` of steps + 1 times, the initial state
-    first. Raises ConvergenceError (with the residual) if a step cannot be solved.
+    first. Raises ValueError for bad input (inputs the statics refuse, an arm that starts
+    inside an obstacle, a trajectory that cannot fit in memory: docs/dynamics.md,
+    "Failures"), ConvergenceError (with the residual) if a step cannot be solved.
 
     Examples
     --------
