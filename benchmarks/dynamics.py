@@ -11,8 +11,12 @@
 3. The heavy soft arm swinging over one period (1.5 s) to 1e-3 L of the method-of-lines
    reference (tests/_mol_rod.py): softarm's cheapest setting that reaches it, beside
    PyElastica's settings (benchmarks/dynamics_pyelastica.py; none of them reaches it).
-4. Throughput: a batch of trajectories of 1 s at Δt = 1 ms in one call (threads over the
-   cores), and the projection to a Dask cluster of W workers.
+4. Throughput: a batch of trajectories of 1 s at Δt = 1 ms, all cases in each call (threads
+   over the cores), run in chunks of steps of which only the tips are kept (1000
+   trajectories whole would take 30 GB), and the projection to a Dask cluster of W workers.
+5. Building a Simulator (a tendon, gravity, an obstacle) against its stations, 10³ to
+   4·10⁵: linear (it was quadratic, issue 42: 17 s at 10⁵); 10⁶ stations need more memory
+   for a step than half of a 24 GB machine (25 kB a station) and are refused at once.
 
 CPU time (``process_time``) beside wall time (``perf_counter``), per step or per run; best of
 ``--repeats`` after a warm-up (the compile is not timed). Run::
@@ -154,24 +158,57 @@ def pyelastica_rows() -> list[tuple]:
     return rows
 
 
+#: Steps per run of the throughput batch: its trajectory is 720 B a case, step and station
+#: at most (Simulator._check_run), 1.5 GB for 1000 cases of 41 stations
+CHUNK_STEPS = 50
+
+
 def throughput(cases: int, duration: float, stations: int) -> dict:
-    """A batch of ``cases`` trajectories (different gravity directions) in one call."""
+    """A batch of ``cases`` trajectories (different gravity directions), every case in each
+    call, in runs of :data:`CHUNK_STEPS` steps of which only the tip positions are kept."""
     arm = softarm.Arm(0.5, softarm.Circle(0.02),
                       softarm.Material(1e6, poisson_ratio=0.5, density=1100.0))
     angle = np.linspace(0.0, np.pi / 2, cases)
     g = 9.81 * np.stack([np.zeros(cases), -np.sin(angle), -np.cos(angle)], axis=-1)
     softarm.simulate(arm, [softarm.Gravity(g[:2])], duration=2e-3, dt=1e-3, stations=stations)
+    steps = round(duration / 1e-3)
+    tips = np.empty((cases, steps + 1, 3))
     w0, c0 = time.perf_counter(), time.process_time()
-    path = softarm.simulate(arm, [softarm.Gravity(g)], duration=duration, dt=1e-3,
-                            stations=stations)
+    sim = softarm.Simulator(arm, loads=[softarm.Gravity(g)], dt=1e-3, stations=stations)
+    done = 0
+    while done < steps:
+        part = sim.run(min(CHUNK_STEPS, steps - done))
+        tips[:, done:done + part.times.size] = part.tip_position
+        done += part.times.size - 1
+        del part
     wall, cpu = time.perf_counter() - w0, time.process_time() - c0
-    steps = path.times.size - 1
     return {"cases": cases, "steps": steps, "stations": stations, "wall_s": wall, "cpu_s": cpu,
             "threads": softarm._threads.available_threads(),
             "cpu_per_trajectory_s": cpu / cases}
 
 
-def markdown(steps, swings, peers, batch, theirs) -> str:
+def construction(counts) -> list[tuple]:
+    """Rows (stations, wall s, CPU s) of building a Simulator and reading its first state:
+    the 3-tendon robot's arm with one of its tendons, gravity and a table under it."""
+    robot = actuation.robot()
+    tendon = actuation.loads(np.full(3, 1.0))[1]
+    table = softarm.Contact(softarm.Plane((0.0, 0.0, -0.1), (0.0, 0.0, 1.0)))
+
+    def build(stations):
+        sim = softarm.Simulator(robot, [tendon], [softarm.Gravity(), table], dt=1e-3,
+                                stations=stations)
+        return sim.state
+
+    build(21)  # (compiled)
+    rows = []
+    for stations in counts:
+        w0, c0 = time.perf_counter(), time.process_time()
+        build(stations)
+        rows.append((stations, time.perf_counter() - w0, time.process_time() - c0))
+    return rows
+
+
+def markdown(steps, swings, peers, batch, theirs, builds=()) -> str:
     lines = ["## Dynamics", "",
              "`python benchmarks/dynamics.py`: best of several runs after a warm-up, CPU time "
              "beside wall time. Till & Rucker's C++ (-O3, this machine, "
@@ -193,14 +230,20 @@ def markdown(steps, swings, peers, batch, theirs) -> str:
         lines.append(f"| PyElastica | {setting}, Δt = {dt:.1e} s | {error:.1e} L | "
                      f"{wall:.2f} s | {cpu:.2f} s |")
     b = batch
+    whole = 720 * b["cases"] * b["steps"] * b["stations"] / 1e9  # GB (Simulator._check_run)
     lines += ["", f"Throughput: {b['cases']} trajectories of {b['steps']} steps "
-              f"({b['stations']} stations) in one call: {b['wall_s']:.1f} s wall, "
+              f"({b['stations']} stations), every case in each call: {b['wall_s']:.1f} s wall, "
               f"{b['cpu_s']:.1f} s CPU on {b['threads']} threads "
               f"({b['cpu_per_trajectory_s']:.3f} s CPU a trajectory). A Dask cluster of W "
               f"single-threaded workers would take about {b['cpu_per_trajectory_s']:.3f} × "
               f"cases / W seconds (10⁶ trajectories on 100 workers: "
               f"{b['cpu_per_trajectory_s'] * 1e6 / 100 / 3600:.1f} h), the scheduler's "
-              "overhead aside (docs/scaling.md)."]
+              f"overhead aside (docs/scaling.md). The batch runs {CHUNK_STEPS} steps a call, "
+              f"keeping the tips only (the whole trajectories would hold up to {whole:.3g} GB)."]
+    if builds:
+        lines += ["", "Building a Simulator (a tendon, gravity, a plane) and its first state:",
+                  "", "| stations | wall | CPU |", "|---|---|---|"]
+        lines += [f"| {n:.0e} | {wall:.3f} s | {cpu:.3f} s |" for n, wall, cpu in builds]
     return "\n".join(lines) + "\n"
 
 
@@ -219,7 +262,11 @@ def measure(quick: bool, with_pyelastica: bool = False) -> str:
     peers = pyelastica_rows() if with_pyelastica else []
     batch = throughput(*((20, 0.1, 41) if quick else (1000, 1.0, 41)))
     print(f"  batch: {json.dumps(batch)}", flush=True)
-    return markdown(steps, swings, peers, batch, their_costs())
+    builds = construction((1000, 10_000, 100_000) if quick else
+                          (1000, 10_000, 100_000, 400_000))
+    for stations, wall, cpu in builds:
+        print(f"  build: {stations} stations: {wall:.3f} s wall, {cpu:.3f} s CPU", flush=True)
+    return markdown(steps, swings, peers, batch, their_costs(), builds)
 
 
 def main(argv=None) -> int:

@@ -18,6 +18,7 @@
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -260,6 +261,24 @@ def test_plane_distance_and_the_law():
         left = (pressure(g, delta, k) - pressure(g - h, delta, k)) / h
         right = (pressure(g + h, delta, k) - pressure(g, delta, k)) / h
         assert left == pytest.approx(right, rel=1e-4, abs=1e-3 * k)
+
+
+@pytest.mark.parametrize(("normal", "unit"), [
+    ((0.0, 0.0, 1e300), (0.0, 0.0, 1.0)),  # |n|² overflows
+    ((3e300, -4e300, 0.0), (0.6, -0.8, 0.0)),
+    ((1e-320, 0.0, 1e-320), (0.5**0.5, 0.0, 0.5**0.5)),  # |n|² underflows (subnormals)
+    ((-1.7e308, 0.0, 0.0), (-1.0, 0.0, 0.0)),
+])
+def test_any_finite_nonzero_normal_is_a_direction(normal, unit):
+    """Issue 42: Plane(normal=(0, 0, 1e300)) leaked numpy's overflow warning and stored a
+    zero normal (every point then 'inside'). The reference: n / |n| by hand (3-4-5)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        plane = sa.Plane((0.0, 0.0, -0.05), normal)
+    np.testing.assert_allclose(plane.normal, unit, rtol=0, atol=1e-15)
+    assert np.linalg.norm(plane.normal) == pytest.approx(1.0, abs=1e-15)
+    d, _ = plane.distance([[0.0, 0.0, 0.0]])
+    assert d[0] == pytest.approx(0.05 * unit[2])
 
 
 @pytest.mark.parametrize(("make", "message"), [

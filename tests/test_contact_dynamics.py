@@ -4,6 +4,8 @@ and far obstacles change nothing."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -121,3 +123,84 @@ def test_friction_holds_a_pushed_arm_below_the_cone():
             assert 0.5 * path.contact_wrench[-1, 2] > 10 * 0.02  # μ N: ten times the push
     assert speeds[0.5] < 1e-3  # at most w_ε: stuck (measured 1.3e-4 m/s)
     assert speeds[0.0] > 1e-2  # (measured 2.8e-2 m/s)
+
+
+FINGER = Path(__file__).resolve().parents[1] / "examples" / "gripper_finger.toml"
+
+
+def test_a_finger_pulled_from_0_to_15_n_stays_outside_the_cylinder():
+    """Issue 42: a Simulator built at 0 N sized its penalty for 0 N, and the finger of
+    examples/gripper_finger.toml, its tendon ramped to 15 N, went 34 mm through the
+    cylinder. The law follows the inputs now (a step's, a run's whole schedule). The
+    reference is the penalty's own bound: at k = μ/Δt² a surface arriving at speed v is
+    stopped within about v Δt (μ v²/2 = k d²/2), so no station of the surface may be deeper
+    than v Δt, v the largest speed of any station (measured: 0.42 mm deep at most, stepped,
+    below v Δt = 0.56 mm; the schedule run at once, 0 deep: its law is sized for 15 N from
+    the start)."""
+    case = sa.load_case(FINGER)
+    tendon, cylinder = case.loads
+    dt, steps = 1e-3, 300
+
+    def pull(t):
+        return [15.0 * min(t / 0.2, 1.0)]
+
+    sim = sa.Simulator(case.arm, [tendon.replace(tension=0.0)], [cylinder], dt=dt,
+                       stations=41, damping=sa.Damping(retardation=0.02))
+    deepest, fastest = np.inf, 0.0
+    for k in range(1, steps + 1):
+        state = sim.step(pull(k * dt))
+        gaps, _ = cylinder.gaps(state.positions, cylinder.station_radii(case.arm, state.s))
+        deepest = min(deepest, gaps.min())
+        fastest = max(fastest, np.linalg.norm(state.velocities, axis=-1).max())
+    assert fastest * dt < 1e-3  # (the bound has content: below a millimetre)
+    assert deepest >= -fastest * dt, (deepest, fastest * dt)
+    # the law at 15 N is the one a Simulator built at 15 N has
+    at_15 = sa.Simulator(case.arm, [tendon], [cylinder], dt=dt, stations=41).loads[-1]
+    assert sim.loads[-1].stiffness == pytest.approx(at_15.stiffness, rel=1e-12)
+    assert sim.loads[-1].distance == pytest.approx(at_15.distance, rel=1e-12)
+    # the same schedule as one run: its law is sized for the schedule's largest input
+    path = sa.simulate(case.arm, [cylinder], duration=steps * dt, dt=dt, stations=41,
+                       actuators=[tendon.replace(tension=0.0)], inputs=pull,
+                       damping=sa.Damping(retardation=0.02))
+    fastest = np.linalg.norm(path.velocities, axis=-1).max()
+    assert path.gaps.min() >= -fastest * dt
+    assert path.contact.distance == pytest.approx(at_15.distance, rel=1e-12)
+    # and from a case file, run in chunks (one law for all of them, the schedule's)
+    data = case.to_dict()
+    data["load"][0]["tension"] = 0.0
+    data["simulate"] = {"duration": steps * dt, "dt": dt, "stations": 41,
+                        "damping": {"retardation": 0.02},
+                        "input": [{"load": 1, "times": [0.0, 0.2], "values": [0.0, 15.0]}]}
+    filed = sa.case.simulate_case(sa.case.parse_case(data))
+    # (the chunks restart the chord iteration: the same to the steps' tolerance, 1e-6 L)
+    np.testing.assert_allclose(filed.positions, path.positions, rtol=0, atol=1e-6 * 0.12)
+    assert filed.contact.distance == pytest.approx(at_15.distance, rel=1e-12)
+
+
+def test_an_arm_starting_inside_an_obstacle_is_refused_as_the_statics_refuse_it():
+    """Issue 42: the dynamics said "a section turned inside out" (a ConvergenceError) for
+    an arm whose start is inside an obstacle. The reference is the statics' refusal of the
+    same arm and obstacle (softarm.solve's ValueError naming the station), and for an
+    initial equilibrium solved without the obstacle, the first of its stations whose
+    surface is inside, found here from softarm.solve's positions by hand."""
+    arm = _arm()  # 0.5 m, radius 10 mm
+    ball = sa.Contact(sa.Sphere((0.3, 0.0, 0.0), 0.05))
+    with pytest.raises(ValueError) as statics:
+        sa.solve(arm, [sa.Gravity(), ball])
+    assert "starts inside an obstacle" in str(statics.value)
+    for make in (lambda: sa.Simulator(arm, [], [sa.Gravity(), ball], dt=1e-3, stations=21),
+                 lambda: sa.simulate(arm, [sa.Gravity(), ball], duration=2e-3, dt=1e-3,
+                                     stations=21)):
+        with pytest.raises(ValueError) as dynamics:
+            make()
+        assert str(dynamics.value) == str(statics.value)
+    # sagging under gravity into a table that the straight arm clears
+    hanging = sa.solve(arm, [sa.Gravity()], s=21, tol=1e-10)
+    table = sa.Contact(sa.Plane((0.0, 0.0, -0.05), (0.0, 0.0, 1.0)))
+    gaps = hanging.positions[:, 2] - 0.01 + 0.05  # (the surface's lowest point)
+    first = int(np.flatnonzero(gaps < -1e-6 * arm.length)[0])
+    with pytest.raises(ValueError) as start:
+        sa.Simulator(arm, [], [sa.Gravity(), table], dt=1e-3, stations=21, initial=hanging)
+    assert str(start.value).startswith(
+        f"Contact: the initial equilibrium starts inside an obstacle (its surface "
+        f"{-gaps[first]:.3g} m deep at station s = {hanging.s[first]:.6g} m)")

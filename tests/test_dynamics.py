@@ -62,6 +62,34 @@ def test_a_base_accelerating_upwards_is_gravity_downwards():
     assert np.abs(carried - heavy.positions).max() < 1e-5 * HEAVY.length
 
 
+def test_a_base_function_is_never_called_before_the_start():
+    """Issue 42: the base's velocity at the start was a central difference, calling the
+    user's function at t = -1e-6 s, before the motion exists (a trajectory read from a
+    table, a spline). The start's is one-sided now: every call at t >= the start, with a
+    Python float. The reference: the base accelerating from rest at t = 0 moves the tip as
+    gravity -a does (test_a_base_accelerating_upwards_is_gravity_downwards, 1e-5 L)."""
+    a, calls = 3.0, []
+
+    def base(t):
+        calls.append(t)
+        if t < 0.0:
+            raise ValueError("no motion before t = 0")
+        pose = np.eye(4)
+        pose[2, 3] = 0.5 * a * t * t
+        return pose
+
+    moving = simulate(HEAVY, [], duration=0.05, dt=1e-3, stations=21, base=base, tol=1e-10)
+    assert min(calls) == 0.0 and all(type(t) is float for t in calls)
+    heavy = simulate(HEAVY, [Gravity([0.0, 0.0, -a])], duration=0.05, dt=1e-3, stations=21,
+                     tol=1e-10)
+    carried = moving.positions - (0.5 * a * moving.times**2)[:, None, None] * [0, 0, 1]
+    assert np.abs(carried - heavy.positions).max() < 1e-5 * HEAVY.length
+    calls.clear()  # continued from a state at t = 0.05 s: nothing before it either
+    simulate(HEAVY, [], duration=0.002, dt=1e-3, stations=21, base=base, tol=1e-10,
+             initial=moving.final)
+    assert min(calls) >= 0.05
+
+
 @pytest.mark.parametrize("damped", [False, True])
 def test_the_energy_of_a_released_arm_is_kept_over_20_periods(damped):
     period = _first_period(SHORT)
@@ -244,6 +272,53 @@ def test_simulator_steps_take_the_inputs_given():
         sim.step([1.0, 2.0])
     with pytest.raises(ValueError, match="finite"):
         sim.step([np.nan])
+
+
+def _refusal(make) -> str:
+    with pytest.raises(ValueError) as info:
+        make()
+    return str(info.value)
+
+
+def test_the_inputs_obey_the_statics_rules_on_every_route():
+    """Issue 42: Simulator.step([-2]) pushed with the tendon and step([1e200]) raised a raw
+    ZeroDivisionError (as did ForwardSolver.solve([1e200])). The reference is the statics'
+    own rule, the one a Tendon and softarm.solve apply: the same words, named at the input's
+    index (its time for a schedule given as a function), and the state unchanged."""
+    tendon = softarm.Tendon(0.2, STRAIGHT)
+    pushing = _refusal(lambda: softarm.Tendon(-2.0, STRAIGHT))
+    assert pushing == "Tendon.tension must be >= 0 N (a tendon cannot push), got -2.0"
+    huge = _refusal(lambda: softarm.solve(ROBOT, [tendon.replace(tension=1e200)]))
+    assert huge.startswith("Tendon.tension: a load of 1e+200 N is not representable")
+    sim = Simulator(ROBOT, [tendon], [Gravity()], dt=1e-3, stations=11)
+    sim.step([0.5])
+    before = sim.state
+    assert _refusal(lambda: sim.step([-2.0])) == f"inputs[0]: {pushing}"
+    assert _refusal(lambda: sim.step([1e200])) == f"inputs[0]: {huge}"
+    assert sim.state is before and sim.time == pytest.approx(1e-3)
+    schedule = np.full((6, 1), 0.5)
+    schedule[4, 0] = -2.0
+    assert _refusal(lambda: sim.run(5, schedule)) == f"inputs[4, 0]: {pushing}"
+    assert _refusal(lambda: sim.run(5, lambda t: [-2.0 if t > 3.5e-3 else 0.5])) == \
+        f"inputs(0.004)[0]: {pushing}"
+    assert _refusal(lambda: simulate(ROBOT, [], duration=2e-3, dt=1e-3, stations=11,
+                                     actuators=[tendon], inputs=lambda t: [1e200])) == \
+        f"inputs(0.001)[0]: {huge}"
+    assert sim.time == pytest.approx(1e-3)
+    model = softarm.ForwardSolver(ROBOT, [tendon])
+    assert _refusal(lambda: model.solve([1e200])) == f"inputs[0]: {huge}"
+    with pytest.raises(ValueError, match="tensions >= 0"):
+        model.solve([-2.0])
+    # what the statics accept, the steps take: a vacuum (p < 0), a slack tendon (0 N)
+    chamber = softarm.Chamber(0.0, area=2e-5, routing=softarm.routing.Straight(0.0, -0.005))
+    both = Simulator(ROBOT, [tendon, chamber], [Gravity()], dt=1e-3, stations=11)
+    assert both.step([0.0, -2e4]).time == pytest.approx(1e-3)
+    assert _refusal(lambda: both.step([0.0, 1e300])).startswith(
+        "inputs[1]: Chamber.pressure: a load of 1e+300 Pa is not representable")
+    magnetic = Arm(0.3, Circle(0.01), SOFT, magnetization=(1e3, 0.0, 0.0))
+    field = softarm.MagneticField([0.0, 0.0, 0.0])
+    assert _refusal(lambda: Simulator(magnetic, [field], dt=1e-3, stations=11).step(
+        [0.0, 0.0, 1e300])).startswith("inputs[0:3]: MagneticField.field: a load of 1e+300 T")
 
 
 def test_a_batch_keeps_going_past_a_failed_case():

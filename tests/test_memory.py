@@ -138,3 +138,84 @@ def test_the_guard_assumes_at_least_what_a_batch_takes(kind, method, count, stat
     assert figures["peak"] <= figures["guard"], figures
     if stations > 1:  # where the result, not one part's work, is most of it: not much more
         assert figures["guard"] <= 2.5 * figures["peak"], figures
+
+
+# ------------------------------------------------------------------------------------------
+# Dynamics (issue 42): a Simulator's stations and a run's steps, guarded like the statics
+# ------------------------------------------------------------------------------------------
+
+# A node of a step holds its state (Z 24, Zold 2 × 24, H 36 float64) nine times and 30
+# outputs twice, 8 (9 × 108 + 60) = 8256 B, and one factorisation's banded rows, 18 rows of
+# 3 × 29 + 1 band columns, 29 multipliers and a pivot: 8 × 18 × 118 = 16992 B.
+NODE = 8256 + 16992
+
+
+def test_a_simulator_and_its_runs_are_refused_before_allocating(monkeypatch):
+    """The reference: the byte counts above by hand (the measurement below checks that
+    they cover what a step and a run take). Before issue 42 a Simulator of 10⁹ stations
+    began a 16 GB linspace (then an out-of-memory kill), run(10**12) a 7 TiB arange."""
+    monkeypatch.setattr(softarm._validate, "memory_limit", lambda: 10**8)
+    # 10⁴ stations and the two ends of the one piece: (10⁴ + 2) × 25248 B + 3 × 12288 B
+    need = (10_000 + 2) * NODE + 3 * 12288
+    with pytest.raises(ValueError, match=rf"^stations: 1 load case × 10002 stations would "
+                                         rf"need {need / 1e6:.3g} MB of memory"):
+        softarm.Simulator(ARM, [], [softarm.Gravity()], dt=1e-3, stations=10_000)
+    sim = softarm.Simulator(ARM, [], [softarm.Gravity()], dt=1e-3, stations=21)
+    # 10¹² steps × (21 stations × 3 copies of 30 float64 + 15 float64 a step) + the work
+    need = 10**12 * (21 * 720 + 120) + 3 * 12288
+    with pytest.raises(ValueError, match=rf"^run\(1000000000000 steps\): 1 load case × 21 "
+                                         rf"stations would need {need / 1e15:.3g} PB .* run "
+                                         r"fewer steps at a time"):
+        sim.run(10**12)
+    with pytest.raises(ValueError, match=r"^run\(1000000000000 steps\)"):
+        softarm.simulate(ARM, [softarm.Gravity()], duration=1e9, dt=1e-3, stations=21)
+    assert sim.run(3).positions.shape == (4, 21, 3)  # (what fits runs)
+
+
+_MEASURE_DYNAMICS = """
+import json, sys
+import numpy as np, softarm
+from softarm._validate import check_allocation
+from softarm.dynamics._simulator import _node_bytes
+from softarm.routing import Straight
+silicone = softarm.Material(youngs_modulus=1.5e6, poisson_ratio=0.49, density=1070.0)
+arm = softarm.Arm(0.3, softarm.Circle(0.01), silicone)
+what, stations, steps = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
+act = [softarm.Tendon(0.1, Straight(0.0, 0.005))]
+for warm in range(2):  # compiled, step and run
+    sim = softarm.Simulator(arm, act, [softarm.Gravity()], dt=1e-3, stations=11)
+    sim.step(); sim.run(2)
+def status(key):
+    return int(open("/proc/self/status").read().split(key + ":")[1].split()[0]) * 1024
+with open("/proc/self/clear_refs", "w") as file:
+    file.write("5")
+before = status("VmRSS")
+sim = softarm.Simulator(arm, act, [softarm.Gravity()], dt=1e-3, stations=stations)
+state, storage = _node_bytes()
+nodes = sim._nodes.size
+guard = check_allocation(1, nodes, per_station=state + storage, per_case=0.0)
+if what == "step":
+    for _ in range(steps):
+        sim.step([0.2])
+    guard += check_allocation(1, nodes, per_station=storage, per_case=0.0)
+else:
+    guard += sim._check_run(steps, "run")
+    path = sim.run(steps)
+peak = status("VmHWM")
+print(json.dumps({"peak": peak - before, "guard": guard}))
+"""
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc (Linux)")
+@pytest.mark.parametrize(("what", "stations", "steps"), [("step", 20_000, 3),
+                                                         ("run", 1001, 1000)])
+def test_the_dynamics_guards_assume_at_least_what_a_step_and_a_run_take(what, stations,
+                                                                         steps):
+    """The reference: the process's peak resident memory (measured 490 MB for the steps of
+    20 000 stations, 0.54 GB for 1000 steps of 1001 stations)."""
+    run = subprocess.run([sys.executable, "-c", _MEASURE_DYNAMICS, what, str(stations),
+                          str(steps)], capture_output=True, text=True, timeout=600)
+    assert run.returncode == 0, run.stderr
+    figures = json.loads(run.stdout.splitlines()[-1])
+    assert figures["peak"] <= figures["guard"] <= 2.5 * figures["peak"], figures

@@ -141,3 +141,61 @@ def test_load_case_raises_case_error_at_any_depth(deep_case, tmp_path):
         nested = {"a": nested}
     with pytest.raises(CaseError, match="nested more than 100 levels deep"):
         softarm.case.parse_case({"arm": nested})
+
+
+# ------------------------------------------------------------------------------------------
+# Issue 42: an empty unit, numpy reprs and a stray space in the dynamics' and the app's words
+# ------------------------------------------------------------------------------------------
+
+
+def test_a_dimensionless_key_reads_without_an_empty_unit(tmp_path):
+    """Contact.friction has no unit: the message was 'must be a number in , got 'high''."""
+    path = tmp_path / "friction.toml"
+    path.write_text('[arm]\nlength = 0.12\nsection = { kind = "circle", radius = 0.01 }\n'
+                    'material = { E = 1.0e6, nu = 0.49, density = 1070.0 }\n'
+                    '[[obstacle]]\nkind = "sphere"\ncenter = [0.06, 0.0, -0.1]\n'
+                    'radius = 0.03\n[contact]\nfriction = "high"\n', encoding="utf-8")
+    with pytest.raises(CaseError) as info:
+        softarm.load_case(path)
+    assert str(info.value) == f"{path}: contact.friction: must be a number, got 'high'"
+
+
+def test_the_apps_switch_and_a_unitless_slider_read_without_a_stray_space():
+    """A switch given 2 said 'l2.on must be in [0.0, 1.0] , got 2.0' (an empty unit)."""
+    switch = app.Input("l2.on", "tendon on", "", 0.0, 1.0, 1.0, load=1)
+    slider = app.Input("l1.ratio", "ratio", "", 0.0, 1.0, 0.5, load=0, field="ratio",
+                       component=-1)
+    by_name = {item.name: item for item in (switch, slider)}
+    for query, message in (({"l2.on": "2"}, "l2.on must be 0 (off) or 1 (on), got 2.0"),
+                           ({"l2.on": "0.5"}, "l2.on must be 0 (off) or 1 (on), got 0.5"),
+                           ({"l1.ratio": "2"}, "l1.ratio must be in [0.0, 1.0], got 2.0")):
+        with pytest.raises(app.BadRequest) as info:
+            app._updated(by_name, {}, query)
+        assert str(info.value) == message
+
+
+def _moving_base(fails_from: float, how: str):
+    def base(t):
+        pose = np.eye(4)
+        pose[0, 3] = 0.01 * t
+        if t >= fails_from:
+            if how == "raises":
+                raise ZeroDivisionError("boom")
+            pose[0, 0] = 2.0  # not a rotation
+        return pose
+    return base
+
+
+@pytest.mark.parametrize(("how", "message"), [
+    ("raises", "base(0.005) raised ZeroDivisionError: boom"),
+    ("scaled", "base(0.005) must be a rigid transform [[R, p], [0, 0, 0, 1]] with R a proper "
+               "rotation"),
+])
+def test_a_base_functions_fault_names_its_time_as_a_plain_number(how, message):
+    """The time was shown as 'base(np.float64(0.005))'."""
+    sim = softarm.Simulator(ARM, [], [softarm.Gravity()], dt=1e-3, stations=5,
+                            base=_moving_base(0.005, how))
+    with pytest.raises(ValueError) as info:
+        sim.run(10)
+    assert str(info.value).startswith(message), str(info.value)
+    assert not re.search(r"np\.\w+\(", str(info.value))

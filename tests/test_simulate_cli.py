@@ -139,6 +139,13 @@ def test_the_table_defaults_are_softarm_simulate_s():
     ("[simulate]\nduration = 0.02\ndt = 0.001\n[[simulate.input]]\nload = 2\n"
      "times = [0, 1]\nvalues = [[1, 2], [3, 4]]", "simulate.input[1].values: load 2 (tendon) "
      "has 1 input (tension); give one number per time, got 2"),
+    # issue 42: a schedule's values obey the load's own rules (the words of Tendon(-1.5))
+    ("[simulate]\nduration = 0.02\ndt = 0.001\n[[simulate.input]]\nload = 2\n"
+     "times = [0, 0.01]\nvalues = [0, -1.5]", "simulate.input[1].values: at t = 0.01 s: "
+     "Tendon.tension must be >= 0 N (a tendon cannot push), got -1.5"),
+    ("[simulate]\nduration = 0.02\ndt = 0.001\n[[simulate.input]]\nload = 2\n"
+     "times = [0, 0.01]\nvalues = [0, 1e200]", "simulate.input[1].values: at t = 0.01 s: "
+     "Tendon.tension: a load of 1e+200 N is not representable on this arm"),
     ("[simulate]\nduration = 0.02\ndt = 0.001\n[[simulate.input]]\nload = 2\ntimes = [0]\n"
      "values = [1]\n[[simulate.input]]\nload = 2\ntimes = [0]\nvalues = [2]",
      "simulate.input[2].load: load 2 has a schedule already (simulate.input[1])"),
@@ -284,6 +291,13 @@ def test_an_interrupt_before_any_step_writes_nothing(small, capsys, monkeypatch)
     (SIMULATE, ["-o", "{dir}/missing/out.npz"], "does not exist"),
     (SIMULATE.replace("dt = 0.001", "dt = -0.001"), ["-o", "{dir}/out.npz"],
      "simulate.dt: must be a positive number of s, got -0.001"),
+    # issue 42: an arm that starts inside an obstacle, as `softarm solve` says it (it was
+    # "a section turned inside out", exit 1): a ball of 5 mm round s = 0.1 m meets the
+    # arm's surface (0.6 mm) from s = 0.1 - 5.6 mm on: the first of 201 stations inside,
+    # s = 0.095 m, is 0.6 mm deep (5 mm from the centre)
+    (SIMULATE + '\n[[obstacle]]\nkind = "sphere"\ncenter = [0.1, 0.0, 0.0]\nradius = 0.005\n',
+     ["-o", "{dir}/out.npz"], "Contact: the unloaded arm starts inside an obstacle (its "
+     "surface 0.0006 m deep at station s = 0.095 m)"),
 ])
 def test_bad_input_is_one_line_exit_2_and_no_output(tmp_path, capsys, extra, argv, message):
     path = write_case(tmp_path, ARM + extra)

@@ -374,7 +374,7 @@ class Table:
         if key.name in self.data:
             return True
         if key.required:
-            self.lacks(key.name, f"a {key.kind} in {key.unit}" if key.unit else f"a {key.kind}")
+            self.lacks(key.name, f"a {key.kind}{_in(key.unit)}")
         return False
 
     def lacks(self, key: str, what: str) -> None:
@@ -414,7 +414,7 @@ class Table:
                     isinstance(v, Real) or (isinstance(v, list) and v and all(
                         isinstance(x, Real) for x in v)) for v in raw)):
                 raise self.type_error(key.name, f"must be a list of numbers or of lists of "
-                                      f"numbers in {key.unit}, got {format_value(raw)}")
+                                      f"numbers{_in(key.unit)}, got {format_value(raw)}")
             return raw
         if kind == "span":  # two numbers in m
             raw = self.raw(key.name)
@@ -464,12 +464,13 @@ class Table:
         ``finite``: reject inf and nan here, for values no model checks."""
         if key not in self.data:
             if required:
-                raise self.missing(key, f"a number in {unit}")
+                raise self.missing(key, f"a number{_in(unit)}")
             self.used.add(key)
             return default
         value = self.raw(key)
         if isinstance(value, bool) or not isinstance(value, Real):
-            raise self.type_error(key, f"must be a number in {unit}, got {format_value(value)}")
+            raise self.type_error(key, f"must be a number{_in(unit)}, got "
+                                  f"{format_value(value)}")
         if finite and not math.isfinite(value):
             raise self.error(key, f"must be finite, got {format_value(value)}")
         return float(value)
@@ -509,7 +510,7 @@ class Table:
 
     def vector(self, key: str, unit: str, *, default=(0.0, 0.0, 0.0)) -> np.ndarray:
         value = self.raw(key, default)
-        what = f"must be a list of 3 finite numbers in {unit}, got {format_value(value)}"
+        what = f"must be a list of 3 finite numbers{_in(unit)}, got {format_value(value)}"
         try:
             array = as_array(value, key)  # strict: no strings, bools or complex numbers
         except TypeError as error:
@@ -524,7 +525,7 @@ class Table:
         """Finite numbers of trailing shape ``shape`` (batch axes only in result files)."""
         value = self.raw(key)
         what = (f"must be {'a number' if not shape else f'a {shape[0]} × {shape[1]} list'} "
-                f"of finite numbers in {unit}, got {format_value(value)}")
+                f"of finite numbers{_in(unit)}, got {format_value(value)}")
         try:
             array = as_array(value, key)
         except TypeError:
@@ -600,6 +601,11 @@ def _has_bool(value) -> bool:
     if isinstance(value, (list, tuple)):
         return any(_has_bool(v) for v in value)
     return False
+
+
+def _in(unit: str) -> str:
+    """" in N" for a unit, "" for a dimensionless key (never "a number in , got")."""
+    return f" in {unit}" if unit else ""
 
 
 def _quoted(choices) -> str:

@@ -203,17 +203,17 @@ class Simulation:
         steps = round(self.duration / self.dt)
         if steps < 1 or abs(steps * self.dt - self.duration) > 1e-9 * self.duration:
             raise ValueError(f"Simulation.duration must be a whole number of time steps dt = "
-                             f"{self.dt!r} s, got {self.duration!r} s "
+                             f"{format_value(self.dt)} s, got {format_value(self.duration)} s "
                              f"({self.duration / self.dt:.6g} steps)")
         try:
             object.__setattr__(self, "tol", check_tol(self.tol))  # the solver's own rule
         except (TypeError, ValueError) as error:
             raise type(error)(f"Simulation.{error}") from None
         if self.stations < 3:
-            raise ValueError(f"Simulation.stations must be >= 3, got {self.stations!r}")
+            raise ValueError(f"Simulation.stations must be >= 3, got {format_value(self.stations)}")
         if not -0.5 <= self.alpha <= 0.0:
             raise ValueError(f"Simulation.alpha must lie in [-0.5, 0] (BDF-α), got "
-                             f"{self.alpha!r}")
+                             f"{format_value(self.alpha)}")
         if self.initial not in INITIAL:
             raise ValueError(f"Simulation.initial must be 'rest' or 'equilibrium', got "
                              f"{format_value(self.initial)}")

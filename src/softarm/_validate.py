@@ -256,15 +256,16 @@ def nonnegative(value, name: str, unit: str) -> float:
 
 def _not_below_zero(value, name: str, unit: str, *, zero: bool) -> float:
     what = "a finite value >= 0" if zero else "a positive finite value"
+    in_unit = f" in {unit}" if unit else ""
     try:
         number = real(value, name, unit)
     except TypeError:
-        raise TypeError(f"{name} must be {'a number >= 0' if zero else 'a positive number'} "
-                        f"in {unit}, got {_kind(value)} ({format_value(value, 40)})") from None
+        raise TypeError(f"{name} must be {'a number >= 0' if zero else 'a positive number'}"
+                        f"{in_unit}, got {_kind(value)} ({format_value(value, 40)})") from None
     except ValueError:
         number = math.nan
     if not (number >= 0 if zero else number > 0):
-        raise ValueError(f"{name} must be {what} in {unit}, got {format_value(value)}")
+        raise ValueError(f"{name} must be {what}{in_unit}, got {format_value(value)}")
     return number
 
 
@@ -340,7 +341,8 @@ CASES_PER_PART = PART_BYTES // 2048
 
 def check_allocation(cases, stations, name: str = "the result", *,
                      per_station: float = BYTES_PER_STATION,
-                     per_case: float = BYTES_PER_CASE) -> int:
+                     per_case: float = BYTES_PER_CASE,
+                     hint: str = "solve fewer cases or stations at a time") -> int:
     """Reject, before allocating, a result of ``cases`` × ``stations`` that cannot fit in memory.
 
     The output of one solve is a pose, strains and stresses per load case and station
@@ -350,7 +352,8 @@ def check_allocation(cases, stations, name: str = "the result", *,
     the part being solved and what the allocator still holds of the one before), and the
     solver copies each part's result into the whole batch's (:data:`CASES_PER_PART` cases,
     twice). ValueError naming the sizes and the memory they would need if that exceeds
-    :func:`memory_limit`; else the number of bytes.
+    :func:`memory_limit`; else the number of bytes. ``hint``: what the message advises (a
+    simulation's runs: fewer steps at a time).
 
     Examples
     --------
@@ -372,8 +375,7 @@ def check_allocation(cases, stations, name: str = "the result", *,
             f"{stations} stations would need "
             f"{format_bytes(size)} "
             "of memory for the result and its solve, more than the "
-            f"{format_bytes(limit)} (half of this machine's memory) one result may take; solve "
-            "fewer cases or stations at a time"
+            f"{format_bytes(limit)} (half of this machine's memory) one result may take; {hint}"
         )
     return int(size)
 

@@ -248,12 +248,12 @@ def _updated(by_name: dict, values: dict, query: dict[str, str]) -> dict:
             raise BadRequest(f"{name} must be a number, got {text!r}") from None
         if not math.isfinite(value):
             raise BadRequest(f"{name} must be a finite number, got {text!r}")
+        if item.component is None and value not in (0.0, 1.0):  # (a switch)
+            raise BadRequest(f"{name} must be 0 (off) or 1 (on), got {format_value(value)}")
         if not item.low <= value <= item.high:
+            unit = f" {item.unit}" if item.unit else ""
             raise BadRequest(f"{name} must be in [{format_value(item.low)}, "
-                             f"{format_value(item.high)}] {item.unit}, got "
-                             f"{format_value(value)}".rstrip())
-        if item.component is None and value not in (0.0, 1.0):
-            raise BadRequest(f"{name} must be 0 (off) or 1 (on), got {text!r}")
+                             f"{format_value(item.high)}]{unit}, got {format_value(value)}")
         new[name] = value
     return new
 

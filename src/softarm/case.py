@@ -43,7 +43,7 @@ from .contact import Contact
 from .dynamics import Damping, Simulator, Trajectory
 from .equilibrium import Equilibrium, Stability
 from .errors import CaseError, CaseTypeError
-from .loads import LOAD_KINDS
+from .loads import LOAD_KINDS, InputRules
 from .model import Arm, SegmentedArm, StiffnessMatrix
 from .statics import Solver
 from .statics.solver import check_tol
@@ -338,8 +338,9 @@ def _input_count(load) -> int:
     return sum(int(np.size(getattr(load, name))) for name in load.inputs)
 
 
-def _simulation(table: Table, loads: tuple) -> Simulation:
-    """The ``[simulate]`` table with its ``damping``, ``[[simulate.input]]`` and ``base``."""
+def _simulation(table: Table, loads: tuple, arm) -> Simulation:
+    """The ``[simulate]`` table with its ``damping``, ``[[simulate.input]]`` and ``base``;
+    a schedule's values obey its load's rules on ``arm`` (a tension >= 0, the size limit)."""
     keys = _schema.SIMULATE
     values = {name: table.read(key) for name, key in keys.items() if table.wants(key)}
     if table.has("damping"):
@@ -366,6 +367,11 @@ def _simulation(table: Table, loads: tuple) -> Simulation:
                             f"({', '.join(loads[schedule.load].inputs)}); give "
                             f"{'one number' if width == 1 else f'a list of {width} numbers'} "
                             f"per time, got {schedule.width}")
+        rules = InputRules(arm, [loads[schedule.load]])
+        for at, value in zip(schedule.times, schedule.values, strict=True):
+            fault = rules.first_fault(value)
+            if fault is not None:
+                raise row.error("values", f"at t = {format_value(at)} s: {fault[1]}")
         for j, other in enumerate(schedules):
             if other.load == schedule.load:
                 raise row.error("load", f"load {schedule.load + 1} has a schedule already "
@@ -510,7 +516,8 @@ def _parse(data, source, *, name=None, batched=False) -> Case:
             sweep = _sweep(table, loads, options.stations)
     inverse = _build(top.table("inverse"), _schema.Schema("", InverseTask, _schema.INVERSE)) \
         if top.has("inverse") else None
-    simulation = _simulation(top.table("simulate"), loads) if top.has("simulate") else None
+    simulation = _simulation(top.table("simulate"), loads, arm) if top.has("simulate") \
+        else None
     top.done()
     if contact is not None:  # after the [[load]] tables, which [sweep] and [simulate] count
         loads = (*loads, contact)
@@ -792,6 +799,11 @@ def simulation_parts(case: Case, *, seconds: float = 0.25) -> Iterator[Trajector
     """
     simulator, inputs = _simulator(case)
     total = case.simulation.steps
+    simulator._check_run(total, "simulate")  # (the chunks are joined: the whole trajectory)
+    if inputs is not None:  # one contact law for every chunk, sized for the schedules'
+        # largest inputs (at their knots: piecewise linear) as simulate's for its whole run
+        knots = sorted({0.0, *(t for schedule in case.simulation.inputs for t in schedule.times)})
+        simulator._follow_contact(np.array([inputs(t) for t in knots])[None])
     done, chunk = 0, 1
     while done < total:
         steps = min(chunk, total - done)

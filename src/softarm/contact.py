@@ -105,11 +105,14 @@ class Plane(Obstacle):
     def __post_init__(self):
         object.__setattr__(self, "point", _point(self.point, "Plane.point"))
         normal = _point(self.normal, "Plane.normal")
-        size = float(np.linalg.norm(normal))
-        if not size > 0.0:
+        largest = float(np.max(np.abs(normal)))
+        if not largest > 0.0:
             raise ValueError(f"Plane.normal must be a non-zero vector, got "
                              f"{format_value(self.normal)}")
-        normal = normal / size
+        # scaled by its largest component first: |n| of (0, 0, 1e300) overflows and that of
+        # (1e-320, 0, 0) underflows, where n / max|nᵢ| (components in [-1, 1]) does neither
+        normal = normal / largest
+        normal = normal / float(np.linalg.norm(normal))
         normal.setflags(write=False)
         object.__setattr__(self, "normal", normal)
 

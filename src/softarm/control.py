@@ -32,7 +32,7 @@ from ._validate import count, format_value, real
 from .dispatch import warn_unstable, warn_verdict
 from .equilibrium import Equilibrium, Stability
 from .errors import ConvergenceError
-from .loads import as_actuators, as_loads
+from .loads import InputRules, as_actuators, as_loads
 from .statics import Solver
 from .statics._bounded import regularised_step
 from .statics.displacement import displaced_columns, displacement_jacobians
@@ -242,6 +242,7 @@ class ForwardSolver:
         self._every = every.copy()  # the fixed loads' inputs, then the actuators' slots
         self._slots = slice(first, first + self.n_inputs)
         self._columns = slice(6 + first, 6 + first + self.n_inputs)  # of the Jacobians
+        self._rules = InputRules(arm, self.actuators)
         # the least value of each input: 0 for a tension, else -inf excluded (finite)
         self._lowest = np.array([0.0 if name == "tension" else -np.finfo(float).max
                                  for load in self.actuators for name in load.inputs
@@ -269,12 +270,15 @@ class ForwardSolver:
         shape, non-finite ones or a negative tension; ConvergenceError if the solver fails
         (the next call then starts from the unloaded arm)."""
         q = np.asarray(inputs, dtype=np.float64)
-        # (one comparison: NaN fails it, and so does -inf; +inf the second)
-        if q.shape != (self.n_inputs,) or not (
-                ((q >= self._lowest) & (q < np.inf)).all()):
-            raise ValueError(
-                f"inputs must be {self.n_inputs} finite numbers (the actuators' inputs in "
-                f"order), tensions >= 0, got {inputs!r}")
+        # (one comparison: NaN fails it; beyond the bounds of InputRules' screen, the exact
+        # rules: a tension >= 0, finite, and the loads' size limit, as the statics')
+        if q.shape != (self.n_inputs,) or not self._rules.admits(q):
+            if q.shape != (self.n_inputs,) or not (
+                    ((q >= self._lowest) & (q < np.inf)).all()):
+                raise ValueError(
+                    f"inputs must be {self.n_inputs} finite numbers (the actuators' inputs in "
+                    f"order), tensions >= 0, got {inputs!r}")
+            self._rules.check(q)
         every = self._every
         every[self._slots] = q
         prepared = self._prepared

@@ -32,6 +32,7 @@ __all__ = [
     "DistributedForce",
     "DistributedMoment",
     "Gravity",
+    "InputRules",
     "Key",
     "Load",
     "LoadTarget",
@@ -1129,3 +1130,122 @@ def _field_sizes(load, arm, scales):
         others = {other: np.zeros_like(getattr(load, other)) for other, _ in present
                   if other != name}
         yield _size(load.replace(**others) if others else load, arm, scales), name, unit
+
+
+#: The inputs at which :class:`InputRules` measures a load's growth (any value far beyond
+#: every limit, whose products with the arm's scales stay finite)
+_FAR = 1e100
+
+
+class InputRules:
+    """The rules that actuation inputs given apart from their loads obey on an arm, the same
+    as the loads' own (a tendon cannot push: its tension >= 0; pressures and fields of any
+    sign; every input finite) and :func:`check_magnitudes`' size limit: for the routes that
+    take inputs as numbers (``ForwardSolver.solve``, ``Simulator.step`` and ``run``,
+    ``simulate``'s schedules), so that every input is held to one rule on every route.
+
+    :meth:`admits` is the common case's test, one comparison per input against bounds set
+    once (an input at most the bound keeps its load within half the size limit, whatever
+    the others); beyond it :meth:`check` builds the loads at those inputs (their own rules
+    and messages) and measures them.
+
+    Parameters
+    ----------
+    arm : Arm or SegmentedArm
+    actuators : sequence of loads with inputs (:func:`as_actuators`), their inputs in order
+        (a tendon's tension, a chamber's pressure, a field's three components).
+    """
+
+    def __init__(self, arm, actuators):
+        self.arm = arm
+        self.actuators = as_actuators(actuators)
+        try:
+            scales = _cached_scales(arm)
+        except TypeError:  # an unhashable field (never with the model's own types)
+            scales = _scales(arm)
+        # (an arm without a bending scale: check_magnitudes measures nothing on it)
+        measured = all(np.isfinite(scales[:2])) and min(scales[:2]) > 0.0
+        #: per load: (its first input, its inputs' count, (field name, shape) of each)
+        self.columns = []
+        low, high = [], []
+        first = 0
+        for load in self.actuators:
+            fields = [(name, np.shape(getattr(load, name))) for name in load.inputs]
+            count = sum(int(np.prod(shape)) for _, shape in fields)
+            self.columns.append((first, count, fields))
+            bound = self._bound(load, fields, scales) if measured else np.inf
+            try:  # a load whose inputs cannot be negative (a tendon) says so itself
+                load.replace(**{name: np.full(shape, -1.0) for name, shape in fields})
+                least = -bound
+            except (TypeError, ValueError):
+                least = 0.0
+            low += [least] * count
+            high += [bound] * count
+            first += count
+        self.low, self.high = np.array(low), np.array(high)
+
+    def _bound(self, load, fields, scales) -> float:
+        """The input t (every input of ``load`` at ±t) below which its size stays within
+        half of :data:`LOAD_LIMIT`: its size grows at most linearly in t, from size(0) at
+        the slope (size(T) - size(0)) / T at a far T (a load's size is the largest of
+        terms affine in its inputs' largest |value|, of slopes >= 0)."""
+        def size(t):
+            return _size(load._with_checked(**{name: np.full(shape, t)
+                                               for name, shape in fields}), self.arm, scales)
+
+        at_zero = size(0.0)
+        slope = (size(_FAR) - at_zero) / _FAR
+        room = 0.5 * LOAD_LIMIT - at_zero
+        if room <= 0.0:
+            return 0.0
+        return room / slope if slope > 0.0 else np.inf
+
+    def admits(self, inputs) -> bool:
+        """Whether every row of ``inputs`` (..., n) passes the common case's test (finite,
+        within the bounds set at construction: NaN fails it)."""
+        q = np.asarray(inputs)
+        return bool(((q >= self.low) & (q <= self.high)).all())
+
+    def check(self, inputs, name: str = "inputs") -> None:
+        """ValueError naming the first inadmissible input of ``inputs`` (..., n), finite
+        floats, as ``name[index]`` (its index in ``inputs``), with its load's own message
+        (``Tendon.tension must be >= 0 N (a tendon cannot push), got -2``) or
+        :func:`check_magnitudes`'; nothing if every row is admissible."""
+        fault = self.first_fault(inputs)
+        if fault is not None:
+            raise ValueError(f"{name}[{fault[0]}]: {fault[1]}")
+
+    def first_fault(self, inputs) -> tuple[str, str] | None:
+        """(the index of the first inadmissible input of ``inputs`` (..., n) in C order, as
+        text: ``"2, 0"``; its load's message), or None if all are admissible."""
+        q = np.asarray(inputs, dtype=np.float64)
+        if self.admits(q):
+            return None
+        batch = q.shape[:-1]
+        for load, (first, count, fields) in zip(self.actuators, self.columns, strict=True):
+            columns = q[..., first:first + count]
+            if ((columns >= self.low[first:first + count])
+                    & (columns <= self.high[first:first + count])).all():
+                continue
+            if self._fault(load, fields, columns) is None:  # (beyond the screen only)
+                continue
+            for index in np.ndindex(*batch):  # the first row at fault, to name it
+                fault = self._fault(load, fields, columns[index])
+                if fault is not None:
+                    where = str(first) if count == 1 else f"{first}:{first + count}"
+                    return ", ".join([*(str(i) for i in index), where]), fault
+        return None
+
+    def _fault(self, load, fields, columns) -> str | None:
+        """The message of ``load`` at the inputs ``columns`` (..., count), None if fine."""
+        batch, start, values = columns.shape[:-1], 0, {}
+        for field_name, shape in fields:
+            size = int(np.prod(shape))
+            values[field_name] = columns[..., start:start + size].reshape(batch + shape)
+            start += size
+        try:
+            check_magnitudes(self.arm, [load.replace(**values)])
+        except (TypeError, ValueError) as error:
+            return str(error)
+        return None
+

@@ -7,9 +7,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._admissible import load_case
 from .._threads import in_threads, threads_for
 from .._validate import (
     as_matrices,
+    check_allocation,
     count,
     format_value,
     positive,
@@ -18,9 +20,9 @@ from .._validate import (
 )
 from ..equilibrium import Equilibrium, _frozen
 from ..errors import ConvergenceError
-from ..loads import Gravity, as_actuators, as_loads
+from ..loads import Gravity, InputRules, as_actuators, as_loads
 from ..statics import Solver
-from ..statics.solver import _kernels, check_tol
+from ..statics.solver import _check_outside, _kernels, check_tol
 from ._results import Energy, State, Trajectory
 
 __all__ = ["Damping", "Simulator", "simulate"]
@@ -54,12 +56,12 @@ class Damping:
     def __post_init__(self):
         if (self.retardation is None) == (self.matrix is None):
             raise ValueError("Damping takes exactly one of retardation= (τ in s) or matrix= "
-                             f"(6 × 6 B), got retardation={self.retardation!r}, "
+                             f"(6 × 6 B), got retardation={format_value(self.retardation)}, "
                              f"matrix={format_value(self.matrix)}")
         if self.retardation is not None:
             tau = real(self.retardation, "Damping.retardation", "s")
             if not tau >= 0.0:
-                raise ValueError(f"Damping.retardation must be >= 0 s, got {tau!r}")
+                raise ValueError(f"Damping.retardation must be >= 0 s, got {format_value(tau)}")
             object.__setattr__(self, "retardation", tau)
         else:
             B = as_matrices(self.matrix, "Damping.matrix", 6, 6)
@@ -101,6 +103,20 @@ def _actuator_loads(actuators) -> tuple:
     return actuators
 
 
+def _node_bytes() -> tuple[int, int]:
+    """(the state of one case, the step's factorisation) per node, bytes: the node's state
+    Z, its two past states and its history H, float64, held up to nine times over a step
+    (the initial state, the current one, a step's working copy, the last and the new
+    State's, their stacks and temporaries) with the outputs at the stations (30 numbers,
+    twice); the banded Jacobian's rows (DUNK a node: 3 KL + 1 columns of the band, KL of
+    the multipliers, a pivot). Measured (tracemalloc and the peak resident memory): 24.5 kB
+    a node over the steps of one case, 1.8 kB after construction (tests/test_memory.py)."""
+    k = _kernels()
+    state = 8 * (9 * (3 * k.DYN + k.DHIST) + 2 * 30)
+    storage = 8 * k.DUNK * ((3 * k._DKL + 1) + k._DKL + 1)
+    return state, storage
+
+
 def _check_base(base):
     """(callable t -> (4, 4) pose or None, the fixed pose)."""
     if base is None:
@@ -119,17 +135,24 @@ def _grid(length: float, starts: np.ndarray, count_: int):
     ends = np.append(starts[1:], length)
     nodes, piece = [], []
     for j, (a, b) in enumerate(zip(starts, ends, strict=True)):
-        inside = s_out[(s_out > a) & (s_out < b)]
+        # the stations strictly inside (a, b): s_out is sorted (a search, not a scan per piece)
+        inside = s_out[np.searchsorted(s_out, a, "right"):np.searchsorted(s_out, b, "left")]
         here = np.concatenate([[a], inside, [b]])
         nodes.append(here)
         piece.append(np.full(here.size, j))
-    s = np.concatenate(nodes)
+    s = np.concatenate(nodes)  # (non-decreasing: a joint's node twice)
     node_piece = np.concatenate(piece).astype(np.int64)
     h = np.diff(s)
     h[h < 1e-12 * length] = 0.0
-    at = np.array([np.flatnonzero(np.abs(s - x) <= 1e-12 * length)[0] for x in s_out],
-                  dtype=np.int64)
-    return s, h, node_piece, at, s_out
+    # each station's node: the first within 1e-12 L of it, found by bisection in O(S log G)
+    # (a scan of every node per station was quadratic: 17 s at 1e5 stations)
+    tol = 1e-12 * length
+    at = np.searchsorted(s, s_out - tol, "left")
+    earlier = (at > 0) & (np.abs(s[np.maximum(at - 1, 0)] - s_out) <= tol)  # (rounding)
+    at = np.where(earlier, at - 1, at)
+    if not np.all(np.abs(s[np.minimum(at, s.size - 1)] - s_out) <= tol):
+        raise AssertionError("a station without its node")  # pragma: no cover
+    return s, h, node_piece, at.astype(np.int64), s_out
 
 
 class Simulator:
@@ -189,7 +212,7 @@ class Simulator:
         self.dt = positive(dt, "dt", "s")
         self.alpha = real(alpha, "alpha")
         if not -0.5 <= self.alpha <= 0.0:
-            raise ValueError(f"alpha must lie in [-0.5, 0] (BDF-α), got {alpha!r}")
+            raise ValueError(f"alpha must lie in [-0.5, 0] (BDF-α), got {format_value(alpha)}")
         self.tol = check_tol(tol)
         stations = count(stations, "stations", 3)
         if damping is not None and not isinstance(damping, Damping):
@@ -199,6 +222,8 @@ class Simulator:
         self.actuators = _actuator_loads(actuators)
         self._solver = Solver(arm, s=2, stability=False)
         self.arm = self._solver.arm
+        #: the inputs' rules: the statics' (a tendon cannot push) and their size limit
+        self._rules = InputRules(self.arm, self.actuators)
         everything = [*as_loads(loads), *self.actuators]
         cuts = ()  # (an initial equilibrium's loads over part of the arm cut it there too)
         if isinstance(initial, Equilibrium) and initial.arm == self._solver.arm:
@@ -212,6 +237,11 @@ class Simulator:
         #: the contact law of the steps, and the arm's surface radius at the stations
         self._contact = contact
         self._contact_radii = None
+        # the law's estimated stiffness per case before the time step's cap (B,), sized
+        # for the largest inputs given so far (_follow_contact); None: a law of the user's
+        given = channels._contact_given
+        self._contact_sized = None if given is None or given.stiffness is not None else \
+            channels._contact_stiffness(given.band(channels.length))
         self.shape = shape
         self._channels = channels
         self._act = channels.arm_tuple()[1]
@@ -229,6 +259,14 @@ class Simulator:
                             channels.tip_loads - self.inputs @ unit_tip[-n:])
         self._motion, self._pose = _check_base(base)
         self.length = self._solver.length
+        # the memory of the state and of a run's factorisations (a thread's each), before
+        # anything of the stations' size is allocated (10⁹ stations: a ValueError, not an OOM)
+        cases = int(np.prod(shape))
+        state, storage = _node_bytes()
+        threads = threads_for(cases, 1)
+        check_allocation(cases, stations + 2 * pieces[0].size, "stations",
+                         per_station=state + storage * threads / cases, per_case=0.0,
+                         hint="simulate fewer cases or stations at a time")
         s, h, node_piece, at, s_out = _grid(self.length, pieces[0], stations)
         self.s = s_out
         if self._contact is not None:
@@ -286,8 +324,8 @@ class Simulator:
                     "dynamics needs the arm's mass and rotary inertia: give the material a "
                     "density, or mass_per_length and inertia_per_length to an arm built "
                     f"from its stiffnesses (segment {int(pieces[12][j])} has "
-                    f"mass_per_length={mu!r}, inertia_per_length="
-                    f"{None if inertia is None else inertia.tolist()!r})")
+                    f"mass_per_length={format_value(mu)}, inertia_per_length="
+                    f"{format_value(None if inertia is None else inertia.tolist())})")
             B = (self.damping.matrix_for(K) if self.damping is not None
                  else np.zeros((6, 6)))
             props[j, k._PK:k._PK + 36] = K.ravel()
@@ -314,6 +352,42 @@ class Simulator:
         A = max(1, act[0].shape[0])
         return law_arm, (np.empty((6, 7)), np.zeros((A, 8)), np.zeros((6, 6)), np.zeros((6, 6)))
 
+    def _follow_contact(self, inputs) -> None:
+        """The contact law sized for ``inputs`` (C, ..., n) too, C = 1 or the batch's cases:
+        the penalty's estimated stiffness (the statics' estimate from the loads' size,
+        resolve_contact) of the loads at those inputs, bounded above by |loads at zero
+        inputs| + Σ max|qᵢ| |unit channel i| over the rows, and the law remade (its stiffness
+        and, past the time step's cap μ/Δt², its band: contact.md, "Dynamics") where that
+        is above the law's now. The law only grows: sized at construction for the inputs
+        the actuators had, a law for 0 N let a finger pulled to 15 N pass 34 mm through
+        the cylinder it closes on (issue 42)."""
+        if self._contact_sized is None or not self.actuators:
+            return
+        q = np.abs(np.asarray(inputs, dtype=np.float64))
+        largest = q.reshape(q.shape[0], -1, q.shape[-1]).max(axis=1)  # (C, n)
+        unit, unit_tip = self._unit
+        B = int(np.prod(self.shape))
+        piece = np.broadcast_to(np.abs(self._loads0[0]) + np.einsum(
+            "cn,npw->cpw", largest, np.abs(unit)), self._loads0[0].shape)
+        tip = np.broadcast_to(np.abs(self._loads0[1]) + largest @ np.abs(unit_tip),
+                              self._loads0[1].shape)
+        channels = self._channels
+        band = channels._contact_given.band(channels.length)
+        needed = channels._contact_stiffness(band, piece.reshape(B, *piece.shape[1:]),
+                                             tip.reshape(B, -1))
+        if np.all(needed <= self._contact_sized):
+            return
+        self._contact_sized = np.maximum(self._contact_sized, needed)
+        contact = channels.resolve_contact(self._contact_sized.copy(), dt=self.dt)
+        self.loads = tuple(contact if load.kind == "contact" else load for load in self.loads)
+        self._contact = contact
+        k = _kernels()
+        for array in (self._loads, self._loads0[0]):  # (each case's k in its channel CT)
+            array[:, :, k.CT] = channels.piece[:, :, k.CT]
+        self._act = channels.arm_tuple()[1]  # (the obstacles' rows and the law's band)
+        if self._factors is not None:
+            self._factors[3][:] = 0  # (the step's kept Jacobian is another law's)
+
     @staticmethod
     def _gravity_of(loads, shape) -> np.ndarray:
         g = np.zeros((*shape, 3))
@@ -331,23 +405,30 @@ class Simulator:
             return rows
         d = _BASE_DIFFERENCE * self.dt
         for i, t in enumerate(times):
+            t = float(t)
             pose = self._base_at(t)
-            before, after = self._base_at(t - d), self._base_at(t + d)
+            if t - d >= self.t0:  # a central difference
+                rate = (self._base_at(t + d) - self._base_at(t - d)) / (2 * d)
+            else:  # at the start: one-sided, of second order too (never called before it)
+                rate = (4.0 * self._base_at(t + d) - self._base_at(t + 2 * d)
+                        - 3.0 * pose) / (2 * d)
             R = pose[:3, :3]
             rows[0, i, :3] = pose[:3, 3]
             rows[0, i, 3:12] = R.ravel()
-            rows[0, i, 12:15] = R.T @ ((after[:3, 3] - before[:3, 3]) / (2 * d))
-            W = R.T @ ((after[:3, :3] - before[:3, :3]) / (2 * d))
+            rows[0, i, 12:15] = R.T @ rate[:3, 3]
+            W = R.T @ rate[:3, :3]
             rows[0, i, 15:18] = 0.5 * np.array([W[2, 1] - W[1, 2], W[0, 2] - W[2, 0],
                                                 W[1, 0] - W[0, 1]])
         return rows
 
     def _base_at(self, t: float) -> np.ndarray:
+        """The user's base pose at time ``t`` (s, a Python float, never before the start)."""
         try:
             pose = self._motion(t)
         except Exception as error:
-            raise ValueError(f"base({t!r}) raised {type(error).__name__}: {error}") from None
-        return rigid_transform(pose, f"base({t!r})")
+            raise ValueError(f"base({format_value(t)}) raised {type(error).__name__}: "
+                             f"{error}") from None
+        return rigid_transform(pose, f"base({format_value(t)})")
 
     def _initial_arrays(self, initial) -> tuple:
         """(Z, Zold, H, aux) of the initial state: a State's own; or at rest: the unloaded
@@ -372,8 +453,13 @@ class Simulator:
         pose0 = np.eye(4)
         pose0[:3, 3], pose0[:3, :3] = base0[:3], base0[3:12].reshape(3, 3)
         unique = np.unique(self._nodes)
+        if initial is None and self._contact is not None:  # (the statics' rule and words)
+            _check_outside(Solver(self.arm, s=2, base=pose0, stability=False, tol=self.tol),
+                           self._contact.replace(stiffness=None))
         solver = Solver(self.arm, s=unique, base=pose0, stability=False, tol=1e-10)
         eq = solver.solve_from_unloaded([] if initial is None else initial.loads)
+        if initial is not None and self._contact is not None:
+            self._check_start(eq, unique)
         S = unique.size
         poses = np.broadcast_to(eq.poses, (*self.shape, S, 4, 4)).reshape(B, S, 4, 4)
         stresses = np.broadcast_to(eq.stresses, (*self.shape, S, 6)).reshape(B, S, 6)
@@ -396,6 +482,24 @@ class Simulator:
         H[..., 12:24] = H[..., 0:12]
         H[..., 24:36] = 0.0
         return Z, np.stack([Z, Z], axis=1), H, np.zeros((B, 2))
+
+    def _check_start(self, eq, s) -> None:
+        """ValueError, as the statics' for the unloaded arm (statics.solver._check_outside),
+        if the initial equilibrium ``eq`` (on the nodes ``s``) is inside an obstacle beyond
+        tol·L at some node: a step from there has no answer (Newton fails, and once said
+        "a section turned inside out")."""
+        contact = self._contact._with_checked_stiffness(None)  # (its geometry only)
+        gaps, _ = contact.gaps(eq.positions, contact.station_radii(self.arm, s))
+        inside = gaps < -self.tol * self.length
+        if not inside.any():
+            return
+        flat = int(np.argmax(inside.reshape(-1)))
+        case, station = divmod(flat, s.size)
+        raise ValueError(
+            f"Contact: the initial equilibrium{load_case(case, gaps.shape[:-1])} starts "
+            f"inside an obstacle (its surface {-float(gaps.reshape(-1)[flat]):.3g} m deep at "
+            f"station s = {float(s[station]):.6g} m): no motion from it is defined; move the "
+            "obstacles or the base, or start from another shape")
 
     def _settle(self, initial, Z, H, base0) -> None:
         """Z, H ← the equilibrium of ``initial``'s loads at rest on this grid: the equations
@@ -448,17 +552,18 @@ class Simulator:
         k = _kernels()
         routes, active = self._act[0], self._act[2]
         out = np.zeros((H.shape[0], self._tendon_columns.size))
-        eps = H[..., 0:6]
+        v, u = H[..., 0:3], H[..., 3:6]
         for i, a in enumerate(self._tendon_columns):
+            on = np.flatnonzero(active[self._node_piece, a] != 0.0)
+            # the path's offset and slope at the nodes where it runs (the kernel's own route
+            # function, node by node), then |w| for every node and case at once
+            y, z, dy, dz = np.array([k._route(routes, np.int64(a), float(s))
+                                     for s in self._nodes[on]]).reshape(-1, 4).T
+            vn, un = v[:, on], u[:, on]
             w = np.zeros((H.shape[0], self._nodes.size))
-            for n, (s, j) in enumerate(zip(self._nodes, self._node_piece, strict=True)):
-                if active[j, a] == 0.0:
-                    continue
-                y, z, dy, dz = k._route(routes, np.int64(a), float(s))
-                v, u = eps[:, n, :3], eps[:, n, 3:]
-                w[:, n] = np.sqrt((v[:, 0] + u[:, 1] * z - u[:, 2] * y) ** 2
-                                  + (v[:, 1] - u[:, 0] * z + dy) ** 2
-                                  + (v[:, 2] + u[:, 0] * y + dz) ** 2)
+            w[:, on] = np.sqrt((vn[..., 0] + un[..., 1] * z - un[..., 2] * y) ** 2
+                               + (vn[..., 1] - un[..., 0] * z + dy) ** 2
+                               + (vn[..., 2] + un[..., 0] * y + dz) ** 2)
             out[:, i] = np.sum(0.5 * self._h * (w[:, :-1] + w[:, 1:]), axis=1)
         return out
 
@@ -570,11 +675,20 @@ class Simulator:
         in N, pressures in Pa, field components in T, in the order of the actuators' inputs,
         as :class:`~softarm.ForwardSolver`'s; batch axes first to give each case its own),
         kept for the next steps; None: as before (at first, the actuators' own values).
-        Raises ConvergenceError (with the step's residual) if a case's step cannot be
-        solved: the simulator's state (and inputs) are then unchanged."""
+        They obey the statics' rules (:class:`~softarm.loads.InputRules`: finite, a tension
+        >= 0, within the loads' size limit), else ValueError naming the input. Raises
+        ConvergenceError (with the step's residual) if a case's step cannot be solved: the
+        simulator's state (and inputs) are then unchanged. The contact law, if the loads
+        hold one, grows with the inputs (docs/contact.md, "Dynamics")."""
         q = self._q if inputs is None else self._checked_inputs(inputs, 1)[:, 0]
+        if inputs is not None:
+            self._follow_contact(q)
         if self._factors is None:  # (kept between steps: the chord iteration's factors)
-            self._factors = [*self._storage(True, int(np.prod(self.shape))), None]
+            cases = int(np.prod(self.shape))
+            check_allocation(cases, self._nodes.size, "step", per_station=_node_bytes()[1],
+                             per_case=0.0, hint="step fewer cases at a time, or run() them "
+                             "(its threads share their factorisations)")
+            self._factors = [*self._storage(True, cases), None]
         arrays = tuple(a.copy() for a in self._arrays)
         times, out, _, info, done = self._advance(
             1, self._factors, arrays=arrays, inputs=None if q is None else q[:, None])
@@ -596,7 +710,9 @@ class Simulator:
         ``inputs``: the actuators' inputs over time, a callable t -> (n,) or an array
         (steps + 1, n) at the trajectory's times (row 0, the current time, is not used),
         the batch axes first ((B..., n), (B..., steps + 1, n)) to give each case its own;
-        None: constant (as the last step left them).
+        None: constant (as the last step left them). The statics' rules hold for every row
+        (:meth:`step`); the contact law is sized for the largest. A run whose trajectory
+        cannot fit in memory is refused first (ValueError: run fewer steps at a time).
 
         ``failures``: "raise" (default): a case whose step cannot be solved raises a
         ConvergenceError and the simulator's state is unchanged. "keep" (a long batch, a
@@ -604,8 +720,9 @@ class Simulator:
         values after it are NaN, ``Trajectory.failed`` marks it and :attr:`failures` says
         when and with what residual (later runs skip it)."""
         if failures not in ("raise", "keep"):
-            raise ValueError(f"failures must be 'raise' or 'keep', got {failures!r}")
+            raise ValueError(f"failures must be 'raise' or 'keep', got {format_value(failures)}")
         steps = count(steps, "steps", 1)
+        self._check_run(steps, "run")
         B = int(np.prod(self.shape))
         first = self.state
         threads = threads_for(B, 1)
@@ -614,6 +731,8 @@ class Simulator:
         if self.actuators:
             q = (np.broadcast_to(self._q[:, None], (len(self._q), steps, self.inputs.size))
                  if inputs is None else self._schedule(inputs, times))
+            if inputs is not None:
+                self._follow_contact(q)
         elif inputs is not None:
             raise ValueError("inputs: these loads have no actuators (give them as "
                              f"actuators=...), got {format_value(inputs)}")
@@ -636,6 +755,19 @@ class Simulator:
         start = self._record_now(initial=first)
         return self._trajectory(first, times, out, energy, info, start)
 
+    def _check_run(self, steps: int, name: str) -> int:
+        """ValueError (check_allocation's) if the trajectory of ``steps`` steps cannot fit in
+        memory: per case, step and station the kernel's outputs (30 numbers), joined to the
+        first step's (a start at rest) and copied into the trajectory (three copies at
+        most); per case and step its energies, errors, iterations, tendon lengths and
+        inputs (several copies). Else the bytes."""
+        tendons = 0 if self._act is None else max(1, self._act[0].shape[0])
+        per_step = 8 * (2 * 4 + 4 + 2 + 3 * tendons + 2 * self.inputs.size + 1)
+        return check_allocation(
+            int(np.prod(self.shape)), self._at.size, f"{name}({steps} steps)",
+            per_station=3 * 30 * 8 * float(steps), per_case=float(per_step) * steps,
+            hint="run fewer steps at a time (each run continues from the last)")
+
     def _case(self, b: int) -> tuple[int, ...]:
         """The batch index of flat case ``b``."""
         return tuple(int(i) for i in np.unravel_index(b, self.shape)) if self.shape else ()
@@ -656,9 +788,11 @@ class Simulator:
             info[b, first:, 1] = 0.0
         self._failed = failed.reshape(self.shape)
 
-    def _checked_inputs(self, values, rows: int) -> np.ndarray:
+    def _checked_inputs(self, values, rows: int, name: str = "inputs") -> np.ndarray:
         """``values`` as (C, rows, n) finite floats, C = 1 (the same for every case) or the
-        batch's case count (batch axes first), else ValueError naming ``inputs``."""
+        batch's case count (batch axes first), admissible (the loads' own rules and size
+        limit, :class:`~softarm.loads.InputRules`: a tension >= 0, ...), else ValueError
+        naming ``inputs`` (``name``: where they come from, ``inputs(0.002)``)."""
         n = self.inputs.size
         if not n:
             raise ValueError("inputs: these loads have no actuators (give them as "
@@ -679,6 +813,7 @@ class Simulator:
                              + f"got {format_value(values)}")
         if not np.all(np.isfinite(q)):
             raise ValueError(f"inputs must be finite, got {format_value(values)}")
+        self._rules.check(q, name)  # (q as given: the message indexes the user's array)
         cases = 1 if q.shape in one else int(np.prod(self.shape))
         return q.reshape(cases, rows, n)
 
@@ -687,10 +822,12 @@ class Simulator:
         if callable(inputs):
             rows = []
             for t in times:
+                at = f"inputs({format_value(float(t))})"
                 try:
-                    rows.append(self._checked_inputs(inputs(float(t)), 1))
+                    rows.append(self._checked_inputs(inputs(float(t)), 1, at))
                 except ValueError as error:
-                    raise ValueError(f"inputs({float(t)!r}): {error}") from None
+                    text = str(error)
+                    raise ValueError(text if text.startswith(at) else f"{at}: {text}") from None
             widest = max(row.shape[0] for row in rows)
             return np.concatenate([np.broadcast_to(row, (widest, 1, row.shape[2]))
                                    for row in rows], axis=1)
@@ -816,7 +953,9 @@ def simulate(arm, loads=(), *, duration, dt, actuators=(), inputs=None, damping=
 
     The parameters are :class:`Simulator`'s; ``duration`` (s) must be a whole number of
     steps (to 1e-9). Returns a :class:`Trajectory` of steps + 1 times, the initial state
-    first. Raises ConvergenceError (with the residual) if a step cannot be solved.
+    first. Raises ValueError for bad input (inputs the statics refuse, an arm that starts
+    inside an obstacle, a trajectory that cannot fit in memory: docs/dynamics.md,
+    "Failures"), ConvergenceError (with the residual) if a step cannot be solved.
 
     Examples
     --------

@@ -481,14 +481,16 @@ class _Channels:
         return load.replace(distance=band, stiffness=float(stiffness[0]) if single
                             else stiffness.reshape(self.shape))
 
-    def _contact_stiffness(self, band: float) -> np.ndarray:
+    def _contact_stiffness(self, band: float, piece=None, tip=None) -> np.ndarray:
         """Each case's penalty stiffness k (N/m², (B,)) that carries the largest pressure
         expected within the band (k δ/2, contact.md): the loads' size W (forces, and
         moments over L/2, the actuators' tension times their offset counted as a moment)
         spread over the width of the arm's shear zone √(EI/GA), where a shearable rod
-        carries what an unshearable one would carry as a point reaction."""
+        carries what an unshearable one would carry as a point reaction. ``piece``,
+        ``tip``: other channels than these (a simulation's inputs, or a bound of them)."""
         k, lengths = self.k, self.lengths
-        piece, tip = np.abs(self.piece), np.abs(self.tip_loads)
+        piece = np.abs(self.piece if piece is None else piece)
+        tip = np.abs(self.tip_loads if tip is None else tip)
         forces = ((piece[..., k.FD:k.FD + 6].sum(-1) @ lengths)
                   + piece[..., k.JD:k.JD + 3].sum((-1, -2))
                   + piece[..., k.JF:k.JF + 3].sum((-1, -2))
