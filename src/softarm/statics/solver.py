@@ -768,23 +768,29 @@ class PreparedSolve:
         self.index, self.conservative = 0, True
         self._last = None  # what this object last wrote as the Solver's _last
         self._q_last, self._dq = np.empty(n), np.empty(n)  # its inputs; their change
-        # The route (_stiff.py): fixed when no input moves a force channel (actuation inputs
-        # act through their own channels), else decided at every call
+        # The route (_stiff.py): fixed when no input changes the loads' largest force (a
+        # tendon's tension, a chamber's pressure and a field's B0 do not: measured at zero
+        # and at each unit input), else decided at every call
         self._route = None
         if solver.shooting != "auto":
             self._route = solver.shooting == "multiple"
         elif channels.contact_load is not None:
             self._route = True  # (as Solver._stiff)
-        elif not (np.any(unit_piece[..., :21]) or np.any(unit_tip[..., :9])):
-            self._route = bool(tension_kl(channels.piece, channels.tip_loads, pieces[1],
-                                          solver.length, solver._data.soft)[0] >= STIFF_KL)
+        else:
+            units = np.eye(n)
+            kls = {float(self._kl(self.loads_at(q))) for q in (np.zeros(n), *units)}
+            if len(kls) == 1:
+                self._route = float(self._kl(loads)) >= STIFF_KL
 
-    def _stiff(self, piece, tip) -> bool:
-        """Whether these loads take multiple shooting (Solver's route, _stiff.py)."""
+    def _kl(self, loads) -> float:
+        return tension_kl(self._solver.arm, loads, (), self._solver._data.soft)[0]
+
+    def _stiff(self) -> bool:
+        """Whether the loads at the present inputs take multiple shooting (Solver's route,
+        _stiff.py)."""
         if self._route is not None:
             return self._route
-        return bool(tension_kl(piece, tip, self._pieces[1], self._solver.length,
-                               self._solver._data.soft)[0] >= STIFF_KL)
+        return bool(self._kl(self.loads_at(self.inputs)) >= STIFF_KL)
 
     def solve(self, q, *, near=None) -> None:
         """Solve at the inputs q (every input, in :attr:`inputs`' order; not validated: the
@@ -829,7 +835,7 @@ class PreparedSolve:
                 np.negative(memory[k.MSTEP:k.MSTEP + 6], out=memory[k.MSTEP:k.MSTEP + 6])
                 memory[k.MPREDICTED] = 1.0
         status = self._outs[4]
-        stiff = self._stiff(piece, tip)
+        stiff = self._stiff()
         if stiff:
             # multiple shooting, from the unloaded arm (it keeps no chained memory: the next
             # call starts from there too), with its verdict
@@ -1133,15 +1139,14 @@ class Solver:
         self._coarse_ratio = 4  # the path runs on N / 4 steps (benchmarks/run.py measures it)
         self.reset()
 
-    def _stiff(self, channels) -> np.ndarray:
+    def _stiff(self, loads, channels) -> np.ndarray:
         """Which cases go to multiple shooting (B,) bool: ``shooting`` "multiple" all,
         "single" none, "auto" those whose estimated kL reaches STIFF_KL (_stiff.py)."""
         if self.shooting != "auto":
             return np.full(channels.count, self.shooting == "multiple")
         if channels.contact_load is not None:  # (contact.md: why contact takes this route)
             return np.full(channels.count, True)
-        return tension_kl(channels.piece, channels.tip_loads, channels.lengths, self.length,
-                          self._data.soft) >= STIFF_KL
+        return tension_kl(self.arm, loads, channels.shape, self._data.soft) >= STIFF_KL
 
     def _threads(self, cases: int) -> int:
         """Threads for a batch of ``cases`` independent cases."""
@@ -1329,7 +1334,7 @@ class Solver:
         arm, options = channels.arm_tuple(), self._options(near)
         outs = (poses, strains, stresses, info, status, jac, motion, base_wrench, lengths)
 
-        stiff = self._stiff(channels)
+        stiff = self._stiff(loads, channels)
         if stiff.any() and (chained or near):
             # multiple shooting starts every case from the unloaded arm: a chained Solver
             # restarts from there after it (docs/solver.md, "Multiple shooting")

@@ -191,8 +191,7 @@ def closed_form_verdict(solver, loads, eq, states_at=None) -> Stability | None:
             eq.poses[..., -1, :, :], (*shape, 4, 4)).reshape(count, 4, 4)
     steps = _closed_form_steps(channels, data)
     states = None
-    kl = tension_kl(channels.piece, channels.tip_loads, channels.lengths, data.length,
-                    data.soft)
+    kl = tension_kl(solver.arm, loads, shape, data.soft)
     if np.any(kl >= STIFF_KL):
         if states_at is None:
             return None
