@@ -11,8 +11,14 @@ are refused up front, and a limit reached is said.
 
 from __future__ import annotations
 
+import math
+import re
+import subprocess
+import sys
+
 import numpy as np
 import pytest
+from _planar_elastica import linear_tension_deflection
 from scipy.integrate import solve_bvp
 
 import softarm as sa
@@ -90,3 +96,128 @@ def test_the_route_counts_a_fields_force_on_the_magnets_and_no_actuator():
     tip = sa.TipLoad(force=[3.0, -4.0, 0.0])
     push = sa.DistributedForce([0.0, 0.0, -2.0], span=(0.1, 0.3))
     assert largest_force(arm, [tip, tendon, chamber, push]) == pytest.approx(7.0 + 0.4)
+
+
+# ---------------------------------------------------------------------------------------------
+# out-of-range inputs, refused before any solve (docs/solver.md, "Out-of-range inputs")
+
+
+def _table_arm():
+    return sa.Arm(0.5, sa.Circle(0.01), sa.Material(youngs_modulus=1e6, poisson_ratio=0.5,
+                                                    density=1000.0))
+
+
+def _table(**options):
+    return sa.Contact(sa.Plane((0.0, 0.0, -0.03), (0.0, 0.0, 1.0)), **options)
+
+
+def test_a_contact_band_or_penalty_the_steps_cannot_resolve_is_refused():
+    # δ >= L / 2^30 (a band crossed tangentially spans √(2δL) along the arm, a step L/2^15)
+    # and k <= EI (2^15 / L)⁴ (a foundation bends the arm on (EI/k)^¼): by hand
+    arm = _table_arm()
+    L, EI = 0.5, 1e6 * math.pi * 0.01**4 / 4
+    least, most = L / 2.0**30, EI * (2.0**15 / L) ** 4
+    with pytest.raises(ValueError, match=rf"Contact\.distance must be at least L / 32768² = "
+                                         rf"{re.escape(f'{least:.3g}')} m .* got 1e-30 m"):
+        sa.solve(arm, [sa.Gravity(), _table(distance=1e-30)])
+    with pytest.raises(ValueError, match=rf"Contact\.stiffness must be at most .* = "
+                                         rf"{re.escape(f'{most:.3g}')} N/m² .* got 1e\+300 N/m²"):
+        sa.solve(arm, [sa.Gravity(), _table(stiffness=1e300)])
+    _table(distance=1.001 * least).check(arm)  # (just inside: accepted)
+    _table(stiffness=0.999 * most).check(arm)
+
+
+def test_a_case_file_with_an_unresolvable_contact_band_is_one_line_on_stderr(tmp_path):
+    case = tmp_path / "band.toml"
+    case.write_text("[arm]\nlength = 0.5\nsection = { kind = 'circle', radius = 0.01 }\n"
+                    "material = { E = 1.0e6, nu = 0.5, density = 1000.0 }\n"
+                    "[[load]]\nkind = 'gravity'\n[[obstacle]]\nkind = 'plane'\n"
+                    "point = [0, 0, -0.03]\nnormal = [0, 0, 1]\n[contact]\ndistance = 1e-30\n")
+    out = tmp_path / "out.npz"
+    run = subprocess.run([sys.executable, "-m", "softarm", "solve", str(case), "-o", str(out)],
+                         capture_output=True, text=True, timeout=300)
+    assert run.returncode == 2, run.stderr
+    assert len(run.stderr.strip().splitlines()) == 1
+    assert "distance" in run.stderr and "Traceback" not in run.stderr
+    assert not out.exists()
+
+
+def test_a_curvature_no_step_count_resolves_is_refused():
+    # 1e12 1/m on 1 m turns the arm by 1e12 rad: more than the 2^15 steps resolve
+    with pytest.raises(ValueError, match=r"Arm\.curvature: the unloaded arm turns by 1e\+12 "
+                                         r"rad .* more than the 32768 rad"):
+        sa.Arm.from_stiffness(1.0, EA=1e6, GAy=1e6, GAz=1e6, GJ=1.0, EIy=1.0, EIz=1.0,
+                              curvature=(0.0, 1e12, 0.0))
+    piece = sa.Arm.from_stiffness(1.0, EA=1e6, GAy=1e6, GAz=1e6, GJ=1.0, EIy=1.0, EIz=1.0,
+                                  curvature=(0.0, 2e4, 0.0))
+    with pytest.raises(ValueError, match=r"SegmentedArm\.segments' curvatures: .* turns by "
+                                         r"4e\+04 rad"):
+        sa.SegmentedArm([piece, piece])
+    # within that range, fewer steps than the turning needs: named
+    with pytest.raises(ValueError, match=r"max_steps = 1024 RK4 steps cannot resolve this "
+                                         r"arm: it turns by 2e\+04 rad .* max_steps >= 20000"):
+        sa.solve(piece, sa.TipLoad(force=[0.0, 0.0, 1.0]), max_steps=1024)
+
+
+def _arc_tip(kappa: float, L: float) -> np.ndarray:
+    """The tip of a circular arc of curvature κ about +y... bending towards -z (the frame's
+    rotation about y by κ s: d1 = (cos κs, 0, -sin κs))."""
+    return np.array([math.sin(kappa * L), 0.0, -(1.0 - math.cos(kappa * L))]) / kappa
+
+
+@pytest.mark.parametrize("method", ["auto", "numeric"])
+def test_a_strongly_curved_arm_under_an_end_moment_is_a_circle(method):
+    # κ⁰ L = 2000 (318 turns), M L/EI = 1: the circle of curvature κ⁰ + M/EI. The numerical
+    # path ran on too few steps for the arm's own turning (a false fold at λ = 0) and the
+    # closed form's stability sweep overflowed (LinAlgError): both counted only the loads'
+    kappa0, M = 2000.0, 1.0
+    arm = sa.Arm.from_stiffness(1.0, EA=1e6, GAy=1e6, GAz=1e6, GJ=1.0, EIy=1.0, EIz=1.0,
+                                curvature=(0.0, kappa0, 0.0))
+    eq = sa.solve(arm, sa.TipLoad(moment=[0.0, M, 0.0]), method=method, tol=1e-6, s=3)
+    assert eq.tip_position == pytest.approx(_arc_tip(kappa0 + M, 1.0), abs=1e-6)
+    assert eq.stability is not None
+
+
+# ---------------------------------------------------------------------------------------------
+# pulls beyond the axial stiffness (docs/solver.md, "The model's limits")
+
+# a nitinol-like guide wire, r = 0.25 mm, E = 50 GPa, L = 1 m: EA L²/EI = 4 L²/r² = 6.4e7,
+# so F L²/EI = 1e8 is a pull of 1.56 EA
+WIRE = sa.Arm(1.0, sa.Circle(0.25e-3), sa.Material(youngs_modulus=50e9, poisson_ratio=0.3))
+
+
+@pytest.mark.parametrize("ratio", [1.56, 10.0])  # F / EA
+def test_a_pull_beyond_ea_stretches_the_rod_by_f_over_ea(ratio):
+    # the linear law σ = K ε holds at any stretch: the bar's tip at L (1 + F/EA) exactly;
+    # with GA = EA the straight rod is stable in tension at any pull, and a lateral P =
+    # 1e-3 F deflects the tip by linear tension theory, exact for EA = GA to (P/F)³ L
+    R = WIRE.rigidities
+    EA, EI, L = R.EA, R.EIy, 1.0
+    arm = sa.Arm.from_stiffness(L, EA=EA, GAy=EA, GAz=EA, GJ=R.GJ, EIy=EI, EIz=EI)
+    F = ratio * EA
+    zero = sa.DistributedForce([0.0, 0.0, 0.0])  # (off the closed form's route)
+    axial = sa.solve(arm, [sa.TipLoad(force=[F, 0.0, 0.0]), zero], method="numeric", s=3)
+    assert axial.tip_position == pytest.approx([L * (1.0 + F / EA), 0.0, 0.0], abs=1e-12)
+    P = 1e-3 * F
+    eq = sa.solve(arm, [sa.TipLoad(force=[F, 0.0, P]), zero], method="numeric", s=3,
+                  tol=1e-10)
+    assert eq.stability.index == 0
+    assert eq.tip_position[2] == pytest.approx(
+        linear_tension_deflection(F, P, EI, L, EA), abs=1e-9 * L)
+    # x: the stretch F L/EA, less (P/F)² L/2 of the tilted line (to (P/F)⁴ and 1/(kL))
+    assert eq.tip_position[0] == pytest.approx(L * (1.0 + F / EA) - 0.5e-6 * L, abs=1e-9)
+
+
+@pytest.mark.slow  # (12-28 s: the path fails among the buckled branches)
+def test_a_pull_beyond_the_tensile_limit_of_a_shearable_rod_says_so():
+    # GA = 0.34 EA (ν = 0.3): past T* = EA GA/(EA - GA) = 0.517 EA the straight rod in
+    # tension is unstable in this model (the shear turns the centreline against its
+    # sections); the path with a lateral imperfection fails there, and says why, not "fold"
+    R = WIRE.rigidities
+    limit = R.EA * R.GAy / (R.EA - R.GAy)
+    F = 1.56 * R.EA
+    with pytest.raises(sa.ConvergenceError, match=rf"T\* = EA·GA/\(EA − GA\) = "
+                                                  rf"{limit:.4g} N") as error:
+        sa.solve(WIRE, [sa.TipLoad(force=[F, 0.0, 1e-3 * F]),
+                        sa.DistributedForce([0.0, 0.0, 0.0])], method="numeric", s=3)
+    assert error.value.load_factor * F * 1.001 >= limit

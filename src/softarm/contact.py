@@ -28,7 +28,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from ._validate import as_array, format_value, real
+from ._validate import MAX_STEPS, as_array, format_value, real
 from .loads import Key, Load
 
 __all__ = ["Capsule", "Contact", "Obstacle", "Plane", "Sphere", "along_the_arm",
@@ -368,6 +368,30 @@ class Contact(Load):
 
     def check(self, arm) -> None:
         self.surface_radii(arm)
+        # The representable range (docs/contact.md, "Limits"): a band crossed tangentially
+        # by an arm curved on the scale of L spans √(2δL) along it, and an elastic
+        # foundation k bends it on (EI/k)^¼; neither resolves below one of the MAX_STEPS
+        # RK4 steps a solve takes at most, L / MAX_STEPS.
+        length = float(arm.length)
+        least = length / MAX_STEPS**2
+        if self.distance is not None and self.distance < least:
+            raise ValueError(
+                f"Contact.distance must be at least L / {MAX_STEPS}² = {least:.3g} m on this "
+                f"arm (L = {length:.4g} m), got {self.distance:.3g} m: a narrower band spans "
+                f"less along the arm (√(2δL) where the arm meets an obstacle tangentially) "
+                f"than the shortest step a solve takes, L / {MAX_STEPS}; give a wider "
+                f"distance, or none (default {DISTANCE:g} L)")
+        if self.stiffness is not None:
+            EI = min(float(min(np.diagonal(seg.stiffness)[4:])) for seg in arm.segments)
+            most = EI * (MAX_STEPS / length) ** 4
+            k = float(np.max(self.stiffness))
+            if k > most:
+                raise ValueError(
+                    f"Contact.stiffness must be at most EI ({MAX_STEPS}/L)⁴ = {most:.3g} N/m² "
+                    f"on this arm (EI = {EI:.3g} N m², L = {length:.4g} m), got {k:.3g} "
+                    f"N/m²: a stiffer penalty bends the arm on (EI/k)^¼, shorter than the "
+                    f"shortest step a solve takes (L / {MAX_STEPS}); give a smaller stiffness, "
+                    "or none (the solver chooses one from the loads)")
 
     def surface_radii(self, arm) -> np.ndarray:
         """The surface radius of each of the arm's segments (m): ``radius``, else the

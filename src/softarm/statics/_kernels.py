@@ -1676,6 +1676,11 @@ def _load_size(arm, act, scale, start, end, tip_start, tip_end):
     return w, moment * flexibility
 
 
+#: Coarse steps per radian of the unloaded arm's turning Σ |κ⁰| L at the least
+#: (_first_steps): one radian a step on the path's quarter grid.
+_CURVED_STEPS = 4.0
+
+
 @_jit
 def _first_steps(arm, tol, turning):
     """The first coarse step count: 0.07 (1 + turning) (tol/L)^-1/4, in [2, 256] (the
@@ -1687,7 +1692,9 @@ def _first_steps(arm, tol, turning):
                                         + arm[3][j, 5] ** 2)
     rel = tol / arm[6] if math.isfinite(tol) else 1e-8
     n = math.ceil(0.07 * (1.0 + kappa0 + turning) * rel ** -0.25)
-    return min(256, max(2, n))
+    # and _CURVED_STEPS per radian of the unloaded arm's own turning, beyond the cap: the
+    # path runs on a quarter of N, and RK4 turns a section stably by < 2.8 rad a step
+    return max(min(256, max(2, n)), math.ceil(_CURVED_STEPS * kappa0))
 
 
 @_inline

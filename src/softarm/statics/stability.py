@@ -103,23 +103,26 @@ def make(index, conservative_, shape) -> Stability:
 def _closed_form_steps(channels, data) -> np.ndarray:
     """RK4 steps for the sweep of each closed-form case: the Jacobi fields vary on the
     scales 1/√(F/EI) and EI/(F L), EI/M; 8 + 2 (kL + F L²/EI + M L/EI) steps keep h k and
-    the turning per step below about 1/2, in [12, 256]."""
+    the turning per step below about 1/2, in [12, 256]; and at least 2 per radian of the
+    unloaded arm's own turning Σ |κ⁰| L (a step turning by more than 2.8 rad is unstable)."""
     k = _k()
     EI, L = data.least_bending, data.length
+    curved = math.ceil(2.0 * data.turning)
     if channels.count == 1:  # one case: scalar arithmetic (numpy's per-call cost dominates)
         t = channels.tip_loads[0].tolist()
         force = math.sqrt(sum((abs(t[k.TD + i]) + abs(t[k.TF + i])) ** 2 for i in range(3)))
         moment = math.sqrt(sum((abs(t[k.TD + 3 + i]) + abs(t[k.TF + 3 + i])) ** 2
                                for i in range(3)))
-        return np.array([min(max(math.ceil(_sweep_steps(force, moment, L, EI)), 12.0),
-                                 256.0)])
+        return np.array([max(min(max(math.ceil(_sweep_steps(force, moment, L, EI)), 12.0),
+                                  256.0), curved)])
     tip = np.abs(channels.tip_loads)
     force = tip[:, k.TD:k.TD + 3] + tip[:, k.TF:k.TF + 3]
     moment = tip[:, k.TD + 3:k.TD + 6] + tip[:, k.TF + 3:k.TF + 6]
     force = np.sqrt((force * force).sum(-1))  # (not np.linalg.norm: 4× its cost here)
     moment = np.sqrt((moment * moment).sum(-1))
     n = _sweep_steps(force, moment, L, EI)
-    return np.minimum(np.maximum(np.ceil(n), 12.0), 256.0)  # (np.clip: 3× the cost)
+    # (np.clip: 3× the cost)
+    return np.maximum(np.minimum(np.maximum(np.ceil(n), 12.0), 256.0), curved)
 
 
 def _sweep_steps(force, moment, L, EI):
