@@ -221,3 +221,31 @@ def test_a_pull_beyond_the_tensile_limit_of_a_shearable_rod_says_so():
         sa.solve(WIRE, [sa.TipLoad(force=[F, 0.0, 1e-3 * F]),
                         sa.DistributedForce([0.0, 0.0, 0.0])], method="numeric", s=3)
     assert error.value.load_factor * F * 1.001 >= limit
+
+
+# ---------------------------------------------------------------------------------------------
+# a limit reached is said: continuation and critical_load
+
+
+def test_a_branch_that_stops_before_its_end_says_why():
+    # a tip pull at F L²/EI = 1000 (kL = 32 at λ = 1): continuation shoots once from the
+    # base, which carries the tension only to kL ≈ 20 (λ ≈ 0.38). The branch so far is
+    # returned, flagged, with the reason; its points are linear tension theory's
+    # (exact for EA = GA to (P/F)³ L = 5e-10 L)
+    arm = sa.Arm.from_stiffness(1.0, EA=1e8, GAy=1e8, GAz=1e8, GJ=1.0, EIy=1.0, EIz=1.0)
+    with pytest.warns(RuntimeWarning, match=r"could not be followed beyond load factor .* "
+                                            r"tension up to kL"):
+        branch = sa.continuation(arm, [sa.TipLoad(force=[1000.0, 0.0, 1.0])])
+    assert not branch.complete and "kL = L √(F/EI) = 19" in branch.reason
+    assert 0.3 < branch.lam[-1] < 1.0
+    tips = np.asarray(branch.equilibria.tip_position)
+    for k in (len(branch.lam) // 2, -1):
+        F = 1000.0 * branch.lam[k]
+        assert tips[k, 2] == pytest.approx(linear_tension_deflection(F, 1e-3 * F, 1.0, 1.0,
+                                                                     1e8), abs=2e-9)
+    # the budget of points, likewise; a branch followed to its end is complete
+    with pytest.warns(RuntimeWarning, match=r"max_points = 3 points were followed"):
+        short = sa.continuation(arm, [sa.TipLoad(force=[10.0, 0.0, 1.0])], max_points=3)
+    assert not short.complete and short.lam.size == 3
+    whole = sa.continuation(arm, [sa.TipLoad(force=[10.0, 0.0, 1.0])])
+    assert whole.complete and whole.reason == "" and whole.lam[-1] == 1.0

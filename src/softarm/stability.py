@@ -23,7 +23,16 @@ from .dispatch import solve_stable
 from .errors import ConvergenceError
 from .loads import as_loads
 from .statics import Solver
-from .statics.continuation import STEPS, Branch, CriticalPoint, Mode, Path, branch, follow
+from .statics.continuation import (
+    STEPS,
+    Branch,
+    CriticalPoint,
+    Mode,
+    Path,
+    branch,
+    follow,
+    follow_to,
+)
 
 __all__ = ["Branch", "CriticalPoint", "Mode", "continuation", "critical_load", "plot_branch",
            "solve_stable"]
@@ -202,7 +211,10 @@ def continuation(arm, loads, lam=(0.0, 1.0), *, steps=STEPS, base=None, s=None,
     (:func:`softarm.solve`). Returns a :class:`Branch`: ``lam``, ``x``, ``index``,
     ``critical`` (folds and bifurcations, located to about 1e-12 in arclength) and
     ``equilibria`` (one batched Equilibrium); ``branch.switch(point)`` follows a bifurcating
-    branch. ``max_step`` bounds the steps (nondimensional arclength in (x, λ): base reaction
+    branch. A branch that stops before lam[1] (``max_points`` points followed, or a point
+    beyond which it cannot be followed: under a tension of kL beyond about 20, or a grid too
+    coarse) is returned with ``complete`` False and ``reason`` saying why, after a
+    RuntimeWarning. ``max_step`` bounds the steps (nondimensional arclength in (x, λ): base reaction
     in units of the bending scale times the load size, and λ); ``steps``: RK4 steps over
     the arm.
     """
@@ -216,9 +228,8 @@ def continuation(arm, loads, lam=(0.0, 1.0), *, steps=STEPS, base=None, s=None,
         z0 = path.correct(path.z(np.asarray(eq.base_wrench), lam0))
     if z0 is None:
         raise ConvergenceError(f"no equilibrium to start from at λ = {lam0}", math.nan)
-    points, indices, critical = follow(path, z0, lam1, max_points=max_points,
-                                       locate=path.conservative, max_step=max_step)
-    return branch(path, points, indices, critical)
+    return branch(path, *follow_to(path, z0, lam1, max_points=max_points,
+                                   locate=path.conservative, max_step=max_step))
 
 
 def plot_branch(*branches, coordinate=2, ax=None, labels=None, path=None):
