@@ -15,6 +15,7 @@ import math
 import re
 import subprocess
 import sys
+import warnings
 
 import numpy as np
 import pytest
@@ -249,3 +250,38 @@ def test_a_branch_that_stops_before_its_end_says_why():
     assert not short.complete and short.lam.size == 3
     whole = sa.continuation(arm, [sa.TipLoad(force=[10.0, 0.0, 1.0])])
     assert whole.complete and whole.reason == "" and whole.lam[-1] == 1.0
+
+
+def test_a_huge_ball_gives_gaps_to_round_off_of_the_gap():
+    # |p - c| - R for a centre 1e6 m away cancelled 1e-10 m of every gap's digits: against
+    # the gap computed in 50-digit decimal arithmetic from the same floats
+    from decimal import Decimal, getcontext
+    getcontext().prec = 50
+    big = 1e6
+    ball = sa.Sphere((0.0, 0.0, -0.03 - big), big)
+    c = [Decimal(float(v)) for v in ball.center]
+    for point in ([0.3, 0.1, -0.0299], [0.49, -0.2, -0.0299999], [0.0, 0.0, 0.5]):
+        d, n = ball.distance(np.array(point))
+        exact = sum((Decimal(v) - w) ** 2 for v, w in zip(point, c, strict=True)).sqrt() \
+            - Decimal(big)
+        assert float(d) == pytest.approx(float(exact), rel=1e-12, abs=1e-22)
+        assert n == pytest.approx((np.array(point) - ball.center)
+                                  / np.linalg.norm(np.array(point) - ball.center), abs=1e-15)
+
+
+def test_an_arm_on_a_huge_ball_lies_as_on_the_plane_less_its_sag():
+    # a ball of radius 1e6 m as a floor: the arm on the table of docs/contact.md, each
+    # station lower by the ball's sag x²/(2R) than on the plane (1.2e-7 m at the tip). It
+    # took 131-140 s and widened the band (the rounding of the gaps made the law noisy); now
+    # it takes the plane's 1-2 s
+    arm = _table_arm()
+    big = 1e6
+    s = np.linspace(0.0, 0.5, 51)
+    plane = sa.solve(arm, [sa.Gravity(), _table()], s=s)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", sa.ApproximationWarning)  # (no widened band)
+        ball = sa.solve(arm, [sa.Gravity(), sa.Contact(sa.Sphere((0.0, 0.0, -0.03 - big),
+                                                                  big))], s=s)
+    p, q = np.asarray(plane.positions), np.asarray(ball.positions)
+    assert q[:, 2] == pytest.approx(p[:, 2] - q[:, 0] ** 2 / (2 * big), abs=2e-9)
+    assert q[:, :2] == pytest.approx(p[:, :2], abs=5e-9)

@@ -144,7 +144,13 @@ class Sphere(Obstacle):
         object.__setattr__(self, "radius", _radius(self.radius, "Sphere.radius"))
 
     def kernel_row(self):
-        return np.array([_SPHERE, *self.center, 0.0, 0.0, 0.0, self.radius])
+        # the surface point q nearest the spatial origin (near the arm) and the outward
+        # normal m there, the centre being q - R m: the gap of a point p is computed from
+        # p - q, precise to round-off of the gap itself, however large the ball (_distance)
+        size = float(np.linalg.norm(self.center))
+        normal = -self.center / size if size > 0.0 else np.array([0.0, 0.0, 1.0])
+        return np.array([_SPHERE, *(self.center + self.radius * normal), *normal,
+                         self.radius])
 
     def moved(self, R, origin):
         return Sphere(R.T @ (self.center - origin), self.radius)
@@ -200,6 +206,13 @@ def _distance(row: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     if kind == _PLANE:
         normal = row[4:7]
         return (p - row[1:4]) @ normal, np.broadcast_to(normal, p.shape).copy()
+    if kind == _SPHERE:  # (a surface point, its normal m, R: Sphere.kernel_row)
+        w, radius = p - row[1:4], row[7]
+        u = w + radius * row[4:7]
+        r = np.linalg.norm(u, axis=-1)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            n = np.where(r[..., None] > 0.0, u / r[..., None], 0.0)
+        return (2.0 * radius * (w @ row[4:7]) + (w * w).sum(-1)) / (r + radius), n
     q = np.broadcast_to(row[1:4], p.shape)
     if kind == _CAPSULE:
         axis = row[4:7] - row[1:4]

@@ -807,6 +807,20 @@ def _nearest(px, py, pz, row):
     if kind == PLANE:
         return ((px - row[1]) * row[4] + (py - row[2]) * row[5] + (pz - row[3]) * row[6],
                 row[4], row[5], row[6], 0.0, 0.0, 0.0, 0.0)
+    if kind == SPHERE:
+        # row: a surface point q, the outward normal m there, the radius R (contact.py's
+        # Sphere.kernel_row): with w = p - q, |p - c| - R = (2R m·w + w·w)/(|p - c| + R),
+        # without the cancellation of |p - c| - R (a ball of 1e6 m as a floor: 1e-10 m of
+        # rounding in every gap, a noisy law within a band of µm)
+        wx, wy, wz = px - row[1], py - row[2], pz - row[3]
+        radius = row[7]
+        ux, uy, uz = wx + radius * row[4], wy + radius * row[5], wz + radius * row[6]
+        r = math.sqrt(ux * ux + uy * uy + uz * uz)
+        if r == 0.0:  # on the centre: the normal is undefined (deep inside)
+            return -radius, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        d = (2.0 * radius * (wx * row[4] + wy * row[5] + wz * row[6])
+             + wx * wx + wy * wy + wz * wz) / (r + radius)
+        return d, ux / r, uy / r, uz / r, 1.0 / r, 0.0, 0.0, 0.0
     qx, qy, qz = row[1], row[2], row[3]
     e0 = e1 = e2 = 0.0
     if kind == CAPSULE:
