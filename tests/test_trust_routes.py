@@ -285,3 +285,22 @@ def test_an_arm_on_a_huge_ball_lies_as_on_the_plane_less_its_sag():
     p, q = np.asarray(plane.positions), np.asarray(ball.positions)
     assert q[:, 2] == pytest.approx(p[:, 2] - q[:, 0] ** 2 / (2 * big), abs=2e-9)
     assert q[:, :2] == pytest.approx(p[:, :2], abs=5e-9)
+
+
+def test_critical_load_in_contact_returns_none_after_two_solves(monkeypatch):
+    # the arm on the table under up to 10× its weight is stable (nothing compresses it):
+    # None after the solves at λ = 0 and at max_factor (sixteen samples took 17 solves,
+    # 28 s of CPU; benchmarks/trust_routes.py)
+    from softarm.statics.solver import Solver
+    solves = []
+    original = Solver.solve_from_unloaded
+
+    def counted(self, loads, **options):
+        solves.append(1)
+        return original(self, loads, **options)
+
+    monkeypatch.setattr(Solver, "solve_from_unloaded", counted)
+    gravity = sa.Gravity()
+    point = sa.critical_load(_table_arm(), [gravity, _table()], vary=[gravity],
+                             max_factor=10.0)
+    assert point is None and len(solves) == 2
