@@ -304,3 +304,26 @@ def test_critical_load_in_contact_returns_none_after_two_solves(monkeypatch):
     point = sa.critical_load(_table_arm(), [gravity, _table()], vary=[gravity],
                              max_factor=10.0)
     assert point is None and len(solves) == 2
+
+
+@pytest.mark.parametrize("ratio", [0.4, 0.6, 1.0])  # T / EA; T* = 0.515 EA
+def test_the_closed_form_index_counts_the_tensile_modes_of_a_shearable_rod(ratio):
+    # the straight rod under a dead tension T, GA < EA: a tilted section θ turns the
+    # centreline by θ (1 + T/EA - T/GA), and EI θ'' = -T (T/GA - T/EA - 1) θ: each plane
+    # has the modes (2n - 1) π/2 < ωL, ω² = T (T/GA - T/EA - 1)/EI (none below T*). The
+    # closed form counted compressions only (0 at any tension); the numerical verdict
+    # (an independent sweep) counted these
+    EA, GA, EI, L = 1e4, 3400.0, 1.0, 1.0
+    arm = sa.Arm.from_stiffness(L, EA=EA, GAy=GA, GAz=GA, GJ=1.0, EIy=EI, EIz=EI)
+    T = ratio * EA
+    omega2 = T * (T / GA - T / EA - 1.0) / EI
+    per_plane = sum(1 for n in range(1, 1000)
+                    if (2 * n - 1) * math.pi / 2 < math.sqrt(max(omega2, 0.0)) * L)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", sa.StabilityWarning)
+        closed = sa.solve(arm, sa.TipLoad(force=[T, 0.0, 0.0]), s=3)
+        numeric = sa.solve(arm, [sa.TipLoad(force=[T, 0.0, 0.0]),
+                                 sa.DistributedForce([0.0, 0.0, 0.0])], method="numeric", s=3)
+    assert closed.method == "analytic.axial_force"
+    assert closed.stability.index == 2 * per_plane == numeric.stability.index
+    assert (per_plane > 0) == (ratio > EA * GA / (EA - GA) / EA)

@@ -134,7 +134,9 @@ def _axial_index(eq, data, loads):
     """The Morse index of the straight arm under a dead axial tip force (a compression P),
     in closed form, or None where it does not apply: each bending plane loses stability at
     every P_n with P_n (1 + P_n (1/GA - 1/EA)) = (2n - 1)² π² EI/(4L²) (the linearised
-    extensible, shearable rod; buckling.json, cosserat_cantilever_extensible_shearable)."""
+    extensible, shearable rod; buckling.json, cosserat_cantilever_extensible_shearable).
+    Its roots P < 0 are tensions beyond EA GA/(EA - GA) where GA < EA, at which the
+    shearable rod buckles in tension (docs/solver.md, "The model's limits")."""
     K = data.K
     if K.shape[0] != 1 or np.any(K[0] != np.diag(np.diagonal(K[0]))) or np.any(data.f0[:, 1:]):
         return None
@@ -148,9 +150,9 @@ def _axial_index(eq, data, loads):
         c = 1.0 / GA - 1.0 / EA
         # the n >= 1 with P_n < P: P (1 + c P) > (2n - 1)² Q1, Q1 = π² EI/(4 L²)
         Q1 = np.pi ** 2 * EI / (4 * L * L)
-        root = np.sqrt(np.maximum(np.where(P > 0, P * (1 + c * P), 0.0), 0.0) / Q1)
+        root = np.sqrt(np.maximum(P * (1 + c * P), 0.0) / Q1)
         n = np.ceil((root + 1.0) / 2.0) - 1.0  # the n with 2n - 1 < root
-        index += np.where(P > 0, n, 0).astype(np.int64)
+        index += n.astype(np.int64)
     return index
 
 
