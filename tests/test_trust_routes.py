@@ -1,14 +1,21 @@
 """Issue 42 ("Trust, round 4"): the solver's route counts every force, out-of-range inputs
 are refused up front, and a limit reached is said.
 
-- a field gradient pulling a magnetised arm (kL = 32 by its pull) goes to multiple shooting
-  and is solved: its tip against a collocation solution (scipy's solve_bvp) of the planar
-  extensible, shearable rod under the magnetic force density G (R m) and torque
-  (R m) × B(p), continued in the load factor as the solver's path is;
-- the route's force of a field on the arm's magnets against the hand bound Σ|G_ij| (|m| L +
-  |dipole|), and actuators' counting nothing (measured in docs/solver.md).
+- the route: a field gradient pulling a magnetised arm (kL = 32 by its pull) goes to
+  multiple shooting and is solved, its tip against a collocation solution (scipy's
+  solve_bvp) of the planar extensible, shearable rod under the magnetic force density
+  G (R m) and torque (R m) × B(p), continued in the load factor as the solver's path is;
+  the route's force on the arm's magnets against the hand bound Σ|G_ij| (|m| L + |dipole|);
+- out-of-range inputs (a contact band or penalty no step resolves, a curvature no step count
+  resolves), refused with the limits by hand, also from a case file; a strongly curved arm
+  under an end moment against the circle;
+- pulls beyond EA: the bar's tip at L (1 + F/EA), a lateral pull against linear tension
+  theory; past T* = EA GA/(EA - GA) the failure says so, and the closed form's index counts
+  the tensile modes the hand linearisation gives;
+- a branch that stops before its end says why (its points against linear tension theory);
+  critical_load in contact returns None after two solves; a ball of radius 1e6 m as a floor:
+  its gaps against 50-digit arithmetic, the arm on it as on the plane less the sag.
 """
-
 from __future__ import annotations
 
 import math

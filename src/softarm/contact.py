@@ -74,7 +74,9 @@ class Obstacle:
         return _distance(self.kernel_row(), np.asarray(points, dtype=np.float64))
 
     def kernel_row(self) -> np.ndarray:
-        """The solver's row (8,): kind, two points, radius (statics/_kernels.py)."""
+        """The solver's row (8,): kind, two points or a point and a direction, radius
+        (statics/_kernels.py's ``_nearest``: a plane's point and normal, a ball's surface
+        point and outward normal there, a capsule's axis ends)."""
         raise NotImplementedError
 
     def moved(self, R, origin) -> Obstacle:
