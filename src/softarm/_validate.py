@@ -23,6 +23,7 @@ __all__ = [
     "BYTES_PER_STATION",
     "CASES_PER_PART",
     "LENGTH_RANGE",
+    "MAX_STEPS",
     "PART_BYTES",
     "WORK_PER_CASE",
     "as_array",
@@ -58,6 +59,12 @@ BYTES_PER_CASE = 640
 #: allocator still holds of the one before, tests/test_memory.py); the solver's parts also
 #: copy their own result into the whole batch's (CASES_PER_PART, counted twice)
 PART_BYTES = 1 << 26
+
+#: The most RK4 steps along the arm a solve takes by default (the numerical solver's
+#: ``max_steps``, the fine solution's count): the inputs' representable range is measured
+#: against it (docs/solver.md, "Out-of-range inputs"): a step resolves a turning of about a
+#: radian, and lengths (an elastic foundation's, a contact band's) of about L / MAX_STEPS.
+MAX_STEPS = 1 << 15
 
 #: Largest deviation ‖RᵀR − I‖ (max entry) of a base rotation that is re-orthonormalised; a
 #: rotation off by more is rejected.

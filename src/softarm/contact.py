@@ -28,7 +28,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from ._validate import as_array, format_value, real
+from ._validate import MAX_STEPS, as_array, format_value, real
 from .loads import Key, Load
 
 __all__ = ["Capsule", "Contact", "Obstacle", "Plane", "Sphere", "along_the_arm",
@@ -74,7 +74,9 @@ class Obstacle:
         return _distance(self.kernel_row(), np.asarray(points, dtype=np.float64))
 
     def kernel_row(self) -> np.ndarray:
-        """The solver's row (8,): kind, two points, radius (statics/_kernels.py)."""
+        """The solver's row (8,): kind, two points or a point and a direction, radius
+        (statics/_kernels.py's ``_nearest``: a plane's point and normal, a ball's surface
+        point and outward normal there, a capsule's axis ends)."""
         raise NotImplementedError
 
     def moved(self, R, origin) -> Obstacle:
@@ -147,7 +149,13 @@ class Sphere(Obstacle):
         object.__setattr__(self, "radius", _radius(self.radius, "Sphere.radius"))
 
     def kernel_row(self):
-        return np.array([_SPHERE, *self.center, 0.0, 0.0, 0.0, self.radius])
+        # the surface point q nearest the spatial origin (near the arm) and the outward
+        # normal m there, the centre being q - R m: the gap of a point p is computed from
+        # p - q, precise to round-off of the gap itself, however large the ball (_distance)
+        size = float(np.linalg.norm(self.center))
+        normal = -self.center / size if size > 0.0 else np.array([0.0, 0.0, 1.0])
+        return np.array([_SPHERE, *(self.center + self.radius * normal), *normal,
+                         self.radius])
 
     def moved(self, R, origin):
         return Sphere(R.T @ (self.center - origin), self.radius)
@@ -203,6 +211,13 @@ def _distance(row: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     if kind == _PLANE:
         normal = row[4:7]
         return (p - row[1:4]) @ normal, np.broadcast_to(normal, p.shape).copy()
+    if kind == _SPHERE:  # (a surface point, its normal m, R: Sphere.kernel_row)
+        w, radius = p - row[1:4], row[7]
+        u = w + radius * row[4:7]
+        r = np.linalg.norm(u, axis=-1)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            n = np.where(r[..., None] > 0.0, u / r[..., None], 0.0)
+        return (2.0 * radius * (w @ row[4:7]) + (w * w).sum(-1)) / (r + radius), n
     q = np.broadcast_to(row[1:4], p.shape)
     if kind == _CAPSULE:
         axis = row[4:7] - row[1:4]
@@ -371,6 +386,30 @@ class Contact(Load):
 
     def check(self, arm) -> None:
         self.surface_radii(arm)
+        # The representable range (docs/contact.md, "Limits"): a band crossed tangentially
+        # by an arm curved on the scale of L spans √(2δL) along it, and an elastic
+        # foundation k bends it on (EI/k)^¼; neither resolves below one of the MAX_STEPS
+        # RK4 steps a solve takes at most, L / MAX_STEPS.
+        length = float(arm.length)
+        least = length / MAX_STEPS**2
+        if self.distance is not None and self.distance < least:
+            raise ValueError(
+                f"Contact.distance must be at least L / {MAX_STEPS}² = {least:.3g} m on this "
+                f"arm (L = {length:.4g} m), got {self.distance:.3g} m: a narrower band spans "
+                f"less along the arm (√(2δL) where the arm meets an obstacle tangentially) "
+                f"than the shortest step a solve takes, L / {MAX_STEPS}; give a wider "
+                f"distance, or none (default {DISTANCE:g} L)")
+        if self.stiffness is not None:
+            EI = min(float(min(np.diagonal(seg.stiffness)[4:])) for seg in arm.segments)
+            most = EI * (MAX_STEPS / length) ** 4
+            k = float(np.max(self.stiffness))
+            if k > most:
+                raise ValueError(
+                    f"Contact.stiffness must be at most EI ({MAX_STEPS}/L)⁴ = {most:.3g} N/m² "
+                    f"on this arm (EI = {EI:.3g} N m², L = {length:.4g} m), got {k:.3g} "
+                    f"N/m²: a stiffer penalty bends the arm on (EI/k)^¼, shorter than the "
+                    f"shortest step a solve takes (L / {MAX_STEPS}); give a smaller stiffness, "
+                    "or none (the solver chooses one from the loads)")
 
     def surface_radii(self, arm) -> np.ndarray:
         """The surface radius of each of the arm's segments (m): ``radius``, else the

@@ -43,6 +43,7 @@ __all__ = [
     "as_loads",
     "batch_shape",
     "check_magnitudes",
+    "largest_force",
     "path_tangent",
 ]
 
@@ -1085,6 +1086,86 @@ class _Sizes:
         B = _largest(field) * 3.0 ** 0.5 + spread * self.length
         self._moment(B * (self.magnetization * self.length + self.dipole))
         self._force(spread * (self.magnetization * self.length + self.dipole))
+
+
+def largest_force(arm, loads):
+    """The largest force (N) the loads can apply to ``arm`` from outside, per case: a float
+    for single loads, else an array of their batch shape. A bound of the tension they can
+    cause anywhere in the arm: each force's components' magnitudes summed, a distributed
+    force's over the length it acts on, summed over the loads. The solver's route counts it
+    (kL = L √(F/EI), statics/_stiff.py).
+
+    Each load is measured through its own :meth:`Load.apply` (the interface every kind
+    implements, as :func:`check_magnitudes` measures it), so a kind made of the
+    :class:`LoadTarget`'s calls is counted without code of its own: forces at points and
+    along the arm, a field gradient's force on the arm's magnets. An actuator (a tendon's
+    tension, a chamber's p A) counts nothing: it is internal, balanced by the sections it
+    pushes on, and compresses the backbone as much as it pulls (docs/solver.md, "The
+    route"); nor does contact (a reaction to the other loads; the route sends it to multiple
+    shooting whatever its size)."""
+    target = _Forces(arm)
+    for load in loads if type(loads) is tuple else as_loads(loads):
+        load.apply(target)
+    return target.force
+
+
+def _magnitudes(value):
+    """Σ |component| over the last axis: (..., 3) -> (...) (a float for one vector)."""
+    value = np.asarray(value)
+    if value.ndim == 1:  # (one case: in Python, a third of numpy's call overhead)
+        return sum(map(abs, value.tolist()))
+    return np.abs(value).sum(-1)
+
+
+class _Forces:
+    """A :class:`LoadTarget` that measures the largest force (N) loads apply to the arm
+    from outside (:func:`largest_force`): ``force``, a float or an array of the loads'
+    batch shape."""
+
+    def __init__(self, arm):
+        self.arm, self.length = arm, float(arm.length)
+        self.force = 0.0
+
+    def distributed(self, *, force=None, moment=None, follower=False, span=None,
+                    per_mass=False):
+        if force is None:
+            return
+        lo, hi = (0.0, self.length) if span is None else span
+        bounds = self.arm.boundaries
+        along = 0.0
+        for k, segment in enumerate(self.arm.segments):  # (∫ ds, or ∫ μ ds, on the span)
+            overlap = max(0.0, min(hi, bounds[k + 1]) - max(lo, bounds[k]))
+            along += overlap * ((segment.linear_density or 0.0) if per_mass else 1.0)
+        self.force = self.force + _magnitudes(force) * along
+
+    def point(self, s, *, force=None, moment=None):
+        if force is not None:
+            self.force = self.force + _magnitudes(force)
+
+    def tip(self, *, force=None, moment=None, follower=False):
+        self.point(self.length, force=force)
+
+    def actuator(self, kind, magnitude, routing, span):
+        pass  # internal (largest_force)
+
+    def displaced_tendon(self, displacement, routing, span):
+        pass  # internal, like a tendon under tension control
+
+    def contact(self, load):
+        pass  # (largest_force)
+
+    def field(self, field, gradient=None):
+        # the force Gᵀ (R m) per length on a magnetisation m and on each dipole: its
+        # components' magnitudes are at most Σ|G_ij| |m| whatever the rotation R
+        if gradient is None:
+            return
+        magnets = sum(_norm(getattr(seg, "magnetization", None)) * seg.length
+                      + _norm(getattr(seg, "tip_magnet", None)) for seg in self.arm.segments)
+        self.force = self.force + np.abs(np.asarray(gradient)).sum((-1, -2)) * magnets
+
+
+def _norm(vector) -> float:
+    return 0.0 if vector is None else float(np.linalg.norm(vector))
 
 
 def _size(load, arm, scales, target=None) -> float:

@@ -23,7 +23,16 @@ from .dispatch import solve_stable
 from .errors import ConvergenceError
 from .loads import as_loads
 from .statics import Solver
-from .statics.continuation import STEPS, Branch, CriticalPoint, Mode, Path, branch, follow
+from .statics.continuation import (
+    STEPS,
+    Branch,
+    CriticalPoint,
+    Mode,
+    Path,
+    branch,
+    follow,
+    follow_to,
+)
 
 __all__ = ["Branch", "CriticalPoint", "Mode", "continuation", "critical_load", "plot_branch",
            "solve_stable"]
@@ -127,19 +136,20 @@ def critical_load(arm, loads, vary=None, *, max_factor=10.0, steps=STEPS, tol=1e
             return point
 
 
-#: Load factors sampled on (0, max_factor] to bracket a contact problem's first loss of
-#: stability before bisection (:func:`_critical_in_contact`).
-_CONTACT_SAMPLES = 16
-
-
 def _critical_in_contact(arm, fixed, varied, max_factor, tol, base) -> CriticalPoint | None:
     """:func:`critical_load` with a Contact among the loads: the Morse index of the
-    multiple-shooting solve (the route that resolves a contact, docs/contact.md) sampled on
-    _CONTACT_SAMPLES load factors, then bisected on the first bracket of a change, each
-    point solved from the unloaded arm (a continuation in λ on a fixed grid does not resolve
-    a contact's band). The point's ``mode`` is None and ``x`` the base reaction at the last
-    stable factor; ``kind`` is "fold" where the solve fails beyond it (no equilibrium
-    connected to the unloaded arm), else "bifurcation"."""
+    multiple-shooting solve (the route that resolves a contact, docs/contact.md) at
+    ``max_factor``: None if the equilibrium there is stable; else bisected on [0,
+    max_factor] to ``tol``, each point solved from the unloaded arm (a continuation in λ on
+    a fixed grid does not resolve a contact's band). Each point is a whole solve (1-3 s on
+    the table of docs/contact.md), so the index is taken to stay lost once lost (what it
+    does along a path from the unloaded arm, where stability is lost at bifurcations
+    crossed, not regained): a window of instability that closes again below
+    ``max_factor`` is not looked for (sixteen samples before bisection missed those
+    narrower than max_factor/16, and took 28 s of CPU to return None on the table). The
+    point's ``mode`` is None and ``x`` the base reaction at the last stable factor; ``kind``
+    is "fold" where the solve fails beyond it (no equilibrium connected to the unloaded
+    arm), else "bifurcation"."""
     solver = Solver(arm, base=base, stability=True)
 
     def index(lam):
@@ -158,16 +168,10 @@ def _critical_in_contact(arm, fixed, varied, max_factor, tol, base) -> CriticalP
         raise ValueError(f"the equilibrium at λ = 0 (the held loads alone) is "
                          f"{'not found' if start is None else 'already unstable'} "
                          f"(Morse index {start})")
-    low = 0.0
-    for k in range(1, _CONTACT_SAMPLES + 1):
-        high = max_factor * k / _CONTACT_SAMPLES
-        found, y = index(high)
-        if found != 0:
-            break
-        low, x = high, y
-    else:
+    low, high = 0.0, max_factor
+    after, _ = index(high)
+    if after == 0:
         return None
-    after = found
     while high - low > tol * high:
         middle = 0.5 * (low + high)
         found, y = index(middle)
@@ -202,7 +206,10 @@ def continuation(arm, loads, lam=(0.0, 1.0), *, steps=STEPS, base=None, s=None,
     (:func:`softarm.solve`). Returns a :class:`Branch`: ``lam``, ``x``, ``index``,
     ``critical`` (folds and bifurcations, located to about 1e-12 in arclength) and
     ``equilibria`` (one batched Equilibrium); ``branch.switch(point)`` follows a bifurcating
-    branch. ``max_step`` bounds the steps (nondimensional arclength in (x, λ): base reaction
+    branch. A branch that stops before lam[1] (``max_points`` points followed, or a point
+    beyond which it cannot be followed: under a tension of kL beyond about 20, or a grid too
+    coarse) is returned with ``complete`` False and ``reason`` saying why, after a
+    RuntimeWarning. ``max_step`` bounds the steps (nondimensional arclength in (x, λ): base reaction
     in units of the bending scale times the load size, and λ); ``steps``: RK4 steps over
     the arm.
     """
@@ -216,9 +223,8 @@ def continuation(arm, loads, lam=(0.0, 1.0), *, steps=STEPS, base=None, s=None,
         z0 = path.correct(path.z(np.asarray(eq.base_wrench), lam0))
     if z0 is None:
         raise ConvergenceError(f"no equilibrium to start from at λ = {lam0}", math.nan)
-    points, indices, critical = follow(path, z0, lam1, max_points=max_points,
-                                       locate=path.conservative, max_step=max_step)
-    return branch(path, points, indices, critical)
+    return branch(path, *follow_to(path, z0, lam1, max_points=max_points,
+                                   locate=path.conservative, max_step=max_step))
 
 
 def plot_branch(*branches, coordinate=2, ax=None, labels=None, path=None):

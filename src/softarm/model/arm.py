@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import as_vectors, format_value, length, nonnegative
+from .._validate import MAX_STEPS, as_vectors, format_value, length, nonnegative
 from .material import Material
 from .sections import Circle, Rectangle, Rigidities, Section, StiffnessMatrix, Tube
 
@@ -89,6 +89,9 @@ class Arm:
         if curvature.shape != (3,):
             raise ValueError(f"Arm.curvature must have shape (3,), got shape {curvature.shape}")
         object.__setattr__(self, "curvature", tuple(float(c) for c in curvature))
+        _check_turning(float(np.linalg.norm(curvature)) * self.length, "Arm.curvature",
+                       f"|κ⁰| = {float(np.linalg.norm(curvature)):.3g} 1/m on L = "
+                       f"{self.length:.3g} m")
         if self.mass_per_length is not None:
             object.__setattr__(self, "mass_per_length",
                                nonnegative(self.mass_per_length, "Arm.mass_per_length",
@@ -234,6 +237,9 @@ class SegmentedArm:
                 f"{format_value(self.segments)}"
             )
         object.__setattr__(self, "segments", segments)
+        turning = sum(float(np.linalg.norm(a.curvature)) * a.length for a in segments)
+        _check_turning(turning, "SegmentedArm.segments' curvatures",
+                       "Σ |κ⁰| L over the segments")
 
     @property
     def length(self) -> float:
@@ -246,3 +252,15 @@ class SegmentedArm:
         bounds = np.concatenate([[0.0], np.cumsum([a.length for a in self.segments])])
         bounds[-1] = self.length  # the same float as ``length``
         return tuple(float(b) for b in bounds)
+
+
+def _check_turning(turning: float, name: str, how: str) -> None:
+    """ValueError if the unloaded arm turns by more than MAX_STEPS rad (``turning``, its
+    own curvature's, |κ⁰| L): no step count softarm takes resolves it (docs/solver.md,
+    "Out-of-range inputs")."""
+    if turning > MAX_STEPS:
+        raise ValueError(
+            f"{name}: the unloaded arm turns by {turning:.3g} rad ({how}), more than the "
+            f"{MAX_STEPS} rad softarm can resolve: its solver and stability verdict take at "
+            f"most {MAX_STEPS} RK4 steps along the arm, and a step turns a section by a "
+            "radian at most")

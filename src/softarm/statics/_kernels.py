@@ -827,6 +827,20 @@ def _nearest(px, py, pz, row):
     if kind == PLANE:
         return ((px - row[1]) * row[4] + (py - row[2]) * row[5] + (pz - row[3]) * row[6],
                 row[4], row[5], row[6], 0.0, 0.0, 0.0, 0.0)
+    if kind == SPHERE:
+        # row: a surface point q, the outward normal m there, the radius R (contact.py's
+        # Sphere.kernel_row): with w = p - q, |p - c| - R = (2R m·w + w·w)/(|p - c| + R),
+        # without the cancellation of |p - c| - R (a ball of 1e6 m as a floor: 1e-10 m of
+        # rounding in every gap, a noisy law within a band of µm)
+        wx, wy, wz = px - row[1], py - row[2], pz - row[3]
+        radius = row[7]
+        ux, uy, uz = wx + radius * row[4], wy + radius * row[5], wz + radius * row[6]
+        r = math.sqrt(ux * ux + uy * uy + uz * uz)
+        if r == 0.0:  # on the centre: the normal is undefined (deep inside)
+            return -radius, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        d = (2.0 * radius * (wx * row[4] + wy * row[5] + wz * row[6])
+             + wx * wx + wy * wy + wz * wz) / (r + radius)
+        return d, ux / r, uy / r, uz / r, 1.0 / r, 0.0, 0.0, 0.0
     qx, qy, qz = row[1], row[2], row[3]
     e0 = e1 = e2 = 0.0
     if kind == CAPSULE:
@@ -1849,6 +1863,11 @@ def _load_size(arm, act, scale, start, end, tip_start, tip_end):
     return w, moment * flexibility
 
 
+#: Coarse steps per radian of the unloaded arm's turning Σ |κ⁰| L at the least
+#: (_first_steps): one radian a step on the path's quarter grid.
+_CURVED_STEPS = 4.0
+
+
 @_jit
 def _first_steps(arm, tol, turning):
     """The first coarse step count: 0.07 (1 + turning) (tol/L)^-1/4, in [2, 256] (the
@@ -1860,7 +1879,9 @@ def _first_steps(arm, tol, turning):
                                         + arm[3][j, 5] ** 2)
     rel = tol / arm[6] if math.isfinite(tol) else 1e-8
     n = math.ceil(0.07 * (1.0 + kappa0 + turning) * rel ** -0.25)
-    return min(256, max(2, n))
+    # and _CURVED_STEPS per radian of the unloaded arm's own turning, beyond the cap: the
+    # path runs on a quarter of N, and RK4 turns a section stably by < 2.8 rad a step
+    return max(min(256, max(2, n)), math.ceil(_CURVED_STEPS * kappa0))
 
 
 @_inline

@@ -8,37 +8,29 @@ import math
 
 import numpy as np
 
+from ..loads import largest_force
+
 __all__ = ["STIFF_KL", "tension_kl"]
 
-#: Cases whose estimated kL = L √(F/EI) (F the largest load's force, EI the softest bending
+#: Cases whose estimated kL = L √(F/EI) (F the loads' largest force, EI the softest bending
 #: stiffness) reaches this go to multiple shooting: at kL = 15 single shooting's tangents
 #: have grown by e^15 = 3e6, and it was measured to fail from kL ≈ 22 (a hanging hose) and
-#: 32 (a rod in tension).
+#: 32 (a rod in tension, and one pulled by a field gradient on its magnetisation).
 STIFF_KL = 15.0
 
 
-def tension_kl(pieces, tip, lengths, length: float, soft: float) -> np.ndarray:
-    """kL per case (B,), estimated from the kernel's load channels (``pieces`` (B, P, C),
-    ``tip`` (B, 12); ``lengths`` (P,) the pieces', ``length`` L, ``soft`` the largest
-    bending compliance 1/EI of the arm): L √(F / EI), F the larger of the tip force and the
-    sum of the distributed and point forces, each as the sum of its components' magnitudes
-    (an upper bound of the tension anywhere). Not the actuators': a tendon's tension or a
-    chamber's pressure is internal, it compresses the backbone (oscillating Jacobi fields,
-    not growing ones), and single shooting was measured to solve a tendon robot at
-    τL²/EI = 1e4. (The channels' layout is _kernels': FD, FF at 0-5, JD at 12, JF at 18; TD
-    at 0, TF at 6. A control loop calls this once a solve: a few µs, not more.)"""
-    if pieces.shape[0] == 1:  # one case (the control loop): Python floats, 4× faster
-        along = points = 0.0
-        for row, piece_length in zip(pieces[0, :, :21].tolist(), lengths.tolist(),
-                                     strict=True):
-            along += sum(abs(v) for v in row[0:6]) * piece_length
-            points += sum(abs(v) for v in row[12:15]) + sum(abs(v) for v in row[18:21])
-        t = tip[0].tolist()
-        at_tip = sum(abs(v) for v in t[0:3]) + sum(abs(v) for v in t[6:9])
-        return np.array([length * math.sqrt(max(at_tip, along + points) * soft)])
-    forces = np.abs(pieces[..., :21])
-    along = forces[..., 0:6].sum(-1) @ lengths
-    points = forces[..., 12:15].sum((-1, -2)) + forces[..., 18:21].sum((-1, -2))
-    tip = np.abs(tip)
-    at_tip = tip[:, 0:3].sum(-1) + tip[:, 6:9].sum(-1)
-    return length * np.sqrt(np.maximum(at_tip, along + points) * soft)
+def tension_kl(arm, loads, shape: tuple, soft: float) -> np.ndarray:
+    """kL per case, flattened (B,) of the batch ``shape``: L √(F / EI), F the loads' largest
+    force (:func:`softarm.loads.largest_force`: every force a load can apply from outside,
+    at points, along the arm, on its magnets, summed; an upper bound of the tension
+    anywhere), ``soft`` the largest bending compliance 1/EI of the arm. Each load measures
+    itself through its own ``apply``: this function knows no load kind. Actuators count
+    nothing: a tendon's tension or a chamber's pressure is internal, it compresses the
+    backbone (oscillating Jacobi fields, not growing ones), and single shooting was measured
+    to solve a tendon robot and a chamber at τL²/EI = p A L²/EI = 1e4 (docs/solver.md). (A
+    control loop calls this once a solve: a few µs.)"""
+    force = largest_force(arm, loads)
+    if isinstance(force, float):  # every load single (np.ndim: 2 µs)
+        kl = arm.length * math.sqrt(force * soft)
+        return np.array([kl]) if shape == () else np.full(math.prod(shape), kl)
+    return arm.length * np.sqrt(np.broadcast_to(force, shape).reshape(-1) * soft)

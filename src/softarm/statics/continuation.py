@@ -11,6 +11,7 @@ any threshold: x and r in units of the bending scale (EI/L², EI/L) times (1 + t
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -19,10 +20,11 @@ from .._admissible import check_stretch, inside_out, stretched
 from ..equilibrium import Equilibrium
 from ..errors import ConvergenceError
 from ..loads import as_loads
+from ._stiff import STIFF_KL, tension_kl
 from .solver import METHOD, Solver, _kernels
 from .stability import conservative, make
 
-__all__ = ["Branch", "CriticalPoint", "Mode", "Path"]
+__all__ = ["Branch", "CriticalPoint", "Mode", "Path", "Stopped"]
 
 #: Default RK4 steps over the arm of a continuation grid (spread over the pieces).
 STEPS = 256
@@ -301,6 +303,10 @@ class Branch:
     equilibria: Equilibrium
     path: Path = field(repr=False)
     conservative: bool = True
+    #: False if the branch stops before the load factor asked for; ``reason`` says why
+    #: (a RuntimeWarning said it too)
+    complete: bool = True
+    reason: str = ""
 
     @property
     def stable(self) -> np.ndarray:
@@ -343,11 +349,40 @@ def _orient(mode: Mode, imperfection) -> np.ndarray:
     return c / np.linalg.norm(c)
 
 
+class Stopped(ConvergenceError):
+    """A branch that could not be followed to its end (:func:`follow`): a ConvergenceError
+    that also holds what was followed, ``points``, ``indices``, ``critical``, for a caller
+    that returns the branch so far (:func:`softarm.continuation`)."""
+
+    def __init__(self, message, tried, load_factor, points, indices, critical):
+        super().__init__(message, math.nan, tried, load_factor=load_factor)
+        self.points, self.indices, self.critical = points, indices, critical
+
+
+def _why_stopped(path: Path, lam: float) -> str:
+    """Why a branch cannot be followed at λ, as far as the loads tell: the tension they can
+    put the arm in (kL, statics/_stiff.py), which one shooting from the base does not carry
+    beyond kL ≈ 20 (docs/solver.md, "Multiple shooting"); else the grid."""
+    solver = path.solver
+    loads = (*path.fixed, *(load.scaled(lam) for load in path.varied))
+    kl = float(tension_kl(solver.arm, loads, (), solver._data.soft)[0])
+    if kl >= STIFF_KL:
+        return (f": there the loads can put the arm in tension up to kL = L √(F/EI) = "
+                f"{kl:.3g}, and continuation shoots once from the base, whose tangents grow "
+                f"like e^{{kL}} beyond what double precision carries from kL ≈ 20 (the solver "
+                f"takes multiple shooting from kL = {STIFF_KL:g}; continuation does not: "
+                f"softarm.solve gives the equilibrium at any one λ)")
+    return (f" (the corrector failed at arclength steps below {_DS_MIN:g}: a finer grid, "
+            f"steps > {path.n}, may follow it)")
+
+
 def follow(path: Path, z0, lam_end, *, direction=None, ds=0.05, max_points=2000,
            locate=True, stop_at_critical=False, max_step=_DS_MAX) -> tuple:
     """Pseudo-arclength continuation from the point z0 (converged) until λ reaches
     ``lam_end``, with steps of at most ``max_step`` (nondimensional arclength in (x, λ)).
-    Returns (points (K, 7), indices (K,), critical points)."""
+    Returns (points (K, 7), indices (K,), critical points); stops early at ``max_points``
+    points (the caller compares the last λ with ``lam_end``). A :class:`Stopped` where the
+    branch cannot be followed, with the points so far."""
     t = path.tangent(z0, direction)
     if direction is None and np.sign(t[6]) != np.sign(lam_end - z0[6]) and t[6] != 0:
         t = -t
@@ -375,9 +410,10 @@ def follow(path: Path, z0, lam_end, *, direction=None, ds=0.05, max_points=2000,
         if new is None:
             ds *= 0.5
             if ds < _DS_MIN:
-                raise ConvergenceError(
-                    f"continuation could not be followed beyond load factor λ = {z[6]:.6g}",
-                    math.nan, f"{path.shootings} shootings", load_factor=float(z[6]))
+                raise Stopped(
+                    f"continuation could not be followed beyond load factor λ = {z[6]:.6g}"
+                    f"{_why_stopped(path, float(z[6]))}", f"{path.shootings} shootings",
+                    float(z[6]), np.array(points), np.array(indices), tuple(critical))
             continue
         index = path.index(new)[0]
         if index != indices[-1] and locate:
@@ -426,13 +462,34 @@ def _locate(path, za, ta, zb, tb, index_a, index_b) -> CriticalPoint:
                          path)
 
 
-def branch(path: Path, points, indices, critical) -> Branch:
+def branch(path: Path, points, indices, critical, reason: str = "") -> Branch:
+    """The Branch of the points followed; ``reason``: why it stops before its end ("" if
+    it does not), after a RuntimeWarning that says so."""
+    if reason:
+        warnings.warn(f"softarm: {reason}", RuntimeWarning, stacklevel=4)
     eq = path.record(points)
     lam = points[:, 6].copy()
     x = points[:, :6] * path.xscale
     for array in (lam, x, indices):
         array.setflags(write=False)
-    return Branch(lam, x, indices, critical, eq, path, path.conservative)
+    return Branch(lam, x, indices, critical, eq, path, path.conservative,
+                  complete=not reason, reason=reason)
+
+
+def follow_to(path: Path, z0, lam_end, *, max_points=2000, **options) -> tuple:
+    """:func:`follow` to ``lam_end``: (points, indices, critical, reason), ``reason`` why the
+    branch stops before it ("" if it does not): the budget of ``max_points``, or a point
+    beyond which it cannot be followed (for :func:`branch`)."""
+    try:
+        points, indices, critical = follow(path, z0, lam_end, max_points=max_points,
+                                           **options)
+    except Stopped as stop:
+        return stop.points, stop.indices, stop.critical, stop.message
+    reason = ""
+    if abs(points[-1, 6] - lam_end) > 1e-14 * max(1.0, abs(lam_end)):
+        reason = (f"the branch stops at load factor λ = {points[-1, 6]:.6g}, short of "
+                  f"{lam_end:.6g}: max_points = {max_points} points were followed")
+    return points, indices, critical, reason
 
 
 def _switch(path: Path, point: CriticalPoint, imperfection, lam_end, ds=0.005,
@@ -458,8 +515,8 @@ def _switch(path: Path, point: CriticalPoint, imperfection, lam_end, ds=0.005,
             f"could not leave the bifurcation at λ = {point.factor:.6g} along its mode",
             math.nan, f"{path.shootings} shootings", load_factor=point.factor)
     t = path.tangent(first, direction)
-    points, indices, critical = follow(path, first, lam_end, direction=t, ds=ds,
-                                       max_points=max_points, max_step=max_step)
+    points, indices, critical, reason = follow_to(path, first, lam_end, direction=t, ds=ds,
+                                                  max_points=max_points, max_step=max_step)
     points = np.vstack([zc[None], points])
     indices = np.concatenate([[-1], indices])  # the bifurcation point itself: critical
-    return branch(path, points, indices, critical)
+    return branch(path, points, indices, critical, reason)

@@ -23,6 +23,7 @@ from .._validate import (
     BYTES_PER_CASE,
     BYTES_PER_STATION,
     CASES_PER_PART,
+    MAX_STEPS,
     check_allocation,
     count,
     real,
@@ -33,7 +34,15 @@ from ..contact import resultant
 from ..equilibrium import Equilibrium, Stability
 from ..errors import ApproximationWarning, ConvergenceError, InadmissibleStateError
 from ..lie import se3
-from ..loads import Gravity, Tendon, as_loads, batch_shape, check_magnitudes, path_tangent
+from ..loads import (
+    Gravity,
+    Tendon,
+    as_loads,
+    batch_shape,
+    check_magnitudes,
+    largest_force,
+    path_tangent,
+)
 from ..model import Arm, Circle, Material, SegmentedArm
 from ..routing import Straight
 from . import _prefetch
@@ -47,7 +56,7 @@ __all__ = ["METHOD", "PreparedSolve", "ShootResult", "Shooter", "Snapshot", "Sol
 #: Equilibrium.method of every result of this solver.
 METHOD = "numeric.shooting"
 
-_N_MAX = 1 << 15  # largest step count of the fine solution is 2 * _N_MAX / 2
+_N_MAX = MAX_STEPS  # largest step count of the fine solution is 2 * _N_MAX / 2
 _IDENTITY = np.eye(4)
 _IDENTITY.setflags(write=False)
 #: Fewest load cases per thread of a batch: below it a thread costs more than it saves.
@@ -127,6 +136,9 @@ class _ArmData:
                              f"be finite and >= 0 kg/m, got {self.mu.tolist()!r}")
         #: the largest bending compliance 1/EI (the tension's kL, _stiff.py)
         self.soft = float(np.max(self.C[:, [4, 5], [4, 5]]))
+        #: the unloaded arm's own turning Σ |κ⁰| L (rad): steps it needs at the least
+        self.turning = float(sum(np.linalg.norm(seg.curvature) * seg.length
+                                 for seg in segments))
         #: the narrowest shear zone √(EI/GA) (m; bending about z with shear along y, and
         #: about y with shear along z): where contact spreads a point reaction (contact.md)
         self.shear_zone = float(np.sqrt(np.min(self.C[:, [1, 2], [1, 2]]
@@ -770,23 +782,29 @@ class PreparedSolve:
         self.index, self.conservative = 0, True
         self._last = None  # what this object last wrote as the Solver's _last
         self._q_last, self._dq = np.empty(n), np.empty(n)  # its inputs; their change
-        # The route (_stiff.py): fixed when no input moves a force channel (actuation inputs
-        # act through their own channels), else decided at every call
+        # The route (_stiff.py): fixed when no input changes the loads' largest force (a
+        # tendon's tension, a chamber's pressure and a field's B0 do not: measured at zero
+        # and at each unit input), else decided at every call
         self._route = None
         if solver.shooting != "auto":
             self._route = solver.shooting == "multiple"
         elif channels.contact_load is not None:
             self._route = True  # (as Solver._stiff)
-        elif not (np.any(unit_piece[..., :21]) or np.any(unit_tip[..., :9])):
-            self._route = bool(tension_kl(channels.piece, channels.tip_loads, pieces[1],
-                                          solver.length, solver._data.soft)[0] >= STIFF_KL)
+        else:
+            units = np.eye(n)
+            kls = {float(self._kl(self.loads_at(q))) for q in (np.zeros(n), *units)}
+            if len(kls) == 1:
+                self._route = float(self._kl(loads)) >= STIFF_KL
 
-    def _stiff(self, piece, tip) -> bool:
-        """Whether these loads take multiple shooting (Solver's route, _stiff.py)."""
+    def _kl(self, loads) -> float:
+        return tension_kl(self._solver.arm, loads, (), self._solver._data.soft)[0]
+
+    def _stiff(self) -> bool:
+        """Whether the loads at the present inputs take multiple shooting (Solver's route,
+        _stiff.py)."""
         if self._route is not None:
             return self._route
-        return bool(tension_kl(piece, tip, self._pieces[1], self._solver.length,
-                               self._solver._data.soft)[0] >= STIFF_KL)
+        return bool(self._kl(self.loads_at(self.inputs)) >= STIFF_KL)
 
     def solve(self, q, *, near=None) -> None:
         """Solve at the inputs q (every input, in :attr:`inputs`' order; not validated: the
@@ -831,7 +849,7 @@ class PreparedSolve:
                 np.negative(memory[k.MSTEP:k.MSTEP + 6], out=memory[k.MSTEP:k.MSTEP + 6])
                 memory[k.MPREDICTED] = 1.0
         status = self._outs[4]
-        stiff = self._stiff(piece, tip)
+        stiff = self._stiff()
         if stiff:
             # multiple shooting, from the unloaded arm (it keeps no chained memory: the next
             # call starts from there too), with its verdict
@@ -1135,15 +1153,14 @@ class Solver:
         self._coarse_ratio = 4  # the path runs on N / 4 steps (benchmarks/run.py measures it)
         self.reset()
 
-    def _stiff(self, channels) -> np.ndarray:
+    def _stiff(self, loads, channels) -> np.ndarray:
         """Which cases go to multiple shooting (B,) bool: ``shooting`` "multiple" all,
         "single" none, "auto" those whose estimated kL reaches STIFF_KL (_stiff.py)."""
         if self.shooting != "auto":
             return np.full(channels.count, self.shooting == "multiple")
         if channels.contact_load is not None:  # (contact.md: why contact takes this route)
             return np.full(channels.count, True)
-        return tension_kl(channels.piece, channels.tip_loads, channels.lengths, self.length,
-                          self._data.soft) >= STIFF_KL
+        return tension_kl(self.arm, loads, channels.shape, self._data.soft) >= STIFF_KL
 
     def _threads(self, cases: int) -> int:
         """Threads for a batch of ``cases`` independent cases."""
@@ -1253,6 +1270,13 @@ class Solver:
             raise TypeError(f"jacobians must be True or False, got {jacobians!r}")
         if not checked:
             loads = as_loads(loads)
+        steps = max(self.max_steps, self.steps or 0)
+        if self._data.turning > steps:
+            raise ValueError(
+                f"max_steps = {steps} RK4 steps cannot resolve this arm: it turns by "
+                f"{self._data.turning:.4g} rad unloaded (its curvature |κ⁰| L), and a step "
+                f"turns a section by a radian at most: give max_steps >= "
+                f"{math.ceil(self._data.turning)}")
         if any(load.displacement_controlled for load in loads):
             # the tensions are unknowns: a bounded Newton method over tension-controlled
             # solves from the unloaded arm (statics/displacement.py); a chained Solver
@@ -1331,7 +1355,7 @@ class Solver:
         arm, options = channels.arm_tuple(), self._options(near)
         outs = (poses, strains, stresses, info, status, jac, motion, base_wrench, lengths)
 
-        stiff = self._stiff(channels)
+        stiff = self._stiff(loads, channels)
         if stiff.any() and (chained or near):
             # multiple shooting starts every case from the unloaded arm: a chained Solver
             # restarts from there after it (docs/solver.md, "Multiple shooting")
@@ -1370,6 +1394,8 @@ class Solver:
                 error = _tendon_limit(self, loads, shape, int(failed[0]),
                                       None if chained else info[failed[0], 2],
                                       error.residual) or error
+                if not chained:
+                    error = _tension_limit(self, loads, shape, int(failed[0]), error) or error
             raise error
         if contact is not None:
             stiffer = _penetration(self, channels.contact_load, poses, s_kernel, attempt,
@@ -1867,6 +1893,37 @@ def _tendon_limit(solver, loads, shape, b: int, reached, residual: float
             f"unloaded arm's at s = {station:.4g} m and would vanish at λ ≈ {lam:.4g}, a "
             f"tension of about {lam * tension:.4g} N)", residual, load_factor=float(reached))
     return None
+
+
+def _tension_limit(solver, loads, shape, b: int, error) -> ConvergenceError | None:
+    """Why the loading path of case ``b`` (from the unloaded arm) failed, if its loads can
+    pull beyond the tension T* = EA GA/(EA − GA) of a segment whose shear is softer than its
+    extension (GA < EA) at the load factor it reached (``error.load_factor``): past T* the
+    straight rod in tension is unstable in this model, and a path into that regime fails
+    among its many branches (docs/solver.md, "The model's limits"). None otherwise."""
+    reached = error.load_factor
+    if reached is None:
+        return None
+    K = solver._data.K
+    EA, GA = K[:, 0, 0], np.minimum(K[:, 1, 1], K[:, 2, 2])
+    soft = GA < EA
+    if not soft.any():
+        return None
+    limits = np.where(soft, EA * GA / np.where(soft, EA - GA, 1.0), np.inf)
+    j = int(np.argmin(limits))
+    pull = reached * float(np.max(largest_force(solver.arm, _case_loads(loads, shape, b))))
+    if pull < limits[j]:
+        return None
+    segment = f" of segment {j}" if len(K) > 1 else ""
+    return ConvergenceError(
+        f"{error.message}; there the loads pull with up to {pull:.4g} N, beyond the tension "
+        f"T* = EA·GA/(EA − GA) = {limits[j]:.4g} N{segment} (EA = {EA[j]:.4g} N, GA = "
+        f"{GA[j]:.4g} N): past T*, at an axial strain of {limits[j] / EA[j]:.2g}, far beyond "
+        "an elastic material's range, the straight rod in tension is unstable in this "
+        "model (the linear law's shear turns the centreline against its sections: tensile "
+        "buckling), with a Morse index in the hundreds on a slender rod, and a path into it "
+        "fails among the buckled branches (docs/solver.md, \"The model's limits\")",
+        error.residual, error.tried, load_factor=reached)
 
 
 def _case_loads(loads, shape, b: int) -> list:

@@ -103,23 +103,26 @@ def make(index, conservative_, shape) -> Stability:
 def _closed_form_steps(channels, data) -> np.ndarray:
     """RK4 steps for the sweep of each closed-form case: the Jacobi fields vary on the
     scales 1/√(F/EI) and EI/(F L), EI/M; 8 + 2 (kL + F L²/EI + M L/EI) steps keep h k and
-    the turning per step below about 1/2, in [12, 256]."""
+    the turning per step below about 1/2, in [12, 256]; and at least 2 per radian of the
+    unloaded arm's own turning Σ |κ⁰| L (a step turning by more than 2.8 rad is unstable)."""
     k = _k()
     EI, L = data.least_bending, data.length
+    curved = math.ceil(2.0 * data.turning)
     if channels.count == 1:  # one case: scalar arithmetic (numpy's per-call cost dominates)
         t = channels.tip_loads[0].tolist()
         force = math.sqrt(sum((abs(t[k.TD + i]) + abs(t[k.TF + i])) ** 2 for i in range(3)))
         moment = math.sqrt(sum((abs(t[k.TD + 3 + i]) + abs(t[k.TF + 3 + i])) ** 2
                                for i in range(3)))
-        return np.array([min(max(math.ceil(_sweep_steps(force, moment, L, EI)), 12.0),
-                                 256.0)])
+        return np.array([max(min(max(math.ceil(_sweep_steps(force, moment, L, EI)), 12.0),
+                                  256.0), curved)])
     tip = np.abs(channels.tip_loads)
     force = tip[:, k.TD:k.TD + 3] + tip[:, k.TF:k.TF + 3]
     moment = tip[:, k.TD + 3:k.TD + 6] + tip[:, k.TF + 3:k.TF + 6]
     force = np.sqrt((force * force).sum(-1))  # (not np.linalg.norm: 4× its cost here)
     moment = np.sqrt((moment * moment).sum(-1))
     n = _sweep_steps(force, moment, L, EI)
-    return np.minimum(np.maximum(np.ceil(n), 12.0), 256.0)  # (np.clip: 3× the cost)
+    # (np.clip: 3× the cost)
+    return np.maximum(np.minimum(np.maximum(np.ceil(n), 12.0), 256.0), curved)
 
 
 def _sweep_steps(force, moment, L, EI):
@@ -131,7 +134,9 @@ def _axial_index(eq, data, loads):
     """The Morse index of the straight arm under a dead axial tip force (a compression P),
     in closed form, or None where it does not apply: each bending plane loses stability at
     every P_n with P_n (1 + P_n (1/GA - 1/EA)) = (2n - 1)² π² EI/(4L²) (the linearised
-    extensible, shearable rod; buckling.json, cosserat_cantilever_extensible_shearable)."""
+    extensible, shearable rod; buckling.json, cosserat_cantilever_extensible_shearable).
+    Its roots P < 0 are tensions beyond EA GA/(EA - GA) where GA < EA, at which the
+    shearable rod buckles in tension (docs/solver.md, "The model's limits")."""
     K = data.K
     if K.shape[0] != 1 or np.any(K[0] != np.diag(np.diagonal(K[0]))) or np.any(data.f0[:, 1:]):
         return None
@@ -145,9 +150,9 @@ def _axial_index(eq, data, loads):
         c = 1.0 / GA - 1.0 / EA
         # the n >= 1 with P_n < P: P (1 + c P) > (2n - 1)² Q1, Q1 = π² EI/(4 L²)
         Q1 = np.pi ** 2 * EI / (4 * L * L)
-        root = np.sqrt(np.maximum(np.where(P > 0, P * (1 + c * P), 0.0), 0.0) / Q1)
+        root = np.sqrt(np.maximum(P * (1 + c * P), 0.0) / Q1)
         n = np.ceil((root + 1.0) / 2.0) - 1.0  # the n with 2n - 1 < root
-        index += np.where(P > 0, n, 0).astype(np.int64)
+        index += n.astype(np.int64)
     return index
 
 
@@ -191,8 +196,7 @@ def closed_form_verdict(solver, loads, eq, states_at=None) -> Stability | None:
             eq.poses[..., -1, :, :], (*shape, 4, 4)).reshape(count, 4, 4)
     steps = _closed_form_steps(channels, data)
     states = None
-    kl = tension_kl(channels.piece, channels.tip_loads, channels.lengths, data.length,
-                    data.soft)
+    kl = tension_kl(solver.arm, loads, shape, data.soft)
     if np.any(kl >= STIFF_KL):
         if states_at is None:
             return None
