@@ -321,36 +321,78 @@ def _parser() -> argparse.ArgumentParser:
 class _Interrupt:
     """SIGINT while the command runs: raise KeyboardInterrupt, as Python does, and remember it.
 
-    A KeyboardInterrupt raised while numba is inside a ctypes callback (writing its cache
-    during a compile) is printed and swallowed there ("Exception ignored on calling ctypes
-    callback function"), and the command would go on for minutes. Remembered, it is raised
-    again at the next progress report (:meth:`check`)."""
+    A KeyboardInterrupt raised while numba is inside a ctypes callback (llvmlite's object
+    cache, called from LLVM's C code right after the long machine-code step of a compile or a
+    cache load: where a Ctrl-C during a compile most often lands) is swallowed there, and
+    Python prints "Exception ignored on calling ctypes callback function" with a traceback;
+    the command would go on, even write its outputs. So :meth:`unraisable` (the command's
+    ``sys.unraisablehook``) drops that message and delivers the interrupt again from another
+    thread a moment later (``_thread.interrupt_main``), when the main thread is back in
+    Python code; and :meth:`check`, at every progress report and before the outputs are
+    written, raises any interrupt still pending. Once the command's outputs are written
+    (``done``), a Ctrl-C is only remembered: the exit status is the command's.
+    """
 
     seen = False
+    done = False
 
     @classmethod
     def handler(cls, signum, frame):
         cls.seen = True
-        raise KeyboardInterrupt
+        if not cls.done:
+            raise KeyboardInterrupt
 
     @classmethod
     def check(cls) -> None:
-        if cls.seen:
+        if cls.seen and not cls.done:
             raise KeyboardInterrupt
+
+    @classmethod
+    def unraisable(cls, previous):
+        def hook(unraisable):
+            if not (isinstance(unraisable.exc_value, KeyboardInterrupt)
+                    or unraisable.exc_type is KeyboardInterrupt):
+                return previous(unraisable)
+            cls.seen = True
+            if not cls.done:
+                again = threading.Timer(0.01, cls._again)
+                again.daemon = True
+                again.start()
+            return None
+        return hook
+
+    @classmethod
+    def _again(cls) -> None:
+        """Run the handler again in the main thread, if the command still runs."""
+        if not cls.done and signal.getsignal(signal.SIGINT) == cls.handler:
+            import _thread
+
+            _thread.interrupt_main()
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the ``softarm`` command with ``argv`` (default ``sys.argv[1:]``); return the exit
     code (see the module docstring and docs/cli.md)."""
-    _Interrupt.seen = False
-    previous = None
+    _Interrupt.seen = _Interrupt.done = False
+    previous = mask = None
     with contextlib.suppress(ValueError, OSError):  # ValueError: not the main thread
         previous = signal.signal(signal.SIGINT, _Interrupt.handler)
+    hook, sys.unraisablehook = sys.unraisablehook, _Interrupt.unraisable(sys.unraisablehook)
     try:
-        return _main(argv)
+        if previous is not None and hasattr(signal, "pthread_sigmask"):
+            # the launcher (src/_softarm_cli.py) holds a Ctrl-C until this handler is in place
+            mask = signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+        code = _main(argv)
+        _Interrupt.done = True
+        return code
     except KeyboardInterrupt:
         return interrupted()
     finally:
+        _Interrupt.done = True
+        sys.unraisablehook = hook
+        if mask is not None:  # held again if it was held (the launcher's exit)
+            with contextlib.suppress(ValueError, OSError):
+                signal.pthread_sigmask(signal.SIG_SETMASK, mask)
         if previous is not None and signal.getsignal(signal.SIGINT) == _Interrupt.handler:
             with contextlib.suppress(ValueError, OSError):
                 signal.signal(signal.SIGINT, previous)
@@ -745,6 +787,7 @@ def _input_size(load, name: str) -> int:
 
 
 def _write(case: Case, result, outputs, picture) -> None:
+    _Interrupt.check()  # a Ctrl-C not yet raised (see _Interrupt): nothing is written
     for out in outputs:
         save_result(result, out, case)
         print(f"wrote {out}")
