@@ -290,13 +290,16 @@ def test_a_swallowed_ctrl_c_is_raised_again_at_the_next_progress_report():
     next progress report, so the command still ends with exit status 130."""
     stream = _stdio.StringIO()
     progress = cli._Progress(stream, delay=0.0)
-    cli._Interrupt.seen = False
+    cli._Interrupt.seen = cli._Interrupt.done = False  # (as inside a command)
     progress(1, 4)  # nothing pending: no interrupt
     try:
         with pytest.raises(KeyboardInterrupt):
             cli._Interrupt.handler(2, None)  # raised, and remembered
         with pytest.raises(KeyboardInterrupt):
             progress(2, 4)  # ... so raised again here
+        cli._Interrupt.done = True  # the outputs written: remembered, no longer raised
+        cli._Interrupt.handler(2, None)
+        progress(3, 4)
     finally:
         cli._Interrupt.seen = False
 
