@@ -519,13 +519,14 @@ def _cold_compile_section(comp) -> list[str]:
         lines.append(f"- the verdict and the output pass compiled {name}"
                      f"{' (on the second core, the default)' if name == 'beside' else ''}: "
                      f"{wall:.1f} s wall, {cpu:.1f} s CPU")
-    output, statics, analytic, probe = comp["capabilities"]
+    output, statics, analytic, loads = comp["capabilities"]
     lines += ["", "Each capability on its first use (`softarm compile --all`, each step after "
-              "the ones before it, in a fresh cache):", "", "```", *output.splitlines(), "```",
+              f"the ones before it, in a fresh cache; load average {loads}):", "", "```",
+              *output.splitlines(), "```",
               "", "The compile time recorded per kernel capability (what the notice of a "
-              "first compile estimates from; the reference machine's figures are "
-              "`softarm._jit.REFERENCE_SECONDS`), and this machine's probe "
-              f"({probe * 1e3:.1f} ms):", "", "| capability | s |", "|---|---|"]
+              "compile quotes as this machine's last time; the reference machine's figures, "
+              "quoted before any, are `softarm._jit.REFERENCE_SECONDS`):", "",
+              "| capability | s |", "|---|---|"]
     for key, seconds in sorted({**statics, **analytic}.items(), key=lambda kv: -kv[1]):
         lines.append(f"| {key} | {seconds:.1f} |")
     return [*lines, ""]

@@ -301,13 +301,15 @@ def _parser() -> argparse.ArgumentParser:
                       help="folder for demo.png and demo.csv (default: the working directory)")
     demo.set_defaults(run=_run_demo)
 
+    from .warmup import STEPS  # (softarm's own modules: no numba until a step runs)
+
     compile_ = commands.add_parser(
         "compile", help="compile softarm's kernels ahead of time",
-        description="Compile the kernels a first solve needs, or with --all those of every "
-        "capability (Jacobians, quasi-static solves, actuated arms, the control loop, inverse "
-        "statics, displacement control, critical loads), and cache them: for a container "
-        "build or a cluster image. Each capability otherwise compiles on its first use; a "
-        "cached one loads in a fraction of a second.")
+        description="Compile the kernels a first solve needs ("
+        + "; ".join(step.text for step in STEPS if step.first) + "), or with --all those of "
+        "every capability (" + "; ".join(step.text for step in STEPS if not step.first)
+        + "), and cache them: for a container build or a cluster image. Each capability "
+        "otherwise compiles on its first use; a cached one loads in a fraction of a second.")
     compile_.add_argument("--all", action="store_true",
                           help="every capability, not only what a first solve needs")
     compile_.set_defaults(run=_run_compile)
