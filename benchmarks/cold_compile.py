@@ -2,8 +2,9 @@
 
 Prints, each in fresh processes with an empty numba cache of their own:
 
-1. ``softarm demo`` cold (the whole command: imports, the compile, the solve, the picture), with
-   the stability verdict compiled on the second core (the default) and in the same process
+1. ``softarm demo`` cold (the whole command: imports, the compile, the solve, the picture), as
+   it is (the stability verdict compiled on the second core where one is idle), with the
+   verdict on the second core (``SOFTARM_PREFETCH=1``) and in the same process
    (``SOFTARM_PREFETCH=0``), then warm (the cache filled); with ``--venv``, also as a new user
    runs it: the ``softarm`` command of a fresh virtual environment where this tree was just
    installed (``pip install .[plot]``: no byte-code of softarm yet, the wheel's own
@@ -77,18 +78,20 @@ def demo(src: Path | None, command=None, **extra) -> tuple[tuple[float, float],
 
 
 def capabilities(src: Path) -> tuple[str, dict, dict, str]:
-    """(``softarm compile --all``'s output, the compile record per capability key, the
-    closed forms' record, the load average before and after)."""
+    """(``softarm compile --all``'s output, the compile record per capability key, (wall,
+    CPU) seconds, the closed forms' record, the load average before and after)."""
     with tempfile.TemporaryDirectory() as cache:
         env = _env(cache, src)
         loads = load()
         _, _, done = _run([sys.executable, "-m", "softarm", "compile", "--all"], env, ROOT)
         loads += f" -> {load()}"
-        records = {}  # per capability, the sum of its compiled versions
+        records = {}  # per capability, (wall, CPU) s: the sums of its compiled versions
         for path in Path(cache).rglob("softarm-compile-seconds.json"):
             records[path.parent.name.split("_")[0]] = {
-                key: sum(versions.values()) for key, versions in
-                json.loads(path.read_text()).items() if isinstance(versions, dict)}
+                key: (sum(wall for wall, _ in versions.values()),
+                      sum(cpu for _, cpu in versions.values()))
+                for key, versions in json.loads(path.read_text()).items()
+                if isinstance(versions, dict)}
     return done.stdout, records.get("statics", {}), records.get("analytic", {}), loads
 
 
@@ -120,8 +123,9 @@ def main() -> None:
     src = ROOT / "src"
     print(f"cold compile, {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, "
           f"{os.cpu_count()} cores, load average {load()}")
-    rows = [("this tree", src, None, {}), ("this tree, verdict in the same process", src, None,
-                                           {"SOFTARM_PREFETCH": "0"})]
+    rows = [("this tree", src, None, {}),
+            ("this tree, verdict on the other core", src, None, {"SOFTARM_PREFETCH": "1"}),
+            ("this tree, verdict in the same process", src, None, {"SOFTARM_PREFETCH": "0"})]
     with tempfile.TemporaryDirectory() as scratch:
         if args.venv:
             rows.insert(0, ("a fresh venv with this tree installed", None,
@@ -150,9 +154,10 @@ def main() -> None:
     print(f"softarm compile --all (each step after the ones before it; load {loads}):")
     for line in output.splitlines():
         print("  " + line)
-    print("compile record per capability (s, softarm._jit.REFERENCE_SECONDS' keys):")
-    for key, seconds in sorted({**statics, **analytic}.items(), key=lambda kv: -kv[1]):
-        print(f"  {key:28s} {seconds:6.1f}")
+    print("compile record per capability (wall s, CPU s; the CPU seconds on a busy machine are "
+          "its wall seconds on a quiet one: softarm._jit.REFERENCE_SECONDS):")
+    for key, (wall, cpu) in sorted({**statics, **analytic}.items(), key=lambda kv: -kv[1][1]):
+        print(f"  {key:32s} {wall:6.1f} {cpu:6.1f}")
 
 
 if __name__ == "__main__":

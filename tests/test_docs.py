@@ -140,3 +140,19 @@ def test_the_readmes_python_runs_and_prints_what_its_comment_says(tmp_path, monk
     assert printed.split()[0] == said[0]
     np.testing.assert_allclose([float(v) for v in printed.split()[1:]],
                                [float(v) for v in said[1:]], atol=6e-5)
+
+
+def test_softarm_compile_and_the_docs_list_every_capability():
+    """Each capability ``softarm compile --all`` compiles (softarm.warmup.STEPS) is listed by
+    ``softarm compile --help``, in docs/cli.md and in docs/performance.md's cold compile."""
+    from softarm.warmup import STEPS
+
+    help_text = " ".join(_commands()["compile"].format_help().split())
+    cli_md = " ".join(CLI_MD.split())
+    performance = " ".join((ROOT / "docs" / "performance.md").read_text(
+        encoding="utf-8").split("### Cold compile", 1)[1].split())
+    for step in STEPS:
+        text = " ".join(step.text.split())
+        assert text in help_text, step.name
+        assert text in cli_md, step.name
+        assert text in performance, step.name

@@ -152,10 +152,17 @@ def compile_seconds(key: str, dispatcher=None, variant: str | None = None
     base, read-only arrays, ...) is a first compile, whatever the others took."""
     recorded = _read_record(dispatcher).get(key) if dispatcher is not None else None
     if isinstance(recorded, dict) and recorded and (variant is None or variant in recorded):
-        seconds = sum(v for v in recorded.values() if isinstance(v, (int, float)))
+        seconds = sum(_wall(v) for v in recorded.values())
         if seconds > 0:
             return float(seconds), True
     return REFERENCE_SECONDS.get(key), False
+
+
+def _wall(version) -> float:
+    """A recorded version's wall seconds: [wall, CPU] (0 for anything else)."""
+    if isinstance(version, list) and version and isinstance(version[0], (int, float)):
+        return float(version[0])
+    return 0.0
 
 
 def _variant(dispatcher, args) -> str:
@@ -196,8 +203,10 @@ def _read_record(dispatcher) -> dict:
         return {}
 
 
-def _write_record(dispatcher, key: str, variant: str, seconds: float) -> None:
-    """Store the measured time of one compiled version of capability ``key`` (atomically: a
+def _write_record(dispatcher, key: str, variant: str, seconds: float, cpu: float) -> None:
+    """Store the measured time of one compiled version of capability ``key``, [wall, CPU]
+    seconds (this process's CPU time: on a quiet machine, the wall time; what
+    benchmarks/cold_compile.py reports for :data:`REFERENCE_SECONDS`), atomically (a
     concurrent process loses nothing but its own figure); nothing if the cache folder cannot
     be written."""
     path = _record_path(dispatcher)
@@ -207,7 +216,7 @@ def _write_record(dispatcher, key: str, variant: str, seconds: float) -> None:
         record = _read_record(dispatcher)
         versions = record.get(key)
         record[key] = versions = versions if isinstance(versions, dict) else {}
-        versions[variant] = round(seconds, 2)
+        versions[variant] = [round(seconds, 2), round(cpu, 2)]
         temporary = f"{path}.{os.getpid()}.tmp"
         try:
             with open(temporary, "w", encoding="utf-8") as file:
@@ -233,7 +242,8 @@ class _Notice(event.Listener):
             return
         key, text = capability(ev.data["args"])
         variant = _variant(dispatcher, ev.data["args"])
-        stack.append((key, text, dispatcher, time.perf_counter(), variant))
+        stack.append((key, text, dispatcher, (time.perf_counter(), time.process_time()),
+                      variant))
         extra = [callback(ev.data["args"]) for callback in _ON_COLD.get(dispatcher.py_func, ())]
         text += "".join(f" ({more})" for more in extra if more)
         with _LOCK:
@@ -252,11 +262,11 @@ class _Notice(event.Listener):
             entry[5].stop()
         # (not ev.is_failed: numba 0.68's is_failed is inverted, True for a success)
         if entry is not None and getattr(ev, "_exc_details", None) is None:
-            key, text, dispatcher, start, variant = entry[:5]
+            key, text, dispatcher, (start, cpu), variant = entry[:5]
             seconds = time.perf_counter() - start
             COMPILED.append((key, text, seconds))
             if _RECORD_TIMES:
-                _write_record(dispatcher, key, variant, seconds)
+                _write_record(dispatcher, key, variant, seconds, time.process_time() - cpu)
 
 
 class Elapsed:

@@ -15,7 +15,12 @@ as before: nothing depends on the process but the time. On a 2-core machine a co
 tests/test_compile.py checks that the solver's process compiled neither).
 
 Not launched with one usable core, where numba cannot write its cache, with
-``SOFTARM_PREFETCH=0``, or inside such a process itself.
+``SOFTARM_PREFETCH=0``, or inside such a process itself; nor, unless ``SOFTARM_PREFETCH=1``,
+on a busy machine, whose 1-minute load average leaves no core idle (above the usable cores
+less one half): there the second core is not free, and the other process's work (its own
+imports, what this one may compile again, the wait for it) costs more than it saves.
+Measured on a 2-core machine at load 5-7 (benchmarks/cold_compile.py, one run each): a cold
+``softarm demo`` 104 s wall (45 s CPU) with the other process, 64 s (33 s CPU) without.
 """
 
 from __future__ import annotations
@@ -44,12 +49,24 @@ def _usable_cores() -> int:
         return os.cpu_count() or 1
 
 
+def _busy() -> bool:
+    """Whether no core is idle: the 1-minute load average above the usable cores less one
+    half (False where there is no load average)."""
+    try:
+        load = os.getloadavg()[0]
+    except (AttributeError, OSError):  # not on this platform
+        return False
+    return load > _usable_cores() - 0.5
+
+
 def start(kind: str, dispatcher) -> str | None:
     """Launch the verdict's compile for ``kind`` ("passive" or "actuated") in another
-    process, unless one ran already or it cannot help (see the module docstring); says so
+    process, unless one ran already or it cannot help (see the module docstring: not on a
+    busy machine unless ``SOFTARM_PREFETCH=1``); says so
     (for the compile notice), or None. ``dispatcher``: a kernel whose cache folder is the one
     to fill (where numba can cache)."""
-    if (os.environ.get("SOFTARM_PREFETCH", "1") == "0" or _usable_cores() < 2
+    wanted = os.environ.get("SOFTARM_PREFETCH", "auto")
+    if (wanted == "0" or _usable_cores() < 2 or (wanted != "1" and _busy())
             or getattr(getattr(dispatcher, "_cache", None), "cache_path", None) is None):
         return None
     with _LOCK:
