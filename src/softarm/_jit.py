@@ -49,13 +49,19 @@ _WARNED = set()
 #: Cold compile of each capability, seconds, on the reference machine (2 cores, AMD EPYC, the
 #: machine of docs/performance.md), each after those before it in softarm.warmup.STEPS (what
 #: a user meets who adds capabilities one by one; a capability used first compiles what it
-#: shares with the others too): ``python benchmarks/cold_compile.py``, 2026-12-01.
+#: shares with the others too); the first version of a capability that compiles several (the
+#: dynamics from rest; from an equilibrium or with contact, 3-5 s more each). Measured by
+#: ``python benchmarks/cold_compile.py``: wall seconds on the quiet machine (load < 1.5),
+#: 2026-12-01; the keys marked * were first measured on 2026-12-06 on the same machine busy
+#: (load 5-6): there its CPU seconds (the wall seconds of a quiet machine: the keys measured
+#: both ways agree to 0-27 %, the CPU seconds above).
 REFERENCE_SECONDS = {
     "solve": 17.0,
     "verdict": 6.0,
     "closed forms": 3.0,
     "solve+jacobians": 7.0,
     "solve+chained": 7.0,
+    "solve+chained+jacobians": 9.4,  # *
     "actuated": 26.0,
     "verdict+actuated": 5.0,
     "actuated+jacobians": 8.0,
@@ -66,17 +72,20 @@ REFERENCE_SECONDS = {
     "shoot": 1.0,
     "shoot+actuated": 2.0,
     "branch": 4.0,
-    "branch+actuated": 5.0,
-    # multiple shooting (stiff problems): a fresh install's first hanging-hose solve after a
-    # passive one, 42.2 s beside "solve" 21.9 s, scaled by that run's 17/21.9 (not yet
-    # measured by benchmarks/cold_compile.py; the actuated one estimated alike)
-    "stiff+verdict": 33.0,
-    "stiff+actuated+verdict": 40.0,
-    # dynamics (softarm.simulate): in a fresh cache after a passive solve (53.3 s there
-    # against 23 s here: a loaded machine), 26.5 s, and the actuated one after an actuated
-    # solve 16.4 s; scaled by 23/53.3
-    "dynamics": 11.5,
-    "dynamics+actuated": 7.0,
+    "branch+actuated": 5.3,  # *
+    # multiple shooting (stiff problems, contact), and a stiff closed form's verdict
+    "stiff+verdict": 36.6,  # *
+    "stiff": 5.3,  # *
+    "stiff+jacobians+verdict": 17.3,  # *
+    "stiff+jacobians": 6.2,  # *
+    "verdict+given": 6.8,  # *
+    "stiff+actuated+verdict": 43.1,  # *
+    "stiff+actuated": 6.7,  # *
+    "stiff+actuated+jacobians+verdict": 22.7,  # *
+    "stiff+actuated+jacobians": 8.0,  # *
+    # dynamics (softarm.simulate, Simulator)
+    "dynamics": 10.4,  # *
+    "dynamics+actuated": 13.4,  # *
 }
 #: On a terminal, the elapsed time of a compile is shown from this many seconds on
 PROGRESS_AFTER = 3.0
