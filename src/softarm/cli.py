@@ -331,8 +331,9 @@ class _Interrupt:
     ``sys.unraisablehook``) drops that message and delivers the interrupt again from another
     thread a moment later (``_thread.interrupt_main``), when the main thread is back in
     Python code; and :meth:`check`, at every progress report and before the outputs are
-    written, raises any interrupt still pending. Once the command's outputs are written
-    (``done``), a Ctrl-C is only remembered: the exit status is the command's.
+    written, raises any interrupt still pending. Once the command starts writing its outputs
+    (``done``: :func:`_write`, or the command's end), a Ctrl-C is only remembered: the exit
+    status is the command's, and 130 means that nothing was written.
     """
 
     seen = False
@@ -790,6 +791,9 @@ def _input_size(load, name: str) -> int:
 
 def _write(case: Case, result, outputs, picture) -> None:
     _Interrupt.check()  # a Ctrl-C not yet raised (see _Interrupt): nothing is written
+    # From here the outputs are written, all of them: a Ctrl-C is only remembered (exit 130
+    # means that nothing was written; the writing takes a fraction of a second)
+    _Interrupt.done = True
     for out in outputs:
         save_result(result, out, case)
         print(f"wrote {out}")
