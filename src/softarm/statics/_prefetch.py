@@ -16,11 +16,13 @@ tests/test_compile.py checks that the solver's process compiled neither).
 
 Not launched with one usable core, where numba cannot write its cache, with
 ``SOFTARM_PREFETCH=0``, or inside such a process itself; nor, unless ``SOFTARM_PREFETCH=1``,
-on a busy machine, whose 1-minute load average leaves no core idle (above the usable cores
-less one half): there the second core is not free, and the other process's work (its own
-imports, what this one may compile again, the wait for it) costs more than it saves.
-Measured on a 2-core machine at load 5-7 (benchmarks/cold_compile.py, one run each): a cold
-``softarm demo`` 104 s wall (45 s CPU) with the other process, 64 s (33 s CPU) without.
+on a busy machine, whose 1-minute load average reaches the usable cores less one (other work
+keeps a core's worth busy): there the second core is not free, and the other process's work
+(its own imports, what this one may compile again, the wait for it) costs more than it saves.
+Measured on a 2-core machine (benchmarks/cold_compile.py, a cold ``softarm demo``, one run
+each, with / without the other process): 19.4 / 26.9 s wall at load 0.8 (2026-12-01);
+46.0 / 33.5 s at load 1.5-2.5, 44.1 / 29.1 s at load 2.9-3.6 and 104 / 64 s at load 6.7
+(2026-12-06): from a load of 1.5 on it only cost time.
 """
 
 from __future__ import annotations
@@ -50,13 +52,13 @@ def _usable_cores() -> int:
 
 
 def _busy() -> bool:
-    """Whether no core is idle: the 1-minute load average above the usable cores less one
-    half (False where there is no load average)."""
+    """Whether no second core is free: the 1-minute load average at or above the usable
+    cores less one (False where there is no load average)."""
     try:
         load = os.getloadavg()[0]
     except (AttributeError, OSError):  # not on this platform
         return False
-    return load > _usable_cores() - 0.5
+    return load >= _usable_cores() - 1.0
 
 
 def start(kind: str, dispatcher) -> str | None:
