@@ -93,6 +93,7 @@ def test_every_class_attribute_the_docs_name_exists():
     assert missing == []
 
 
+@pytest.mark.slow  # (a first simulation in a fresh cache compiles the dynamics)
 def test_the_readme_line_that_writes_a_trajectory_page_works_as_printed(tmp_path):
     """The README prints ``softarm.view.write_trajectory_html(trajectory, "swing.html",
     arm=arm)``: after a plain ``import softarm`` (which imports neither plotly nor numba),
