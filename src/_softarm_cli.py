@@ -3,34 +3,78 @@
 The command's work is :func:`softarm.cli.main`; this module only imports it, which loads numpy,
 scipy and numba and takes a moment. A Ctrl-C during that start-up still ends with one line and
 exit status 130, as at any other moment, instead of a traceback from the middle of an import.
+
+Design note: the Ctrl-C handler is installed by the first statements of this module, before
+anything heavy is imported; only the Python interpreter's own start-up (10-70 ms, before any
+line of softarm runs) is out of reach. During the import, a Ctrl-C raises KeyboardInterrupt and
+is also remembered: a C extension may turn the KeyboardInterrupt into an ImportError (numpy:
+"PyCapsule_Import could not import module ...") or an ``except`` in a library may swallow it,
+so what decides is the memory, not the exception's type. Once imported, SIGINT is *blocked*
+(held by the kernel, not lost) until :func:`softarm.cli.main` has installed its own handler
+and unblocks it: a Ctrl-C in between reaches that handler. ``softarm.cli.main`` restores the
+mask when it returns, so a Ctrl-C after the command's work (its outputs written) stays held and
+is dropped at exit: the exit status is the command's.
 """
 
 import signal
 import sys
 
+_INTERRUPTED = False
 
-def _ignore_ctrl_c() -> None:
+
+def _on_ctrl_c(signum, frame):
+    global _INTERRUPTED
+    _INTERRUPTED = True
+    raise KeyboardInterrupt
+
+
+try:
+    signal.signal(signal.SIGINT, _on_ctrl_c)
+except (ValueError, OSError):  # pragma: no cover - not the main thread
+    pass
+
+
+def _block_ctrl_c() -> None:
+    """Hold SIGINT (pending) until softarm.cli.main unblocks it; where signals cannot be
+    blocked (Windows), ignore it from now on instead."""
     try:
+        if hasattr(signal, "pthread_sigmask"):
+            signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
         signal.signal(signal.SIGINT, signal.SIG_IGN)
     except (ValueError, OSError):  # pragma: no cover - not the main thread
         pass
 
 
+def _interrupted() -> int:
+    _block_ctrl_c()
+    try:
+        sys.stderr.write("softarm: interrupted\n")
+        sys.stderr.flush()
+    except (ValueError, OSError):  # pragma: no cover - stderr closed
+        pass
+    return 130
+
+
 def main() -> int:
     try:
         from softarm.cli import main as run
-    except KeyboardInterrupt:
-        _ignore_ctrl_c()
-        try:
-            sys.stderr.write("softarm: interrupted\n")
-            sys.stderr.flush()
-        except (ValueError, OSError):  # pragma: no cover - stderr closed
-            pass
-        return 130
-    code = run()  # handles a Ctrl-C during the work itself (exit status 130, one line)
+
+        if hasattr(signal, "pthread_sigmask"):
+            # held from here until softarm.cli.main's handler is in place (it unblocks)
+            signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    except BaseException:
+        if not _INTERRUPTED:
+            raise
+        return _interrupted()
+    if _INTERRUPTED:  # a KeyboardInterrupt that something in the import swallowed
+        return _interrupted()
+    try:
+        code = run()  # handles a Ctrl-C during the work itself (exit status 130, one line)
+    except KeyboardInterrupt:  # (only where signals cannot be blocked, at run's very start)
+        return _interrupted()
     # The work is done and its outputs written: a Ctrl-C from here on, while the interpreter
-    # shuts down, is ignored instead of killing the process without a word.
-    _ignore_ctrl_c()
+    # shuts down, is held or ignored instead of killing the process without a word.
+    _block_ctrl_c()
     return code
 
 

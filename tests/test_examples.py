@@ -224,3 +224,35 @@ def test_gripper_finger_example_touches_the_cylinder():
     assert result.contact_wrench[2] > 1.0
     assert result.tip_position[2] < -0.015
     assert np.min(result.gaps) > -1e-8 * 0.12
+
+
+def test_the_gripper_finger_example_says_what_it_shows():
+    """Its comment once said the finger wraps onto the cylinder; it presses on a short patch.
+    The numbers its comment gives: the free curl (κ = τ d / EI, the hand formula for a
+    straight tendon, against the solver's free finger), wider than the cylinder; the loaded
+    patch; the contact's total, which balances the reaction at the clamp (global balance: the
+    tendon's pull is internal to the arm)."""
+    import re
+
+    import softarm
+
+    header = (EXAMPLES / "gripper_finger.toml").read_text(encoding="utf-8").split("name =")[0]
+    assert "wraps onto" not in header and "does\n# not wrap" in header
+    case, result = solve("gripper_finger")
+    kappa = 15.0 * 0.007 / (1.0e6 * np.pi * 0.01**4 / 4)  # τ d / EI, 1/m
+    free = softarm.solve(case.arm, case.loads[:1], s=5)  # the tendon alone
+    np.testing.assert_allclose(np.linalg.norm(free.strains[:, 3:], axis=-1), kappa, rtol=1e-6)
+    said_kappa = float(re.search(r"κ = τ d / EI =\s*#?\s*([\d.]+) 1/m", header).group(1))
+    said_radius = float(re.search(r"a circle of ([\d.]+) mm radius", header).group(1))
+    assert said_kappa == pytest.approx(kappa, abs=0.05)
+    assert said_radius == pytest.approx(1e3 / kappa, abs=0.5)
+    assert said_radius > (0.03 + 0.01) * 1e3  # wider than the cylinder: no wrap
+    first, last = (float(v) for v in re.search(r"s = (\d+)-(\d+) mm", header).groups())
+    loaded = result.s[np.linalg.norm(result.contact_forces, axis=-1) > 0] * 1e3  # mm
+    assert first - 0.5 <= loaded.min() and loaded.max() <= last + 0.5
+    free_length = float(re.search(r"its last (\d+) mm free", header).group(1))
+    assert free_length == pytest.approx(120.0 - loaded.max(), abs=1.0)
+    total = float(re.search(r"([\d.]+) N in all", header).group(1))
+    assert np.linalg.norm(result.contact_wrench[:3]) == pytest.approx(total, abs=0.05)
+    # (the contact's resultant is integrated over the stations: 1e-4 N of the 1.6)
+    np.testing.assert_allclose(result.contact_wrench[:3], result.base_wrench[:3], atol=1e-4)

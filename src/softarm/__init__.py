@@ -34,6 +34,23 @@ from .model import Arm, Circle, Material, Rectangle, Rigidities, Section, Segmen
 from .stability import Branch, CriticalPoint, continuation, critical_load
 from .sweep import open_sweep
 
+#: Submodules loaded on first use as an attribute, so that ``softarm.view.write_trajectory_html``
+#: and ``softarm.io.read_trajectory`` work after a plain ``import softarm`` while
+#: ``import softarm`` itself stays light (no plotly, matplotlib or numba: tests/test_package.py).
+_ON_FIRST_USE = ("geometry", "io", "plot", "view", "warmup")
+
+
+def __getattr__(name: str):
+    if name in _ON_FIRST_USE:
+        import importlib
+
+        return importlib.import_module(f"{__name__}.{name}")
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *_ON_FIRST_USE})
+
 __all__ = [
     "ApproximationWarning",
     "Arm",

@@ -9,16 +9,27 @@ is registered with a ``capability`` function that names, from the argument types
 compile, what is being compiled ("the solver for passive arms", "... with Jacobians": the
 solver is compiled per capability, statics/README.md). numba's event API reports every
 compile that misses the cache (``numba:compile``; a cache hit is no event), so a listener
-prints one line the first time a capability compiles in a process, with the time it takes
-on this machine, and afterwards records how long it took. The record lives in numba's cache
-folder beside the compiled code it describes (``softarm-compile-seconds.json``), so the next
-estimate on this machine is a measurement; before any, it is the reference machine's time
-(:data:`REFERENCE_SECONDS`, ``python benchmarks/cold_compile.py``) scaled by a 20-ms probe of this
-machine's single-core speed. ``SOFTARM_COMPILE_NOTICE=0`` silences the notice.
+prints one line the first time a capability compiles in a process and afterwards records how
+long it took. The record lives in numba's cache folder beside the compiled code it describes
+(``softarm-compile-seconds.json``): per capability, the seconds of each compiled version (an
+entry point and its argument types; a capability may compile several: other argument types,
+or several entry points).
+
+The notice says only what was measured: the time this capability took on this machine the
+last time this version of it compiled here (after an upgrade of softarm or numba, whose
+cache then misses: the sum of its recorded versions), or, for a first compile here (of this
+version), that it is one, with the time it took on the reference machine
+(:data:`REFERENCE_SECONDS`, ``python benchmarks/cold_compile.py``) and that it varies with the
+machine and its load. (A guess from a speed probe of this machine was off by 0.5-5x: a
+compile's time follows the load of the machine more than its speed.) On a
+terminal, a compile that runs longer than :data:`PROGRESS_AFTER` seconds also shows its
+elapsed time, redrawn in place each second and erased at its end; nothing more is written
+when stderr is not a terminal. ``SOFTARM_COMPILE_NOTICE=0`` silences both.
 """
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import sys
@@ -30,21 +41,27 @@ from collections.abc import Callable
 from numba import njit
 from numba.core import event
 
-__all__ = ["COMPILED", "REFERENCE_SECONDS", "compile_seconds", "jit", "notices",
-           "on_cold_compile"]
+__all__ = ["COMPILED", "PROGRESS_AFTER", "REFERENCE_SECONDS", "compile_seconds", "jit",
+           "notices", "on_cold_compile"]
 
 _WARNED = set()
 
 #: Cold compile of each capability, seconds, on the reference machine (2 cores, AMD EPYC, the
 #: machine of docs/performance.md), each after those before it in softarm.warmup.STEPS (what
 #: a user meets who adds capabilities one by one; a capability used first compiles what it
-#: shares with the others too): ``python benchmarks/cold_compile.py``, 2026-12-01.
+#: shares with the others too); the first version of a capability that compiles several (the
+#: dynamics from rest; from an equilibrium or with contact, 3-5 s more each). Measured by
+#: ``python benchmarks/cold_compile.py``: wall seconds on the quiet machine (load < 1.5),
+#: 2026-12-01; the keys marked * were first measured on 2026-12-06 on the same machine busy
+#: (load 5-6): there its CPU seconds (the wall seconds of a quiet machine: the keys measured
+#: both ways agree to 0-27 %, the CPU seconds above).
 REFERENCE_SECONDS = {
     "solve": 17.0,
     "verdict": 6.0,
     "closed forms": 3.0,
     "solve+jacobians": 7.0,
     "solve+chained": 7.0,
+    "solve+chained+jacobians": 9.4,  # *
     "actuated": 26.0,
     "verdict+actuated": 5.0,
     "actuated+jacobians": 8.0,
@@ -55,20 +72,23 @@ REFERENCE_SECONDS = {
     "shoot": 1.0,
     "shoot+actuated": 2.0,
     "branch": 4.0,
-    "branch+actuated": 5.0,
-    # multiple shooting (stiff problems): a fresh install's first hanging-hose solve after a
-    # passive one, 42.2 s beside "solve" 21.9 s, scaled by that run's 17/21.9 (not yet
-    # measured by benchmarks/cold_compile.py; the actuated one estimated alike)
-    "stiff+verdict": 33.0,
-    "stiff+actuated+verdict": 40.0,
-    # dynamics (softarm.simulate): in a fresh cache after a passive solve (53.3 s there
-    # against 23 s here: a loaded machine), 26.5 s, and the actuated one after an actuated
-    # solve 16.4 s; scaled by 23/53.3
-    "dynamics": 11.5,
-    "dynamics+actuated": 7.0,
+    "branch+actuated": 5.3,  # *
+    # multiple shooting (stiff problems, contact), and a stiff closed form's verdict
+    "stiff+verdict": 36.6,  # *
+    "stiff": 5.3,  # *
+    "stiff+jacobians+verdict": 17.3,  # *
+    "stiff+jacobians": 6.2,  # *
+    "verdict+given": 6.8,  # *
+    "stiff+actuated+verdict": 43.1,  # *
+    "stiff+actuated": 6.7,  # *
+    "stiff+actuated+jacobians+verdict": 22.7,  # *
+    "stiff+actuated+jacobians": 8.0,  # *
+    # dynamics (softarm.simulate, Simulator)
+    "dynamics": 10.4,  # *
+    "dynamics+actuated": 13.4,  # *
 }
-#: The probe's time on the reference machine, seconds (:func:`_probe`, best of 5)
-_REFERENCE_PROBE = 0.0158
+#: On a terminal, the elapsed time of a compile is shown from this many seconds on
+PROGRESS_AFTER = 3.0
 #: The file of measured compile times, in numba's cache folder of the compiled module.
 _RECORD = "softarm-compile-seconds.json"
 
@@ -79,7 +99,6 @@ _ON_COLD: dict[Callable, list[Callable]] = {}
 _ANNOUNCED: set[str] = set()
 _STATE = threading.local()
 _LOCK = threading.Lock()
-_PROBE: list[float] = []
 #: The capabilities compiled in this process, in order: (key, text, seconds)
 COMPILED: list[tuple[str, str, float]] = []
 #: Whether compile times are recorded (not in statics/_prefetch.py's process, whose times
@@ -132,33 +151,49 @@ def on_cold_compile(dispatcher, callback: Callable) -> None:
     _ON_COLD.setdefault(getattr(dispatcher, "py_func", dispatcher), []).append(callback)
 
 
-def compile_seconds(key: str, dispatcher=None) -> tuple[float, bool]:
-    """(seconds, measured): how long capability ``key`` takes to compile on this machine, as
-    last measured here (in the cache folder of ``dispatcher``'s module), else the reference
-    machine's time scaled by this machine's speed (``measured`` False)."""
+def compile_seconds(key: str, dispatcher=None, variant: str | None = None
+                    ) -> tuple[float | None, bool]:
+    """(seconds, measured): how long capability ``key`` took to compile on this machine the
+    last time, every compiled version of it recorded in the cache folder of ``dispatcher``'s
+    module (``measured`` True), else on the reference machine (``measured`` False; None for
+    a key it has no time for). With ``variant`` (see :func:`_variant`), measured only if that
+    version is among them: a version never compiled here (other argument types: a moving
+    base, read-only arrays, ...) is a first compile, whatever the others took."""
     recorded = _read_record(dispatcher).get(key) if dispatcher is not None else None
-    if isinstance(recorded, (int, float)) and recorded > 0:
-        return float(recorded), True
-    return REFERENCE_SECONDS.get(key, 20.0) * _speed_ratio(), False
+    if isinstance(recorded, dict) and recorded and (variant is None or variant in recorded):
+        seconds = sum(_wall(v) for v in recorded.values())
+        if seconds > 0:
+            return float(seconds), True
+    return REFERENCE_SECONDS.get(key), False
 
 
-def _speed_ratio() -> float:
-    """This machine's time for the probe over the reference machine's, in [0.25, 8]."""
-    if not _PROBE:
-        _PROBE.append(min(_probe() for _ in range(3)))
-    return min(8.0, max(0.25, _PROBE[0] / _REFERENCE_PROBE))
+def _wall(version) -> float:
+    """A recorded version's wall seconds: [wall, CPU] (0 for anything else)."""
+    if isinstance(version, list) and version and isinstance(version[0], (int, float)):
+        return float(version[0])
+    return 0.0
 
 
-def _probe() -> float:
-    """About 20 ms of what a compile does most (Python objects: dicts, tuples, strings) on
-    one core."""
-    start = time.perf_counter()
-    table = {}
-    for i in range(40_000):
-        key = ("v", i % 977, str(i))
-        table[key] = table.get(key, 0) + len(key[2])
-    sorted(table.items(), key=lambda item: item[0][2])
-    return time.perf_counter() - start
+def _variant(dispatcher, args) -> str:
+    """The compiled version of an entry point: its name and a digest of its argument types
+    (the same in every process, unlike hash())."""
+    digest = hashlib.sha1(repr(tuple(args)).encode("utf-8")).hexdigest()[:12]
+    return f"{getattr(getattr(dispatcher, 'py_func', None), '__name__', 'kernel')}:{digest}"
+
+
+def announcement(text: str, seconds: float | None, measured: bool, cached: bool) -> str:
+    """The notice of a first compile of capability ``text`` in this process: what was
+    measured, and nothing else (the module docstring)."""
+    if not cached:
+        return (f"softarm: compiling {text} (not cached here: every process compiles it; set "
+                "NUMBA_CACHE_DIR to a writable folder)")
+    if measured:
+        return (f"softarm: compiling {text}, once (it took about {_about(seconds)} on this "
+                "machine the last time; later runs load it from the cache)")
+    reference = "" if seconds is None else \
+        f"; about {_about(seconds)} on a quiet 2-core reference machine, more on a busy one"
+    return (f"softarm: compiling {text}, once: a first compile on this machine (it varies "
+            f"with the machine and its load{reference}; later runs load it from the cache)")
 
 
 def _record_path(dispatcher) -> str | None:
@@ -177,15 +212,20 @@ def _read_record(dispatcher) -> dict:
         return {}
 
 
-def _write_record(dispatcher, key: str, seconds: float) -> None:
-    """Store the measured time (atomically: a concurrent process loses nothing but its own
-    figure); nothing if the cache folder cannot be written."""
+def _write_record(dispatcher, key: str, variant: str, seconds: float, cpu: float) -> None:
+    """Store the measured time of one compiled version of capability ``key``, [wall, CPU]
+    seconds (this process's CPU time: on a quiet machine, the wall time; what
+    benchmarks/cold_compile.py reports for :data:`REFERENCE_SECONDS`), atomically (a
+    concurrent process loses nothing but its own figure); nothing if the cache folder cannot
+    be written."""
     path = _record_path(dispatcher)
     if path is None:
         return
     with _LOCK:
         record = _read_record(dispatcher)
-        record[key] = round(seconds, 2)
+        versions = record.get(key)
+        record[key] = versions = versions if isinstance(versions, dict) else {}
+        versions[variant] = [round(seconds, 2), round(cpu, 2)]
         temporary = f"{path}.{os.getpid()}.tmp"
         try:
             with open(temporary, "w", encoding="utf-8") as file:
@@ -210,31 +250,80 @@ class _Notice(event.Listener):
             stack.append(None)
             return
         key, text = capability(ev.data["args"])
-        stack.append((key, text, dispatcher, time.perf_counter()))
+        variant = _variant(dispatcher, ev.data["args"])
+        stack.append((key, text, dispatcher, (time.perf_counter(), time.process_time()),
+                      variant))
         extra = [callback(ev.data["args"]) for callback in _ON_COLD.get(dispatcher.py_func, ())]
         text += "".join(f" ({more})" for more in extra if more)
         with _LOCK:
             first = key not in _ANNOUNCED
             _ANNOUNCED.add(key)
         if first and notices:
-            seconds, _ = compile_seconds(key, dispatcher)
+            seconds, measured = compile_seconds(key, dispatcher, variant)
             cached = _record_path(dispatcher) is not None
-            print(f"softarm: compiling {text}{', once' if cached else ''} (about "
-                  f"{_about(seconds)} on this machine; " + (
-                      "later runs load it from the cache)" if cached else
-                      "not cached here: every process compiles it; set NUMBA_CACHE_DIR)"),
-                  file=sys.stderr, flush=True)
+            print(announcement(text, seconds, measured, cached), file=sys.stderr, flush=True)
+            stack[-1] += (Elapsed(sys.stderr).start(),)
 
     def on_end(self, ev):
         stack = _STATE.__dict__.setdefault("stack", [])
         entry = stack.pop() if stack else None
+        if entry is not None and len(entry) > 5:
+            entry[5].stop()
         # (not ev.is_failed: numba 0.68's is_failed is inverted, True for a success)
         if entry is not None and getattr(ev, "_exc_details", None) is None:
-            key, text, dispatcher, start = entry
+            key, text, dispatcher, (start, cpu), variant = entry[:5]
             seconds = time.perf_counter() - start
             COMPILED.append((key, text, seconds))
-            if _RECORD_TIMES:  # (several entry points of one capability: their sum)
-                _write_record(dispatcher, key, sum(t for k, _, t in COMPILED if k == key))
+            if _RECORD_TIMES:
+                _write_record(dispatcher, key, variant, seconds, time.process_time() - cpu)
+
+
+class Elapsed:
+    """On a terminal (``stream.isatty()``), the elapsed time of a running compile, from
+    ``after`` seconds on: ``  compiling... 12 s`` redrawn in place every ``every`` seconds by
+    a daemon thread (numba releases the GIL in LLVM's C code: the thread gets its turn), and
+    erased by :meth:`stop`. Elsewhere nothing."""
+
+    def __init__(self, stream, after: float | None = None, every: float = 1.0):
+        self.stream, self.every = stream, every
+        self.after = PROGRESS_AFTER if after is None else after
+        self.done = threading.Event()
+        self.thread = None
+        self.shown = False
+
+    def start(self) -> Elapsed:
+        try:
+            tty = self.stream.isatty()
+        except (AttributeError, ValueError, OSError):
+            tty = False
+        if tty:
+            self.begin = time.perf_counter()
+            self.thread = threading.Thread(target=self._run, daemon=True,
+                                           name="softarm-compile-elapsed")
+            self.thread.start()
+        return self
+
+    def _run(self) -> None:
+        if self.done.wait(self.after):
+            return
+        while not self.done.is_set():
+            self._write(f"\r  compiling... {time.perf_counter() - self.begin:.0f} s")
+            self.shown = True
+            self.done.wait(self.every)
+
+    def stop(self) -> None:
+        self.done.set()
+        if self.thread is not None:
+            self.thread.join()
+            if self.shown:
+                self._write("\r\x1b[K")  # (erase the line: the notice said the rest)
+
+    def _write(self, text: str) -> None:
+        try:
+            self.stream.write(text)
+            self.stream.flush()
+        except (ValueError, OSError):  # stderr closed
+            pass
 
 
 def _about(seconds: float) -> str:

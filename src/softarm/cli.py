@@ -301,13 +301,15 @@ def _parser() -> argparse.ArgumentParser:
                       help="folder for demo.png and demo.csv (default: the working directory)")
     demo.set_defaults(run=_run_demo)
 
+    from .warmup import STEPS  # (softarm's own modules: no numba until a step runs)
+
     compile_ = commands.add_parser(
         "compile", help="compile softarm's kernels ahead of time",
-        description="Compile the kernels a first solve needs, or with --all those of every "
-        "capability (Jacobians, quasi-static solves, actuated arms, the control loop, inverse "
-        "statics, displacement control, critical loads), and cache them: for a container "
-        "build or a cluster image. Each capability otherwise compiles on its first use; a "
-        "cached one loads in a fraction of a second.")
+        description="Compile the kernels a first solve needs ("
+        + "; ".join(step.text for step in STEPS if step.first) + "), or with --all those of "
+        "every capability (" + "; ".join(step.text for step in STEPS if not step.first)
+        + "), and cache them: for a container build or a cluster image. Each capability "
+        "otherwise compiles on its first use; a cached one loads in a fraction of a second.")
     compile_.add_argument("--all", action="store_true",
                           help="every capability, not only what a first solve needs")
     compile_.set_defaults(run=_run_compile)
@@ -321,36 +323,79 @@ def _parser() -> argparse.ArgumentParser:
 class _Interrupt:
     """SIGINT while the command runs: raise KeyboardInterrupt, as Python does, and remember it.
 
-    A KeyboardInterrupt raised while numba is inside a ctypes callback (writing its cache
-    during a compile) is printed and swallowed there ("Exception ignored on calling ctypes
-    callback function"), and the command would go on for minutes. Remembered, it is raised
-    again at the next progress report (:meth:`check`)."""
+    A KeyboardInterrupt raised while numba is inside a ctypes callback (llvmlite's object
+    cache, called from LLVM's C code right after the long machine-code step of a compile or a
+    cache load: where a Ctrl-C during a compile most often lands) is swallowed there, and
+    Python prints "Exception ignored on calling ctypes callback function" with a traceback;
+    the command would go on, even write its outputs. So :meth:`unraisable` (the command's
+    ``sys.unraisablehook``) drops that message and delivers the interrupt again from another
+    thread a moment later (``_thread.interrupt_main``), when the main thread is back in
+    Python code; and :meth:`check`, at every progress report and before the outputs are
+    written, raises any interrupt still pending. Once the command starts writing its outputs
+    (``done``: :func:`_write`, or the command's end), a Ctrl-C is only remembered: the exit
+    status is the command's, and 130 means that nothing was written.
+    """
 
     seen = False
+    done = False
 
     @classmethod
     def handler(cls, signum, frame):
         cls.seen = True
-        raise KeyboardInterrupt
+        if not cls.done:
+            raise KeyboardInterrupt
 
     @classmethod
     def check(cls) -> None:
-        if cls.seen:
+        if cls.seen and not cls.done:
             raise KeyboardInterrupt
+
+    @classmethod
+    def unraisable(cls, previous):
+        def hook(unraisable):
+            if not (isinstance(unraisable.exc_value, KeyboardInterrupt)
+                    or unraisable.exc_type is KeyboardInterrupt):
+                return previous(unraisable)
+            cls.seen = True
+            if not cls.done:
+                again = threading.Timer(0.01, cls._again)
+                again.daemon = True
+                again.start()
+            return None
+        return hook
+
+    @classmethod
+    def _again(cls) -> None:
+        """Run the handler again in the main thread, if the command still runs."""
+        if not cls.done and signal.getsignal(signal.SIGINT) == cls.handler:
+            import _thread
+
+            _thread.interrupt_main()
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the ``softarm`` command with ``argv`` (default ``sys.argv[1:]``); return the exit
     code (see the module docstring and docs/cli.md)."""
-    _Interrupt.seen = False
-    previous = None
+    _Interrupt.seen = _Interrupt.done = False
+    previous = mask = None
     with contextlib.suppress(ValueError, OSError):  # ValueError: not the main thread
         previous = signal.signal(signal.SIGINT, _Interrupt.handler)
+    hook, sys.unraisablehook = sys.unraisablehook, _Interrupt.unraisable(sys.unraisablehook)
     try:
-        return _main(argv)
+        if previous is not None and hasattr(signal, "pthread_sigmask"):
+            # the launcher (src/_softarm_cli.py) holds a Ctrl-C until this handler is in place
+            mask = signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+        code = _main(argv)
+        _Interrupt.done = True
+        return code
     except KeyboardInterrupt:
         return interrupted()
     finally:
+        _Interrupt.done = True
+        sys.unraisablehook = hook
+        if mask is not None:  # held again if it was held (the launcher's exit)
+            with contextlib.suppress(ValueError, OSError):
+                signal.pthread_sigmask(signal.SIG_SETMASK, mask)
         if previous is not None and signal.getsignal(signal.SIGINT) == _Interrupt.handler:
             with contextlib.suppress(ValueError, OSError):
                 signal.signal(signal.SIGINT, previous)
@@ -745,6 +790,10 @@ def _input_size(load, name: str) -> int:
 
 
 def _write(case: Case, result, outputs, picture) -> None:
+    _Interrupt.check()  # a Ctrl-C not yet raised (see _Interrupt): nothing is written
+    # From here the outputs are written, all of them: a Ctrl-C is only remembered (exit 130
+    # means that nothing was written; the writing takes a fraction of a second)
+    _Interrupt.done = True
     for out in outputs:
         save_result(result, out, case)
         print(f"wrote {out}")

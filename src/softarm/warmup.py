@@ -62,8 +62,8 @@ def _jacobians():
 
 def _chained():
     solver = Solver(_arm())
-    for f in (0.005, 0.01):
-        solver.solve([Gravity(), TipLoad(force=[0.0, f, 0.0])])
+    for f in (0.005, 0.01, 0.015):  # the last with Jacobians
+        solver.solve([Gravity(), TipLoad(force=[0.0, f, 0.0])], jacobians=f > 0.012)
 
 
 def _actuated():
@@ -103,27 +103,65 @@ def _critical():
                   max_factor=4.0)
 
 
+def _critical_actuated():
+    critical_load(_arm(), [Gravity(), Tendon(0.1, Straight(0.0, 0.006))], max_factor=2.0)
+
+
+def _each_verdict_and_jacobians(arm, loads) -> None:
+    """Multiple shooting compiles one version per (verdict, Jacobians) pair: all four."""
+    for stability in (True, False):
+        for jacobians in (False, True):
+            Solver(arm, stability=stability).solve(loads, jacobians=jacobians)
+
+
 def _stiff():
     arm = Arm.from_stiffness(1.0, EA=1e9, GAy=1e9, GAz=1e9, GJ=1.0, EIy=1.0, EIz=1.0)
-    solve(arm, [TipLoad(force=[1e3, 0.0, 1.0]), DistributedForce([0.0, 0.0, 0.0])])
+    _each_verdict_and_jacobians(arm, [TipLoad(force=[1e3, 0.0, 1.0]),
+                                      DistributedForce([0.0, 0.0, 0.0])])
+    # without the distributed load, a closed form (the elastica), whose verdict under this
+    # tension sweeps the closed form's own states (softarm.statics.stability)
+    solve(arm, [TipLoad(force=[1e3, 0.0, 1.0])])
 
 
 def _contact():
     arm = Arm.from_stiffness(1.0, EA=1e4, GAy=1e4, GAz=1e4, GJ=1.0, EIy=1.0, EIz=1.0)
-    solve(arm, [TipLoad(force=[0.0, 0.0, -10.0]),
-                Contact(Plane((0.0, 0.0, -0.1), (0.0, 0.0, 1.0)), radius=0.01)])
+    _each_verdict_and_jacobians(arm, [TipLoad(force=[0.0, 0.0, -10.0]), Contact(
+        Plane((0.0, 0.0, -0.1), (0.0, 0.0, 1.0)), radius=0.01)])
+
+
+def _moving() -> Arm:
+    return Arm(0.2, Circle(0.01), Material(1e6, poisson_ratio=0.5, density=1100.0))
+
+
+def _tendon(tension: float = 0.1) -> Tendon:
+    return Tendon(tension=tension, routing=Straight(0.0, 0.005))
+
+
+def _steps(*args, **options):
+    """Three implicit steps on five stations."""
+    simulate(*args, duration=3e-3, dt=1e-3, stations=5, **options)
 
 
 def _dynamics():
     arm = Arm.from_stiffness(1.0, EA=1e3, GAy=1e3, GAz=1e3, GJ=1.0, EIy=1.0, EIz=1.0,
                              mass_per_length=1.0, inertia_per_length=(1e-4, 5e-5, 5e-5))
-    simulate(arm, [Gravity()], duration=2e-3, dt=1e-3, stations=5)
+    _steps(arm, [Gravity()])
+    # from an equilibrium: its loads balanced on the simulation's stations first (the
+    # kernel's other argument types, numba's other compiled version)
+    _steps(_moving(), [Gravity()],
+           initial=solve(_moving(), [Gravity(), TipLoad(force=[0.0, 0.0, -0.01])], s=5))
 
 
 def _dynamics_actuated():
-    arm = Arm(0.2, Circle(0.01), Material(1e6, poisson_ratio=0.5, density=1100.0))
-    simulate(arm, actuators=[Tendon(tension=0.1, routing=Straight(0.0, 0.005))],
-             duration=2e-3, dt=1e-3, stations=5)
+    _steps(_moving(), actuators=[_tendon()])
+    _steps(_moving(), [Gravity()], actuators=[_tendon()],
+           initial=solve(_moving(), [Gravity(), _tendon(0.05)], s=5))
+
+
+def _dynamics_contact():
+    table = Contact(Plane((0.0, 0.0, -0.0102), (0.0, 0.0, 1.0)))  # touched from the start
+    _steps(_moving(), [Gravity(), table])
+    _steps(_moving(), [Gravity(), table], actuators=[_tendon()])
 
 
 @dataclass(frozen=True)
@@ -145,8 +183,8 @@ STEPS: tuple[Step, ...] = (
     Step("closed forms", "the closed forms", ("closed forms",), _closed_forms, first=True),
     Step("jacobians", "Jacobians (tip and station compliance)", ("solve+jacobians",),
          _jacobians),
-    Step("chained", "quasi-static solves (Solver.solve, softarm app)", ("solve+chained",),
-         _chained),
+    Step("chained", "quasi-static solves (Solver.solve, softarm app)",
+         ("solve+chained", "solve+chained+jacobians"), _chained),
     Step("actuated", "actuated and magnetic arms (tendons, chambers, magnets)",
          ("actuated", "verdict+actuated"), _actuated),
     Step("actuated jacobians", "actuation Jacobians", ("actuated+jacobians",),
@@ -158,14 +196,22 @@ STEPS: tuple[Step, ...] = (
     Step("inverse", "inverse statics", ("inverse",), _inverse),
     Step("displacement", "displacement-controlled tendons", ("bounded",), _displacement),
     Step("critical", "critical loads and continuation", ("shoot", "branch"), _critical),
-    Step("stiff", "multiple shooting (arms in strong tension: kL >= 15)", ("stiff+verdict",),
-         _stiff),
-    Step("contact", "contact with obstacles (softarm.Contact: multiple shooting)",
-         ("stiff+actuated+verdict",), _contact),
-    Step("dynamics", "dynamics of passive arms (softarm.simulate, Simulator)", ("dynamics",),
-         _dynamics),
-    Step("actuated dynamics", "dynamics of actuated and magnetic arms",
-         ("dynamics+actuated",), _dynamics_actuated),
+    Step("critical actuated", "critical loads and continuation of actuated arms",
+         ("shoot+actuated", "branch+actuated"), _critical_actuated),
+    Step("stiff", "multiple shooting (arms in strong tension: kL >= 15), with and without "
+         "the verdict and Jacobians, and the verdict of a closed form in strong tension",
+         ("stiff+verdict", "stiff", "stiff+jacobians+verdict", "stiff+jacobians",
+          "verdict+given"), _stiff),
+    Step("contact", "contact with obstacles (softarm.Contact: multiple shooting), with and "
+         "without the verdict and Jacobians",
+         ("stiff+actuated+verdict", "stiff+actuated", "stiff+actuated+jacobians+verdict",
+          "stiff+actuated+jacobians"), _contact),
+    Step("dynamics", "dynamics of passive arms (softarm.simulate, Simulator), from rest and "
+         "from an equilibrium", ("dynamics",), _dynamics),
+    Step("actuated dynamics", "dynamics of actuated and magnetic arms, from rest and from an "
+         "equilibrium", ("dynamics+actuated",), _dynamics_actuated),
+    Step("contact dynamics", "dynamics with contact, passive and actuated",
+         ("dynamics", "dynamics+actuated"), _dynamics_contact),
 )
 
 
@@ -182,7 +228,8 @@ def compile_kernels(all: bool = False, progress: Callable | None = None) -> list
     previous, _jit.notices = _jit.notices, progress is None and _jit.notices
     try:
         for index, step in enumerate(steps):
-            estimate = sum(_jit.compile_seconds(key, _dispatcher(key))[0] for key in step.keys)
+            estimate = sum(_jit.compile_seconds(key, _dispatcher(key))[0] or 0.0
+                           for key in step.keys)
             before = len(_jit.COMPILED)
             start = time.perf_counter()
             with _Ticker(progress, (step, index, len(steps)), estimate):

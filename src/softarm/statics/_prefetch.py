@@ -15,7 +15,14 @@ as before: nothing depends on the process but the time. On a 2-core machine a co
 tests/test_compile.py checks that the solver's process compiled neither).
 
 Not launched with one usable core, where numba cannot write its cache, with
-``SOFTARM_PREFETCH=0``, or inside such a process itself.
+``SOFTARM_PREFETCH=0``, or inside such a process itself; nor, unless ``SOFTARM_PREFETCH=1``,
+on a busy machine, whose 1-minute load average reaches the usable cores less one (other work
+keeps a core's worth busy): there the second core is not free, and the other process's work
+(its own imports, what this one may compile again, the wait for it) costs more than it saves.
+Measured on a 2-core machine (benchmarks/cold_compile.py, a cold ``softarm demo``, one run
+each, with / without the other process): 19.4 / 26.9 s wall at load 0.8 (2026-12-01);
+46.0 / 33.5 s at load 1.5-2.5, 44.1 / 29.1 s at load 2.9-3.6 and 104 / 64 s at load 6.7
+(2026-12-06): from a load of 1.5 on it only cost time.
 """
 
 from __future__ import annotations
@@ -44,12 +51,24 @@ def _usable_cores() -> int:
         return os.cpu_count() or 1
 
 
+def _busy() -> bool:
+    """Whether no second core is free: the 1-minute load average at or above the usable
+    cores less one (False where there is no load average)."""
+    try:
+        load = os.getloadavg()[0]
+    except (AttributeError, OSError):  # not on this platform
+        return False
+    return load >= _usable_cores() - 1.0
+
+
 def start(kind: str, dispatcher) -> str | None:
     """Launch the verdict's compile for ``kind`` ("passive" or "actuated") in another
-    process, unless one ran already or it cannot help (see the module docstring); says so
+    process, unless one ran already or it cannot help (see the module docstring: not on a
+    busy machine unless ``SOFTARM_PREFETCH=1``); says so
     (for the compile notice), or None. ``dispatcher``: a kernel whose cache folder is the one
     to fill (where numba can cache)."""
-    if (os.environ.get("SOFTARM_PREFETCH", "1") == "0" or _usable_cores() < 2
+    wanted = os.environ.get("SOFTARM_PREFETCH", "auto")
+    if (wanted == "0" or _usable_cores() < 2 or (wanted != "1" and _busy())
             or getattr(getattr(dispatcher, "_cache", None), "cache_path", None) is None):
         return None
     with _LOCK:
