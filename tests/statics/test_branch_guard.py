@@ -229,3 +229,33 @@ def test_an_exactly_axial_load_keeps_the_column_straight_and_says_it_is_unstable
     np.testing.assert_allclose(eq.tip_position, [1.0 - magnitude / 1e12, 0.0, 0.0], rtol=0,
                                atol=1e-12)
     assert eq.stability.index == index
+
+
+# ---------------------------------------------------------------------------------------------
+# a fold only where the path turns
+
+
+def test_a_path_single_shooting_cannot_carry_is_not_called_a_fold():
+    """A field gradient pulling a magnetised arm (g M L³/EI = 1000, the tension g L at the
+    clamp: kL = 32, issue 42) forced onto single shooting, which cannot resolve it (its
+    Jacobian grows like e^{kL}): the error says so, not "fold" (before: "a limit point (fold)"
+    at λ = 0.62). The path there is smooth (multiple shooting follows it to λ = 1:
+    tests/test_trust_routes.py checks its end against solve_bvp)."""
+    arm = softarm.Arm.from_stiffness(1.0, EA=1e8, GAy=1e8, GAz=1e8, GJ=1.0, EIy=1.0, EIz=1.0,
+                                     magnetization=(1.0, 0.0, 0.0))
+    field = softarm.MagneticField([0.0, 0.0, 2.0], gradient=np.diag([1e3, -5e2, -5e2]))
+    with pytest.raises(softarm.ConvergenceError) as caught:
+        softarm.solve(arm, field, method="numeric", shooting="single", s=3)
+    assert "fold" not in str(caught.value) and 0.0 < caught.value.load_factor < 1.0
+    assert softarm.solve(arm, field, method="numeric", s=3).residual < 1e-9
+
+
+def test_a_fold_is_still_called_a_fold():
+    """The limit point of tests/statics/test_trust_regressions.py (λ_c ≈ 0.64, shown there
+    to be one by det ∂r/∂x vanishing like √(λ_c − λ)): the error names it a fold."""
+    from statics.test_trust_regressions import _folding_arm_and_loads
+
+    arm, loads = _folding_arm_and_loads()
+    with pytest.raises(softarm.ConvergenceError, match=r"a limit point \(fold\)") as caught:
+        softarm.solve(arm, loads)
+    assert 0.63 < caught.value.load_factor < 0.65

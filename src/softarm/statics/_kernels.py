@@ -116,11 +116,10 @@ def _fixed(key: str, text: str):
 OK = 0
 NEWTON_FAILED = 1  # the corrector did not converge at the final load (refinement)
 TOO_MANY_STEPS = 2  # the error estimate stayed above tol up to the largest step count
-PATH_FAILED = 3  # the loading path could not be followed past a load factor (a fold)
+PATH_FAILED = 3  # the loading path could not be followed past a load factor (x: its last point)
 BUDGET = 4  # the shooting budget ran out
 NOT_FINITE = 5  # the state became non-finite at an accepted point
 SINGULAR = 6  # jacobians: ∂r/∂x is singular at the solution (no compliance exists there)
-PATH_STUCK = 7  # the loading path could not be followed past a load factor, not a fold there
 
 # Layout of the state y (18) and of each tangent row (12).
 _P, _R, _N, _M = 0, 3, 12, 15
@@ -199,10 +198,6 @@ _CROSS_REL = 1e-7
 # and the tip's direction of motion guard the path.
 _PHASE_STEP = 0.5 * math.pi
 _PHASE_TESTED = 12.0
-# A path that cannot pass a load factor is a fold (the path turns) when the tip's motion
-# per unit load factor there, times the load factor's scale, exceeds this (nondimensional:
-# L and rad); otherwise it is a point the solver cannot resolve.
-_FOLD_RATE = 1e3
 # Refinement of a solution under a change of step count: distances are of the order of the
 # discretisation error, far below this.
 _REFINE_MAX = 0.05
@@ -1508,9 +1503,8 @@ def _follow(x, steps, base, arm, act, case, scratch, scale, dscale, length, thre
     the tip position at λ = 1, converged as the caller's own corrector would leave them (a
     last step no larger than ``final``, or the threshold: no refinement is needed on these
     steps); otherwise ``reached[0]`` is the last load factor reached (a fold, or a point the
-    path cannot be followed past) and ``reached[2]`` the tip's motion per unit load factor
-    there times the load factor's scale (large at a fold, where the path turns). Points on
-    the way are converged to ``_LOOSE``. ``J_path`` receives ∂r/∂x at the last point
+    path cannot be followed past) and x the solution there. Points on the way are converged
+    to ``_LOOSE``. ``J_path`` receives ∂r/∂x at the last point
     accepted (the caller checks its own last correction against it).
 
     Predictor: the tangent dx/dλ = -J_x⁻¹ J_λ from the variational equations for the first
@@ -1532,7 +1526,6 @@ def _follow(x, steps, base, arm, act, case, scratch, scale, dscale, length, thre
     ``_DIST_MAX`` and contraction test, so the last step is checked as any other).
     """
     reached[0] = 0.0
-    reached[2] = 0.0
     end = 1.0
     nt = J.shape[1]  # all 7 columns (a variable, not a literal: one compiled version)
     if not _corrector(x, 0.0, nt, steps, base, arm, act, case, scratch, scale, dscale, length,
@@ -1609,7 +1602,6 @@ def _follow(x, steps, base, arm, act, case, scratch, scale, dscale, length, thre
             lam_p = lam
             lam = target
             reached[0] = lam
-            reached[2] = _distance(t, scratch[1], dscale, length) * (lam + bounds[6])
             dl = _grown(dl, _distance(dx, scratch[1], dscale, length), max_load_step)
         else:
             for i in range(6):
@@ -1618,15 +1610,6 @@ def _follow(x, steps, base, arm, act, case, scratch, scale, dscale, length, thre
             if dl < _smallest_step(bounds, lam):
                 return False
     return True
-
-
-@_jit
-def _path_failure(reached):
-    """The status of a path that could not be followed past reached[0]: PATH_FAILED (a fold)
-    where it was turning (the tip's motion per unit load factor, times the load factor's
-    scale, reached[2], above _FOLD_RATE: dx/dλ grows without bound at a limit point), else
-    PATH_STUCK."""
-    return PATH_FAILED if reached[2] > _FOLD_RATE else PATH_STUCK
 
 
 @_jit
@@ -2078,8 +2061,7 @@ def solve_cases(base, arm, act, loads, first, options, s_out, memory, inputs, ou
     dx_f = np.empty(6)
     # a Newton step of this size at N leaves an error of about its square: far below tol
     final_step = min(1e-3, math.sqrt(0.01 * tol / length)) if math.isfinite(tol) else 1e-9
-    # the load factor reached, the sign of det ∂r/∂x there, the motion rate there (_follow)
-    reached = np.zeros(3)
+    reached = np.zeros(2)  # the load factor reached, the sign of det ∂r/∂x there
     J_path = np.empty((6, 6))  # ∂r/∂x at the path's last point
     guard = _guard_work()
     steps = np.empty(npieces, dtype=np.int64)
@@ -2229,7 +2211,7 @@ def solve_cases(base, arm, act, loads, first, options, s_out, memory, inputs, ou
                         failed_at = reached[0]
                         N = 2 * N
                         continue
-                    status[b] = _path_failure(reached)
+                    status[b] = PATH_FAILED
                     break
                 # the coarse solution at N: the end of a path on N steps; from the last
                 # prediction of a path on a coarser grid, a checked Newton, which must not
@@ -2303,6 +2285,9 @@ def solve_cases(base, arm, act, loads, first, options, s_out, memory, inputs, ou
         if status[b] != OK:
             info[b, 0] = _norm_scaled(r, scale)
             info[b, 3] = counter[0]
+            if status[b] == PATH_FAILED:  # the path's last point on N steps: whether the
+                for i in range(6):        # path turns there is for the caller to find out
+                    out[7][b, i] = x[i]
             if memory is not None:
                 memory[_MVALID] = memory[_MPREDICTED] = 0.0
             continue
@@ -3735,12 +3720,11 @@ def _ms_follow(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, co
     path's phase is at most _PHASE_TESTED (:func:`_phase`), the crossings of the condensed
     Jacobian (:func:`_ms_condensed`) and the phase's advance per step. True on success
     (x, Z at λ = end, the band factors there); else reached[0] is the last load factor
-    reached and reached[2] the motion rate there (:func:`_follow`)."""
+    reached."""
     B, G, piv, Lm, du, motion = work[1], work[2], work[5], work[6], work[7], work[8]
     n = 12 * M - 6
     nt = M - M + _COLS  # (a variable: one compiled version of the callees)
     reached[0] = lam0
-    reached[2] = 0.0
     ok, sign, dist = _ms_corrector(x, Z, M, lam0, nt, chunks, first, csteps, base, arm, act, case,
                              scratch, colscale, rowscale, work, w, length, threshold,
                              max_iterations, _REFINE_MAX, _LOOSE, tip, counter)
@@ -3810,8 +3794,6 @@ def _ms_follow(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, co
                 t[i] = du[i]
             lam = target
             reached[0] = lam
-            reached[2] = _ms_distance(t, n, scratch[1], M, colscale, w, length,
-                                      motion) * (lam + bounds[6])
             dl = _grown(dl, dist, max_load_step)
         else:
             _copy(x_keep, x)
@@ -4128,7 +4110,7 @@ def solve_stiff_cases(base, arm, act, loads, options, s_out, out, verdicts, inpu
     tip_rate = np.zeros((7, TIP_LOADS))
     case = (start, rate, tip_start, tip_rate)
     final_step = min(1e-3, math.sqrt(0.01 * tol / length)) if math.isfinite(tol) else 1e-9
-    reached = np.zeros(3)
+    reached = np.zeros(2)
     counter = np.zeros(1, dtype=np.int64)
     x = np.zeros(6)
     x_f = np.zeros(6)
@@ -4183,7 +4165,7 @@ def solve_stiff_cases(base, arm, act, loads, options, s_out, out, verdicts, inpu
                         failed_at = reached[0]
                         N = 2 * N
                         continue
-                    status[b] = _path_failure(reached)
+                    status[b] = PATH_FAILED
                     break
                 path = False
             if counter[0] > budget:

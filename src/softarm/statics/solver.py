@@ -865,7 +865,7 @@ class PreparedSolve:
             solver.reset()
             self._last = None
             error = _failure(k, 0, (), status, self._outs[3], solver, near is not None)
-            if status[0] in (k.PATH_FAILED, k.PATH_STUCK) and near is None:
+            if status[0] == k.PATH_FAILED and near is None:
                 error = _tendon_limit(solver, self.loads_at(self.inputs), (), 0, None,
                                       error.residual) or error
             raise error
@@ -1389,8 +1389,13 @@ class Solver:
                 return self._solve(wider, chained=chained, jacobians=jacobians, near=near,
                                    outputs=outputs, checked=True,
                                    contact_retry=(None, 0, widened + 1))
-            error = _failure(k, failed[0], shape, status, info, self, near)
-            if status[failed[0]] in (k.PATH_FAILED, k.PATH_STUCK) and not near:
+            b = int(failed[0])
+            turns = None  # a single-shooting path from the unloaded arm: does it turn there?
+            if status[b] == k.PATH_FAILED and not (chained or near or stiff[b]):
+                turns = _path_turns(k, self, arm, channels, pieces, b, base_wrench[b],
+                                    float(info[b, 2]), int(info[b, 4]))
+            error = _failure(k, failed[0], shape, status, info, self, near, turns)
+            if status[failed[0]] == k.PATH_FAILED and not near:
                 error = _tendon_limit(self, loads, shape, int(failed[0]),
                                       None if chained else info[failed[0], 2],
                                       error.residual) or error
@@ -1772,15 +1777,16 @@ class _Parts:
         return dataclasses.replace(self.template, loads=loads, **fields)
 
 
-def _failure(k, b, shape, status, info, solver, near=False) -> ConvergenceError:
+def _failure(k, b, shape, status, info, solver, near=False, turns=None) -> ConvergenceError:
     """The ConvergenceError of the first failed case (``near``: of :meth:`Solver.solve_near`,
-    whose path has no load to follow: a failure there means no solution near its start)."""
+    whose path has no load to follow: a failure there means no solution near its start;
+    ``turns``: whether the loading path turns back where it stopped, :func:`_path_turns`)."""
     b = int(b)
     where = load_case(b, shape)
     residual, estimate, reached, shootings, N = info[b]
     code = int(status[b])
     tried = f"{int(shootings)} shootings, {2 * int(N)} RK4 steps"
-    if near and code in (k.PATH_FAILED, k.PATH_STUCK, k.NEWTON_FAILED):
+    if near and code in (k.PATH_FAILED, k.NEWTON_FAILED):
         return ConvergenceError(
             "Solver.solve_near found no equilibrium of these loads near the given base "
             "reaction (neither the correction from it nor the path from its own loads "
@@ -1792,17 +1798,19 @@ def _failure(k, b, shape, status, info, solver, near=False) -> ConvergenceError:
             f"{solver.tol * solver.length:.3e} m{where}", residual,
             f"step doubling up to {2 * int(N)} RK4 steps")
     if code == k.PATH_FAILED:
-        return ConvergenceError(
-            f"the loading path could not be followed beyond load factor λ = {reached:.6g}"
-            f"{where}: a limit point (fold), where the path turns back and the arm would snap "
-            "to another shape (softarm.continuation follows the branch around it)", residual,
-            tried, load_factor=float(reached))
-    if code == k.PATH_STUCK:
-        return ConvergenceError(
-            f"the loading path could not be followed beyond load factor λ = {reached:.6g}"
-            f"{where}, where it does not turn (not a fold): the solver cannot resolve the arm "
-            "there (Newton's method does not converge however short the load step)",
-            residual, tried, load_factor=float(reached))
+        followed = f"the loading path could not be followed beyond load factor λ = {reached:.6g}"
+        if turns is None:
+            why = (": a limit point (fold), where the arm would snap to another shape, or a "
+                   "point the solver cannot resolve (not told apart on this route)")
+        elif turns:
+            why = (": a limit point (fold): the path turns back there (pseudo-arclength "
+                   "continuation from it), and the arm would snap to another shape "
+                   "(softarm.continuation follows the branch around it)")
+        else:
+            why = (", where the path does not turn (not a fold: pseudo-arclength continuation "
+                   "passes it): the solver could not follow it there")
+        return ConvergenceError(f"{followed}{where}{why}", residual, tried,
+                                load_factor=float(reached))
     if code == k.BUDGET:
         return ConvergenceError(
             f"the shooting budget max_shootings={solver.max_shootings} ran out{where} with the "
@@ -1817,6 +1825,86 @@ def _failure(k, b, shape, status, info, solver, near=False) -> ConvergenceError:
     return ConvergenceError(
         f"Newton's method on the base wrench did not converge at the full load{where}",
         residual, tried)
+
+
+#: The pseudo-arclength probe of :func:`_path_turns`: its largest number of steps and its
+#: first step (in the nondimensional (x, λ) of continuation.py), and how far past the
+#: load factor where natural continuation stopped the path must go (relative) to be seen
+#: not to turn there.
+_PROBE_STEPS = 60
+_PROBE_FIRST = 1e-4
+_PROBE_PAST = 1e-6
+
+
+def _path_turns(k, solver, arm, channels, pieces, b, x, lam, N) -> bool | None:
+    """Whether the loading path of case ``b`` (from the unloaded arm, single shooting) turns
+    back at the load factor ``lam`` where natural continuation stopped (x: the solution
+    there, on N steps): a few steps of pseudo-arclength continuation from it, in (x in the
+    bending scale times the load size, λ), each a Newton corrector on the residual and the
+    arclength. True if λ turns back (a fold), False if the path goes on past ``lam``, None
+    if neither can be seen (the correctors fail: single shooting cannot resolve the arm
+    there). Only on a failure: a few milliseconds."""
+    piece, tip = channels.piece[b], channels.tip_loads[b]
+    case = (np.zeros_like(piece), piece[None].copy(), np.zeros(k.TIP_LOADS), tip[None].copy())
+    counts = solver._step_counts(pieces[1], N)
+    actuators = len(channels.actuators)
+    scale = solver._data.scale
+
+    def at(z):
+        """(the scaled residual (6,), its Jacobian (6, 7)) at z = (x / xscale, λ)."""
+        result = _shoot(k, z[:6] * xscale, float(z[6]), counts, solver._base_kernel, arm, case,
+                        actuators)
+        J = np.column_stack([result.jacobian_x * xscale[None, :],
+                             result.jacobian_inputs[:, :1]]) / scale[:, None]
+        return result.residual / scale, J
+
+    try:
+        first = _shoot(k, np.asarray(x, dtype=np.float64), lam, counts, solver._base_kernel,
+                       arm, case, actuators)
+    except ValueError:  # (a non-finite x)
+        return None
+    xscale = scale * (1.0 + float(np.max(np.abs(first.jacobian_inputs[:, 0]) / scale)))
+    z = np.append(np.asarray(x) / xscale, lam)
+    with np.errstate(all="ignore"):
+        r, J = at(z)
+        tangent = np.linalg.svd(J)[2][-1]
+        if tangent[6] < 0.0:
+            tangent = -tangent
+        h = _PROBE_FIRST
+        for _ in range(_PROBE_STEPS):
+            if h < 1e-12:
+                return None
+            predicted = z + h * tangent
+            w = predicted.copy()
+            converged = False
+            for _ in range(8):
+                r, J = at(w)
+                if not np.all(np.isfinite(J)) or not np.all(np.isfinite(r)):
+                    break
+                if np.max(np.abs(r)) <= 1e-10:
+                    converged = True
+                    break
+                try:
+                    w = w - np.linalg.solve(np.vstack([J, tangent]),
+                                            np.append(r, tangent @ (w - predicted)))
+                except np.linalg.LinAlgError:
+                    break
+            if not converged or np.max(np.abs(w - predicted)) > 0.5 * h:
+                h *= 0.5
+                continue
+            new = np.linalg.svd(J)[2][-1]
+            if new @ tangent < 0.0:
+                new = -new
+            if new @ tangent < 0.9:  # turned too much in one step: a shorter one
+                h *= 0.5
+                continue
+            z, tangent = w, new
+            if tangent[6] < 0.0:
+                return True
+            if z[6] > lam * (1.0 + _PROBE_PAST) + _PROBE_PAST:
+                return False
+            h *= 2.0
+    return None
 
 
 def _admissible(solver, strains, stresses, s, shape, residual, chained: bool) -> None:
