@@ -58,7 +58,9 @@ def test_a_failure_in_a_part_names_its_case_in_the_whole_batch(monkeypatch):
     monkeypatch.setattr(solver_module, "CASES_PER_PART", 5)
     force = np.zeros((4, 5, 3))
     force[..., 2] = -0.05
-    force[2, 3, 2] = -30.0  # bends the arm through several turns: more shootings
+    # bends the arm through several turns and pulls it hard: more shootings (-30 N, which
+    # single shooting took more than 40 for, multiple shooting now solves within them)
+    force[2, 3, 2] = -300.0
     loads = [softarm.TipLoad(force=force), softarm.DistributedForce([0.0, 0.0, 0.0])]
     counts = softarm.statics.Solver(ARM, s=3).solve_from_unloaded(
         [softarm.TipLoad(force=[0.0, 0.0, -0.05]), softarm.DistributedForce([0.0, 0.0, 0.0])])

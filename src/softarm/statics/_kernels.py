@@ -3236,6 +3236,12 @@ _STIFF_STEPS = 0.6  # coarse RK4 steps per unit of kL at least: hk <= 1.7 (RK4 i
 # arm without tension), so steps far below a single-shooting path's are needed there,
 # doubling from then on.
 _DLAM_MIN_STIFF = 1e-12
+# With contact the branch guard is det's sign alone, and a step no longer than this crosses
+# (the guard of before issue 42): the penalty's band switches on within a step at a
+# touchdown, and J changes there by more than the eigenvalue test and the phase's step allow
+# (a path that the old guard followed failed and widened the band). Contact is to be solved
+# as a constraint instead (issue 39).
+_DLAM_CROSS_CONTACT = 1e-3
 # The corrector's contraction test with contact: Newton on a penalty contracts slowly until
 # it is within the band of the answer (a contact that closes between prediction and answer).
 _CONTRACTION_CONTACT = 0.9
@@ -3732,11 +3738,13 @@ def _ms_follow(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, co
         return False
     bounds = np.empty(7)
     _path_bounds(arm, act, case, arm[7], bounds)
+    touching = act is not None and act[5].shape[0] > 0
     guard = _guard_work()
     P_prev = np.empty((6, 6))
     P_new = np.empty((6, 6))
     v = np.empty(n)
-    tested = _phase(bounds, lam0) <= _PHASE_TESTED and _ms_condensed(B, n, piv, Lm, v, P_prev)
+    tested = (not touching and _phase(bounds, lam0) <= _PHASE_TESTED
+              and _ms_condensed(B, n, piv, Lm, v, P_prev))
     t = np.empty(n)
     for i in range(n):
         t[i] = -G[i]
@@ -3756,7 +3764,7 @@ def _ms_follow(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, co
     while lam < end:
         if counter[0] > max_shootings:
             return False
-        dl, target = _load_step(lam, _phase_limited(bounds, lam, dl), end)
+        dl, target = _load_step(lam, dl if touching else _phase_limited(bounds, lam, dl), end)
         _copy(x, x_keep)
         _copy(Z, Z_keep)
         for i in range(n):
@@ -3777,10 +3785,9 @@ def _ms_follow(x, Z, M, chunks, first, csteps, base, arm, act, case, scratch, co
             _ms_motion(scratch[1], M, du, colscale, 1.0, motion_new)
             crossing = new_sign != sign or (
                 check and _crossings(P_new, P_prev, np.int64(6), guard[2], guard[3], 0.0) != 0)
-            # (with contact the tip turns where it touches: only the singular points guard)
-            ok = dl <= _cross_step(bounds, lam) or (not crossing and (
-                _cosine(motion_prev, motion_new) >= 0.5
-                or (act is not None and act[5].shape[0] > 0)))
+            # (with contact the tip turns where it touches: only det's sign guards)
+            ok = dl <= (_DLAM_CROSS_CONTACT if touching else _cross_step(bounds, lam)) or (
+                not crossing and (_cosine(motion_prev, motion_new) >= 0.5 or touching))
         if ok:
             sign = new_sign
             reached[1] = sign
