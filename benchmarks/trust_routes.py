@@ -24,23 +24,12 @@ import time
 import warnings
 
 import numpy as np
+from contact import _timed  # (benchmarks/contact.py: best wall and CPU after a warm-up)
 
 import softarm
 from softarm.routing import Straight
 from softarm.statics._stiff import tension_kl
 from softarm.statics.solver import Solver
-
-
-def _timed(call, repeats):
-    """(result, best wall s, best CPU s) after one warm-up call."""
-    result = call()
-    walls, cpus = [], []
-    for _ in range(repeats):
-        wall, cpu = time.perf_counter(), time.process_time()
-        result = call()
-        walls.append(time.perf_counter() - wall)
-        cpus.append(time.process_time() - cpu)
-    return result, min(walls), min(cpus)
 
 
 def _channel_kl(pieces, tip, lengths, length, soft):
