@@ -9,6 +9,7 @@ CI that no local run had met: the example is now pinned in its test.)
 from __future__ import annotations
 
 import os
+import signal
 
 import numpy as np
 import pytest
@@ -23,6 +24,19 @@ settings.load_profile("softarm")
 # numba cache holds when a test runs: off for the suite and the commands it starts, on in
 # tests/test_compile.py, which tests it.
 os.environ["SOFTARM_COMPILE_NOTICE"] = "0"
+
+
+@pytest.fixture(autouse=True)
+def _sigint_restored():
+    """Each test leaves Ctrl-C as it found it. softarm.cli.main ignores a second Ctrl-C after an
+    interrupt, for the rest of the process (cli.interrupted): called in the test process
+    (tests/test_simulate_cli.py), that left SIGINT ignored for the tests after it, whose
+    commands then inherited it and could not be interrupted (with pytest-xdist, the order of
+    tests/test_hard_edges.py's Ctrl-C test and that one depends on the worker)."""
+    handler = signal.getsignal(signal.SIGINT)
+    yield
+    if handler is not None and signal.getsignal(signal.SIGINT) is not handler:
+        signal.signal(signal.SIGINT, handler)
 
 
 @pytest.fixture
