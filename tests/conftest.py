@@ -4,11 +4,18 @@ Hypothesis (the property tests of tests/lie and tests/analytic) draws its exampl
 fixed seed too (``derandomize``), with no example database: every run, CI's included,
 tests the same examples, and a failure reproduces. (A random draw once found a hang in
 CI that no local run had met: the example is now pinned in its test.)
+
+A plain ``pytest`` leaves out the tests marked ``slow`` (README, "Test"): ``pytest -m slow``
+runs only them, ``pytest --run-slow`` everything, and a slow test named by its node id
+(``pytest tests/test_compile.py::test_...``) runs as named; any ``-m`` expression decides
+alone. .ci/run runs ``pytest`` and then ``pytest -m slow``.
 """
 
 from __future__ import annotations
 
 import os
+import signal
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -23,6 +30,80 @@ settings.load_profile("softarm")
 # numba cache holds when a test runs: off for the suite and the commands it starts, on in
 # tests/test_compile.py, which tests it.
 os.environ["SOFTARM_COMPILE_NOTICE"] = "0"
+
+
+def pytest_addoption(parser):
+    parser.addoption("--run-slow", action="store_true", default=False,
+                     help="run the tests marked slow too (a plain pytest leaves them out; "
+                          "-m slow runs only them)")
+
+
+def _named(config) -> list[str]:
+    """The node ids (relative to the rootdir) that the command line names: its arguments
+    with a ``::``."""
+    named = []
+    for arg in config.args:
+        path, sep, rest = arg.partition("::")
+        if not sep:
+            continue
+        try:
+            path = Path(path).resolve().relative_to(config.rootpath).as_posix()
+        except ValueError:
+            continue
+        named.append(f"{path}::{rest}")
+    return named
+
+
+def _slow_left_out(config) -> bool:
+    return not (config.option.markexpr or config.getoption("--run-slow"))
+
+
+def pytest_collection_modifyitems(config, items):
+    if not _slow_left_out(config):
+        return
+    named = _named(config)
+
+    def runs(item) -> bool:
+        return item.get_closest_marker("slow") is None or any(
+            item.nodeid == n or item.nodeid.startswith((n + "::", n + "[")) for n in named)
+
+    left_out = [item for item in items if not runs(item)]
+    if left_out:
+        config.hook.pytest_deselected(items=left_out)
+        items[:] = [item for item in items if runs(item)]
+    _SLOW_LEFT_OUT[0] = len(left_out)
+    if hasattr(config, "workerinput"):  # a pytest-xdist worker: told to the controller
+        config.workeroutput["slow_left_out"] = len(left_out)
+
+
+#: how many tests marked slow this run leaves out (with pytest-xdist: as a worker counted)
+_SLOW_LEFT_OUT = [0]
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_testnodedown(node, error):
+    _SLOW_LEFT_OUT[0] = max(_SLOW_LEFT_OUT[0],
+                            getattr(node, "workeroutput", {}).get("slow_left_out", 0))
+
+
+def pytest_terminal_summary(terminalreporter, config):
+    if _SLOW_LEFT_OUT[0] and not hasattr(config, "workerinput"):
+        terminalreporter.write_line(
+            f"{_SLOW_LEFT_OUT[0]} tests marked slow were left out: pytest -m slow runs them, "
+            "pytest --run-slow runs everything")
+
+
+@pytest.fixture(autouse=True)
+def _sigint_restored():
+    """Each test leaves Ctrl-C as it found it. softarm.cli.main ignores a second Ctrl-C after an
+    interrupt, for the rest of the process (cli.interrupted): called in the test process
+    (tests/test_simulate_cli.py), that left SIGINT ignored for the tests after it, whose
+    commands then inherited it and could not be interrupted (with pytest-xdist, the order of
+    tests/test_hard_edges.py's Ctrl-C test and that one depends on the worker)."""
+    handler = signal.getsignal(signal.SIGINT)
+    yield
+    if handler is not None and signal.getsignal(signal.SIGINT) is not handler:
+        signal.signal(signal.SIGINT, handler)
 
 
 @pytest.fixture

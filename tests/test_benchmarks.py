@@ -13,6 +13,9 @@ from pathlib import Path
 
 import pytest
 
+# benchmarks/run.py --quick takes ~20 s: the module's tests run with pytest -m slow
+pytestmark = pytest.mark.slow
+
 ROOT = Path(__file__).resolve().parents[1]
 RUN = ROOT / "benchmarks" / "run.py"
 

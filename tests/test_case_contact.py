@@ -163,6 +163,7 @@ def test_a_bad_contact_entry_in_a_result_file_is_named(tmp_path, table_eq):
         io.load_saved(path)
 
 
+@pytest.mark.slow  # (~9 s)
 def test_a_sweep_counts_the_load_tables_only(tmp_path):
     text = TABLE.replace("[solve]", """[[load]]
 kind = "tip"
@@ -295,6 +296,7 @@ def test_every_obstacle_kind_has_a_case_table():
         assert OBSTACLES[obstacle.kind].write(obstacle) == obstacle.to_case()
 
 
+@pytest.mark.slow  # (~13 s)
 def test_a_stable_branch_sweep_solves_every_step_with_one_contact_law():
     """branch = "stable" solves step by step, each with its own penalty stiffness: each step
     equals its own softarm.solve."""

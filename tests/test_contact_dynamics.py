@@ -22,6 +22,7 @@ def _arm(length=0.5, modulus=1e6):
 TABLE = sa.Contact(sa.Plane((0.0, 0.0, -0.05), (0.0, 0.0, 1.0)))
 
 
+@pytest.mark.slow  # (~7 s)
 def test_a_damped_drop_comes_to_rest_at_the_static_answer():
     arm = _arm()
     sim = sa.Simulator(arm, [], [sa.Gravity(), TABLE], dt=1e-3,

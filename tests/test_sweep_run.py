@@ -415,6 +415,7 @@ def _children(pid: int) -> list[int]:
     return found
 
 
+@pytest.mark.slow  # (~7 s)
 @pytest.mark.skipif(not Path("/proc/self/stat").is_file(), reason="reads /proc (Linux)")
 def test_a_killed_worker_is_one_line_naming_the_resume_command(tmp_path):
     """One worker of --workers 2 gets SIGKILL (what the kernel's out-of-memory killer sends):

@@ -235,6 +235,7 @@ def test_a_pull_beyond_the_tensile_limit_of_a_shearable_rod_says_so():
 # a limit reached is said: continuation and critical_load
 
 
+@pytest.mark.slow  # (~5 s)
 def test_a_branch_that_stops_before_its_end_says_why():
     # a tip pull at F L²/EI = 1000 (kL = 32 at λ = 1): continuation shoots once from the
     # base, which carries the tension only to kL ≈ 20 (λ ≈ 0.38). The branch so far is

@@ -478,6 +478,7 @@ print(json.dumps({
 """
 
 
+@pytest.mark.slow  # (~35 s: compiles the solver in memory, without numba's cache)
 def test_r8_import_and_solve_without_a_writable_cache(tmp_path):
     root = Path(tempfile.mkdtemp(prefix="softarm-ro-"))
     try:
