@@ -1,5 +1,5 @@
-"""Every capability of softarm, each on a small problem (tests/test_compile.py runs this after
-``softarm compile --all`` in the same fresh numba cache: nothing may compile here).
+"""Every capability of softarm, each on a small problem (tests/test_compile_all.py runs this
+after ``softarm compile --all`` in the same fresh numba cache: nothing may compile here).
 
 ``python tests/_every_capability.py [NAME ...]``: prints ``NAME: ok SECONDS`` per capability, or
 the error, and exits 1 if any failed. Chosen by what a user calls, not by softarm's kernels:
