@@ -321,9 +321,9 @@ def pin_penalty(L, EA, GA, EI, r, w, P, R_pin, x_p, z_p, k, *, pressure_scale=No
     a fresh mesh dense around the previous contact. ``tol`` is solve_bvp's, on the residual of
     each equation relative to 1 + |its right-hand side|: at the contact's edges, where the
     pressure fades, that is the absolute residual of n', whose round-off ~ 1e-16 |n|/h stalls
-    the mesh refinement below about tol = 5e-7 for k ≥ 1e10 N/m² (the solution's own error
-    at tol = 1e-6 is ~2e-10 m, against tol = 5e-7 .. 2e-7). Raises RuntimeError if solve_bvp
-    fails.
+    the mesh refinement below about tol = 5e-7 for k ≥ 1e10 N/m² (on some machines already
+    at 5e-7: their rounding differs; the solution's own error at tol = 1e-6 is ~2e-10 m,
+    against tol = 7e-7 .. 2e-7). Raises RuntimeError if solve_bvp fails.
     """
     pr = _Scaled.of(L, EA, GA, EI, r, w, P, R_pin, x_p, z_p)
     beta = GA / (R_pin + r) if pressure_scale is None else float(pressure_scale)

@@ -77,8 +77,9 @@ def test_penalty_converges_to_the_hard_contact_at_rate_one(hard, penalties):
     assert errors[1e11] < 1.5e-7
     assert all(0.85 < rate < 1.1 for rate in rates)
     assert rates[-1] > 0.95  # O(1/k) once the penalty's edge layers are thin
-    # the penalty's own discretisation error is far below what it is compared to
-    tighter = pin_penalty(*_args(), 1e10, softer=penalties[1e10], tol=5e-7)
+    # the penalty's own discretisation error is far below what it is compared to (tol 7e-7:
+    # the tightest that every machine reaches, _pin_reference.pin_penalty)
+    tighter = pin_penalty(*_args(), 1e10, softer=penalties[1e10], tol=7e-7)
     own = np.max(np.abs(tighter.positions(STATIONS) - penalties[1e10].positions(STATIONS)))
     assert own < 1e-3 * errors[1e10]
     # the pin's force, from each penalty solution's own balance (clamp reaction, weight, tip)
