@@ -48,6 +48,18 @@ class SpatialEnd:
     steps: int
 
 
+_E1 = np.array([1.0, 0.0, 0.0])
+
+
+def _cross(a, b):
+    """a × b over the last axis (3,) or (4, 3), broadcast: numpy's cross costs more than the
+    products at this size."""
+    a, b = np.asarray(a), np.asarray(b)
+    return np.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
+                     a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
+                     a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], axis=-1)
+
+
 def _hat(w):
     return np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
 
@@ -63,29 +75,31 @@ class _Rod:
         self.q = np.asarray(distributed, dtype=float)
 
     def rhs(self, s, y, lam):
-        """y: R (9, row-major), p (3), m (3), then per column (m₀ x, y, z; λ) δθ, δp, δm."""
+        """y: R (9, row-major), p (3), m (3), then per column (m₀ x, y, z; λ) δθ, δp, δm
+        (the four columns' variations as the rows of a (4, 9) block)."""
         R = y[:9].reshape(3, 3)
         m = y[12:15]
         unit = self.F + self.q * (self.L - s)
         n = lam * unit
         mm, nm = R.T @ m, R.T @ n  # material components
         u = self.k0 + mm / self.kb
-        v = np.array([1.0, 0.0, 0.0]) + nm / self.ks
+        v = _E1 + nm / self.ks
         dp = R @ v
         out = np.empty_like(y)
         out[:9] = (R @ _hat(u)).ravel()
         out[9:12] = dp
-        out[12:15] = -np.cross(dp, n)
-        for c in range(4):
-            o = 15 + 9 * c
-            dth, dm = y[o:o + 3], y[o + 6:o + 9]
-            dn = unit if c == 3 else np.zeros(3)
-            du = (R.T @ dm + np.cross(mm, dth)) / self.kb
-            dv = (R.T @ dn + np.cross(nm, dth)) / self.ks
-            ddp = R @ (np.cross(dth, v) + dv)
-            out[o:o + 3] = -np.cross(u, dth) + du
-            out[o + 3:o + 6] = ddp
-            out[o + 6:o + 9] = -np.cross(ddp, n) - np.cross(dp, dn)
+        out[12:15] = -_cross(dp, n)
+        variation = y[15:].reshape(4, 9)
+        dth, dm = variation[:, :3], variation[:, 6:]
+        dn = np.zeros((4, 3))
+        dn[3] = unit  # ∂n/∂λ; n does not depend on m₀
+        du = (dm @ R + _cross(mm, dth)) / self.kb  # rows: Rᵀ δm + Rᵀm × δθ, per column
+        dv = (dn @ R + _cross(nm, dth)) / self.ks
+        ddp = (_cross(dth, v) + dv) @ R.T
+        rates = out[15:].reshape(4, 9)
+        rates[:, :3] = -_cross(u, dth) + du
+        rates[:, 3:6] = ddp
+        rates[:, 6:] = -_cross(ddp, n) - _cross(dp, dn)
         return out
 
     def shoot(self, m0, lam):
