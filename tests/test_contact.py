@@ -336,7 +336,8 @@ def test_a_given_stiffness_that_lets_the_arm_penetrate_is_an_error(soft_arm):
         sa.solve(soft_arm, [sa.Gravity(), soft])
 
 
-@pytest.mark.parametrize(("tip", "clearance"), [(0.1, 0.0), (0.2, 0.002)])
+@pytest.mark.parametrize(("tip", "clearance"),
+                         [(0.1, 0.0), pytest.param(0.2, 0.002, marks=pytest.mark.slow)])
 def test_pin_matches_the_hard_contact_wrap(soft_arm, tip, clearance):
     """A pin (a Capsule of radius 5 mm across the arm at 0.6 L) under the arm, the arm pressed
     on it by its weight and a tip force: the shape and the contact force against the

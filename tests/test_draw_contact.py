@@ -94,6 +94,7 @@ def test_the_picture_draws_the_obstacles_and_the_contact_forces(table, tmp_path)
     assert (tmp_path / "table.png").stat().st_size > 10_000
 
 
+@pytest.mark.slow
 def test_a_sweep_picture_draws_the_obstacles(tmp_path):
     pytest.importorskip("matplotlib")
     from softarm import plot
@@ -132,6 +133,7 @@ def test_the_view_draws_the_obstacles_and_the_contact_forces(table):
     assert z_range[1] > 0.22
 
 
+@pytest.mark.slow
 def test_a_sweep_view_keeps_the_obstacles_out_of_its_frames():
     pytest.importorskip("plotly")
     from softarm import view

@@ -157,6 +157,7 @@ def test_store_layout_units_and_attributes(tmp_path):
                                    atol=1e-7)
 
 
+@pytest.mark.slow
 def test_serial_equals_two_processes_case_by_case(tmp_path):
     case = parse_case(soft_arm_case(SOFT_GRID), tmp_path / "soft.toml")
     serial = softarm.sweep.run(case, out=tmp_path / "serial.zarr", chunk=2,
@@ -171,6 +172,7 @@ def test_serial_equals_two_processes_case_by_case(tmp_path):
     assert_same_outputs(serial, memory, atol=1e-12)  # chunking changes nothing
 
 
+@pytest.mark.slow
 def test_dask_local_cluster_equals_serial(tmp_path):
     distributed = need("distributed", "dask")
     case = parse_case(soft_arm_case(SOFT_GRID), tmp_path / "soft.toml")
@@ -198,6 +200,7 @@ _KILLED_DESIGN = {"design": "grid", "parameter": [
     {"path": "load[2].force.z", "start": -0.1, "stop": 0.0, "steps": 8}]}
 
 
+@pytest.mark.slow
 def test_resume_after_sigkill_equals_an_uninterrupted_run(tmp_path, capsys):
     """softarm sweep is killed (SIGKILL) while writing; --resume finishes the chunks whose
     done flag is missing, and the store then equals an uninterrupted run."""

@@ -295,6 +295,7 @@ def test_an_arm_on_a_huge_ball_lies_as_on_the_plane_less_its_sag():
     assert q[:, :2] == pytest.approx(p[:, :2], abs=5e-9)
 
 
+@pytest.mark.slow
 def test_critical_load_in_contact_returns_none_after_two_solves(monkeypatch):
     # the arm on the table under up to 10× its weight is stable (nothing compresses it):
     # None after the solves at λ = 0 and at max_factor (sixteen samples took 17 solves,

@@ -225,6 +225,7 @@ def test_reproduce_without_matplotlib_writes_the_report_without_figures(tmp_path
     assert "wrote" in child.stdout and "png" not in child.stdout
 
 
+@pytest.mark.slow
 def test_plot_without_matplotlib_is_one_line(tmp_path):
     case = tmp_path / "moment.toml"
     case.write_text('[arm]\nlength = 1.0\nstiffness = { EA = 1e6, GAy = 1e6, GAz = 1e6, '

@@ -359,6 +359,7 @@ def test_r6_sweep_direction_that_overflows_python(tmp_path):
     assert swept.tip_position[1, 2] > 0.3  # k = 1 along +z: w/L = 0.30 (Mattiasson 1981)
 
 
+@pytest.mark.slow
 def test_r6_sweep_direction_that_overflows_cli(tmp_path):
     path = tmp_path / "overflow.toml"
     path.write_text(SWEEP_CASE)
