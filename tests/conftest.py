@@ -58,10 +58,16 @@ def _slow_left_out(config) -> bool:
     return not (config.option.markexpr or config.getoption("--run-slow"))
 
 
-#: test files that start first under pytest-xdist: the longest single piece of work (the fresh
-#: cache's ``softarm compile --all``, about 7 minutes), so that it runs beside everything else
-#: instead of after it
-STARTS_FIRST = ("tests/test_compile_all.py",)
+#: test files that start first under pytest-xdist, in this order (two workers take them in
+#: turn). First the longest single piece of work (the fresh cache's ``softarm compile --all``,
+#: about 7 minutes: ``pytest -m slow``), so that it runs beside everything else instead of after
+#: it. Then, for a first run (numba's cache empty, most of its time compiling), files whose
+#: first tests compile different capabilities, so that the two workers do not compile the same
+#: one at once (measured: 97 s of such duplicates in a 431-s run, the passive solver and the
+#: contact solver above all): the passive solver and multiple shooting; actuated arms;
+#: contact; dynamics.
+STARTS_FIRST = ("tests/test_compile_all.py", "tests/statics/test_invariants.py",
+                "tests/test_model_limits.py", "tests/test_contact.py", "tests/test_dynamics.py")
 
 
 def pytest_collection_modifyitems(config, items):
@@ -71,9 +77,9 @@ def pytest_collection_modifyitems(config, items):
 
 def _order_files(config, items) -> None:
     """The files in the order pytest-xdist hands them out (``--dist loadfile``,
-    ``--no-loadscope-reorder``): :data:`STARTS_FIRST`, then the files with more tests first
-    (what xdist itself would do: its longest files tend to be its largest), each file's tests
-    in their own order. Without xdist the order is only rearranged by file."""
+    ``--no-loadscope-reorder``): :data:`STARTS_FIRST` in its order, then the files with more
+    tests first (what xdist itself would do: its longest files tend to be its largest), each
+    file's tests in their own order. Without xdist the order is only rearranged by file."""
     def file_of(item) -> str:
         path = Path(item.path).resolve()
         return path.relative_to(config.rootpath).as_posix() \
@@ -82,7 +88,8 @@ def _order_files(config, items) -> None:
     counts: dict[str, int] = {}
     for item in items:
         counts[file_of(item)] = counts.get(file_of(item), 0) + 1
-    rank = {name: (name not in STARTS_FIRST, -count, position)
+    first = {name: position for position, name in enumerate(STARTS_FIRST)}
+    rank = {name: (first.get(name, len(first)), -count, position)
             for position, (name, count) in enumerate(counts.items())}
     items.sort(key=lambda item: rank[file_of(item)])
 

@@ -161,6 +161,7 @@ def stop_app(child) -> str:
 
 
 @pytest.mark.skipif(sys.platform == "win32", reason="SIGINT to a child process")
+@pytest.mark.slow
 def test_ctrl_c_stops_the_app_cleanly():
     child, address = start_app()
     assert get(address)[0] == 200
@@ -175,6 +176,7 @@ def reset(sock: socket.socket) -> None:
 
 
 @pytest.mark.skipif(sys.platform == "win32", reason="SIGINT to a child process")
+@pytest.mark.slow
 def test_a_client_that_resets_its_connection_is_no_error():
     # It used to print a ConnectionResetError traceback on the app's stderr.
     child, address = start_app()

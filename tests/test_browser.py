@@ -27,6 +27,9 @@ from softarm import app, io, view
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
+# a real browser: in pytest -m slow (and CI), not in a plain pytest
+pytestmark = pytest.mark.slow
+
 
 def wait_for(driver, script, timeout=60.0):
     end = time.monotonic() + timeout

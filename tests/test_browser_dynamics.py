@@ -26,6 +26,9 @@ from softarm import app, view
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
+# a real browser: in pytest -m slow (and CI), not in a plain pytest
+pytestmark = pytest.mark.slow
+
 
 def test_motion_page_plays_at_the_trajectorys_pace(browser, tmp_path):
     arm = softarm.Arm(0.5, softarm.Circle(0.02),

@@ -88,6 +88,7 @@ def test_obstacles_make_one_contact_after_the_loads(table_case):
     np.testing.assert_array_equal(table_case.loads[-1].obstacles[0].normal, [0.0, 0.0, 1.0])
 
 
+@pytest.mark.slow
 def test_the_case_solves_as_the_contact_built_by_hand(table_case, table_eq):
     direct = softarm.solve(ARM, [softarm.Gravity(), _by_hand()], s=51, tol=1e-8)
     np.testing.assert_allclose(table_eq.poses, direct.poses, rtol=0, atol=1e-12)

@@ -211,6 +211,7 @@ def test_progress_bar_only_when_slow():
 
 
 @pytest.mark.parametrize("method", ["auto", "numeric"])
+@pytest.mark.slow
 def test_long_sweep_is_solved_in_chunks_with_progress(monkeypatch, method):
     """A sweep whose first step is slow is solved in chunks; the result is one batch.
 
@@ -246,6 +247,7 @@ def entry_point() -> Path:
 
 
 @pytest.mark.skipif(not entry_point().exists(), reason="softarm entry point not installed")
+@pytest.mark.slow
 def test_installed_entry_point(tmp_path):
     out = tmp_path / "fig2.json"
     done = subprocess.run([str(entry_point()), "solve", str(FIG2), "-o", str(out)],

@@ -142,6 +142,7 @@ def test_batch_equals_loop(soft_arm):
         assert np.array_equal(batch.contact_forces[b], one.contact_forces)
 
 
+@pytest.mark.slow
 def test_tip_compliance_matches_finite_differences(soft_arm):
     # the tip pressed on a table: the contact stiffens the tip (an exact Jacobian through
     # the penalty's ∂f/∂p) and the finite difference of solves agrees (on a small ball the
@@ -336,8 +337,8 @@ def test_a_given_stiffness_that_lets_the_arm_penetrate_is_an_error(soft_arm):
         sa.solve(soft_arm, [sa.Gravity(), soft])
 
 
-@pytest.mark.parametrize(("tip", "clearance"),
-                         [(0.1, 0.0), pytest.param(0.2, 0.002, marks=pytest.mark.slow)])
+@pytest.mark.slow
+@pytest.mark.parametrize(("tip", "clearance"), [(0.1, 0.0), (0.2, 0.002)])
 def test_pin_matches_the_hard_contact_wrap(soft_arm, tip, clearance):
     """A pin (a Capsule of radius 5 mm across the arm at 0.6 L) under the arm, the arm pressed
     on it by its weight and a tip force: the shape and the contact force against the

@@ -42,6 +42,7 @@ def test_a_damped_drop_comes_to_rest_at_the_static_answer():
     assert path.gaps[0].min() > 0.03 and path.gaps[-1].min() < law.distance
 
 
+@pytest.mark.slow
 def test_an_undamped_impact_keeps_the_energy_to_the_steps_accuracy():
     """Undamped, the impact's energy goes into the penalty and back (restitution 1): kinetic
     + elastic + gravity + the penalty's stored energy stays near its start (0), the error
@@ -62,6 +63,7 @@ def test_an_undamped_impact_keeps_the_energy_to_the_steps_accuracy():
     assert errors[1] < 0.75 * errors[0]
 
 
+@pytest.mark.slow
 def test_sliding_friction_follows_coulombs_law():
     """A stiff arm lying on an inclined table (gravity tilted by θ), its base pulled up the
     slope at 5 cm/s: the axial force at the base is the weight's component along the slope
@@ -106,6 +108,7 @@ def test_far_obstacles_change_nothing_in_motion():
     assert np.isinf(free.gaps).all() and near.gaps.min() > 4.0
 
 
+@pytest.mark.slow
 def test_friction_holds_a_pushed_arm_below_the_cone():
     """Sticking: an arm lying on a table (μ = 0.5) pushed sideways at its tip by 0.02 N, a
     tenth of what friction can hold (μ N = 0.23 N): after 0.2 s it creeps at most at the
@@ -129,6 +132,7 @@ def test_friction_holds_a_pushed_arm_below_the_cone():
 FINGER = Path(__file__).resolve().parents[1] / "examples" / "gripper_finger.toml"
 
 
+@pytest.mark.slow
 def test_a_finger_pulled_from_0_to_15_n_stays_outside_the_cylinder():
     """Issue 42: a Simulator built at 0 N sized its penalty for 0 N, and the finger of
     examples/gripper_finger.toml, its tendon ramped to 15 N, went 34 mm through the

@@ -179,6 +179,7 @@ def test_a_singular_value_failure_is_a_convergence_error():
         solver._singular(np.full((3, 3), np.nan))
 
 
+@pytest.mark.slow
 def test_tracking_recovers_after_an_unreachable_target():
     """issue 30: one unreachable target in a tracked path (far below the base) left the
     path at its closest point, tensions of 1e4 N, and every later target was missed too
@@ -225,6 +226,7 @@ def test_the_halton_starts_are_scipys_unscrambled_halton_points():
     ([0.0, 0.0, 6.1727], 2),  # the answer without the upper bounds lies within them
     ([5.5775, 0.1215, 7.1299], 3),  # that one misses too: projected, then a Halton point
 ])
+@pytest.mark.slow
 def test_a_missed_reachable_target_is_reached_from_more_starts(hidden, starts):
     """issue 30: a reachable target that inverse called unreachable, with bounds (0, 10) N
     (examples/tendon_robot.toml's): from zero the bounded iteration runs along the weak
@@ -294,6 +296,7 @@ def test_the_tracking_example_runs(tmp_path, capsys):
     assert (tmp_path / "track.png").stat().st_size > 10_000
 
 
+@pytest.mark.slow
 def test_the_jacobian_control_example_tracks_its_circle(tmp_path, capsys):
     """examples/jacobian_control.py: a resolved-rate loop on ForwardSolver. Its tips against
     independent solves from the unloaded arm at the tensions it commanded (1e-6 L), and

@@ -163,6 +163,7 @@ def test_a_sweep_view_keeps_the_obstacles_out_of_its_frames():
     assert lengths[0] < lengths[1]
 
 
+@pytest.mark.slow
 def test_the_app_draws_the_solved_contact_forces():
     pytest.importorskip("plotly")
     from softarm import app

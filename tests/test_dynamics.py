@@ -91,6 +91,7 @@ def test_a_base_function_is_never_called_before_the_start():
 
 
 @pytest.mark.parametrize("damped", [False, True])
+@pytest.mark.slow
 def test_the_energy_of_a_released_arm_is_kept_over_20_periods(damped):
     period = _first_period(SHORT)
     dt = period / 200
@@ -228,6 +229,7 @@ def test_an_actuated_arm_settles_to_the_static_equilibrium(actuator):
         assert path.tendon_lengths[-1, 0] == pytest.approx(eq.tendon_lengths[0], abs=1e-5)
 
 
+@pytest.mark.slow
 def test_a_magnetic_arm_settles_to_the_static_equilibrium():
     field = softarm.MagneticField([0.0, 0.0, 0.02])
     # a magnetisation along the arm turns it up by 85° (2.6e-3 L and 6.6e-4 L measured)

@@ -41,6 +41,7 @@ def _section(arm):
     return r, mu, rho_j
 
 
+@pytest.mark.slow
 def test_the_first_two_bending_frequencies_are_timoshenkos():
     r, mu, rho_j = _section(THICK)
     omega = cantilever_bending(THICK.length, r.EIy, r.GAy, mu, rho_j[1], count=2)
@@ -126,6 +127,7 @@ def _till_rucker(example: str):
     return params, rod, Gravity(params["gravity_softarm_frame"])
 
 
+@pytest.mark.slow
 def test_till_aloi_ruckers_cantilever():
     """Their example 02_Dynamics/00_Cosserat_Rod_PDE (tests/data/till_rucker/README.md): a
     steel rod under gravity released from its equilibrium with a 20 g tip weight, BDF-α
@@ -149,6 +151,7 @@ def test_till_aloi_ruckers_cantilever():
     assert np.abs(tip[:, 0] - reference["z_extrap"]).max() < 8e-5
 
 
+@pytest.mark.slow
 def test_till_aloi_ruckers_tendon_robot_converges_to_softarm():
     """Their example 02_Dynamics/03_Tendon_Robot: a spring-steel rod with one tendon,
     displacement-controlled by a motor that pulls the arm up, holds it and lets it fall

@@ -226,6 +226,7 @@ def test_gripper_finger_example_touches_the_cylinder():
     assert np.min(result.gaps) > -1e-8 * 0.12
 
 
+@pytest.mark.slow
 def test_the_gripper_finger_example_says_what_it_shows():
     """Its comment once said the finger wraps onto the cylinder; it presses on a short patch.
     The numbers its comment gives: the free curl (κ = τ d / EI, the hand formula for a

@@ -18,6 +18,7 @@ def test_small_amplitude_limit_is_the_timoshenko_cantilever():
     np.testing.assert_allclose((4 * fine - coarse) / 3, exact, rtol=1e-5)
 
 
+@pytest.mark.slow
 def test_undamped_swing_conserves_the_discrete_energy():
     # T + V is exactly conserved by the semi-discrete system (module docstring); the change
     # over 0.3 s is the time integration's alone and shrinks with rtol

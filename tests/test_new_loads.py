@@ -302,6 +302,7 @@ def references():
 
 # --- the reference validated on today's solver -----------------------------------------------
 
+@pytest.mark.slow
 def test_bvp_reference_reproduces_the_dead_distributed_force(references):
     # Today's solver and the reference agree to 2e-12 L (measured); asserted at 1e-9 L.
     eq = numeric(ARM, DistributedForce(F_DEAD), s=STATIONS, tol=1e-11)
@@ -341,6 +342,7 @@ def test_follower_distributed_moment_equals_solve_bvp(references):
     assert_matches_reference(eq, references("follower_moment"), 1e-6 * ARM.length)
 
 
+@pytest.mark.slow
 def test_span_and_segment_restrictions_equal_solve_bvp(references):
     loads = [DistributedForce(F_SPAN, span=SPAN),
              distributed_moment(M_SEGMENT, follower=True, segment=1)]

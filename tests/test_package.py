@@ -43,6 +43,7 @@ def test_version_matches_the_dynamic_version_source():
     assert importlib.metadata.version("softarm") == softarm.__version__
 
 
+@pytest.mark.slow
 def test_plain_pytest_says_why_a_test_was_skipped(tmp_path):
     """The project's pytest configuration reports the reason of every skip (``-rs``): a plain
     ``pytest`` must not print "4 skipped" and leave the reader to guess; failures stay listed

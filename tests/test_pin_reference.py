@@ -60,6 +60,7 @@ def penalties():
 STATIONS = np.linspace(0.0, L, 4001)
 
 
+@pytest.mark.slow
 def test_refinement_moves_nothing(hard):
     fine = pin_reference(*_args(), tol=1e-10)
     assert fine.nodes > 3 * hard.nodes  # a real refinement (measured 1718 against 401)
@@ -68,6 +69,7 @@ def test_refinement_moves_nothing(hard):
     assert np.max(np.abs(fine.contact_force - hard.contact_force)) < 1e-9
 
 
+@pytest.mark.slow
 def test_penalty_converges_to_the_hard_contact_at_rate_one(hard, penalties):
     errors = {k: np.max(np.abs(pen.positions(STATIONS) - hard.positions(STATIONS)))
               for k, pen in penalties.items()}

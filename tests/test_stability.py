@@ -371,6 +371,7 @@ def test_cli_critical_and_the_stable_branch_in_a_case_file(tmp_path, capsys):
     assert err.count("\n") == 1 and "flutter" in err
 
 
+@pytest.mark.slow
 def test_closed_form_axial_index_agrees_with_the_count_and_the_sweep():
     # the closed form's index (a formula) and the numerical route's (the sweep) against the
     # count of the model's critical loads below P, over a range reaching index 5

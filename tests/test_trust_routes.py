@@ -195,6 +195,7 @@ WIRE = sa.Arm(1.0, sa.Circle(0.25e-3), sa.Material(youngs_modulus=50e9, poisson_
 
 
 @pytest.mark.parametrize("ratio", [1.56, 10.0])  # F / EA
+@pytest.mark.slow
 def test_a_pull_beyond_ea_stretches_the_rod_by_f_over_ea(ratio):
     # the linear law σ = K ε holds at any stretch: the bar's tip at L (1 + F/EA) exactly;
     # with GA = EA the straight rod is stable in tension at any pull, and a lateral P =
@@ -277,6 +278,7 @@ def test_a_huge_ball_gives_gaps_to_round_off_of_the_gap():
                                   / np.linalg.norm(np.array(point) - ball.center), abs=1e-15)
 
 
+@pytest.mark.slow
 def test_an_arm_on_a_huge_ball_lies_as_on_the_plane_less_its_sag():
     # a ball of radius 1e6 m as a floor: the arm on the table of docs/contact.md, each
     # station lower by the ball's sag x²/(2R) than on the plane (1.2e-7 m at the tip). It

@@ -201,6 +201,7 @@ sys.exit(main(sys.argv[1:]))
 
 
 @pytest.mark.parametrize("failing", [False, True])
+@pytest.mark.slow
 def test_reproduce_without_matplotlib_writes_the_report_without_figures(tmp_path, failing):
     """No traceback: the report and tables, one line saying how to get the figures, and the
     exit status of the checks alone (0, or 1 with a failed check)."""

@@ -447,6 +447,7 @@ def test_conservative_equilibrium_is_the_continued_one(index):
 
 
 @pytest.mark.parametrize("index", REFERENCE_CASES)
+@pytest.mark.slow
 def test_conservative_equilibrium_is_the_solve_bvp_one(index):
     """Against the independent solve_bvp continuation: shape and potential energy."""
     arm, loads = case("energy", index, conservative=True)

@@ -401,6 +401,7 @@ _R7 = {
 
 
 @pytest.mark.parametrize("name", sorted(_R7))
+@pytest.mark.slow
 def test_r7_non_finite_or_subnormal_derived_quantity_is_a_value_error(name):
     code, pattern = _R7[name]
     script = textwrap.dedent("""\
