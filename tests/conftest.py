@@ -8,7 +8,7 @@ CI that no local run had met: the example is now pinned in its test.)
 A plain ``pytest`` leaves out the tests marked ``slow`` (README, "Test"): ``pytest -m slow``
 runs only them, ``pytest --run-slow`` everything, and a slow test named by its node id
 (``pytest tests/test_compile.py::test_...``) runs as named; any ``-m`` expression decides
-alone. .ci/run runs tests/test_compile_all.py, then ``pytest``, then the other slow tests.
+alone. .ci/run runs ``pytest`` and then ``pytest -m slow``.
 """
 
 from __future__ import annotations

@@ -284,3 +284,25 @@ def test_the_verdict_compiles_beside_only_where_a_core_is_idle(monkeypatch):
         launched.clear()
         said = _prefetch.start("passive", dispatcher)
         assert bool(launched) is launches and (said is not None) is launches, (load, wanted)
+
+
+def test_compile_all_shares_its_steps_among_processes_by_their_reference_times():
+    """softarm compile --all --jobs N: every step in exactly one share, the first step (the
+    passive solver) in this process's, and no share over the largest step's time beyond an
+    even split (the greedy bound: a share exceeds total/N by at most one step)."""
+    from softarm._jit import REFERENCE_SECONDS
+    from softarm.warmup import STEPS, _shares, compile_kernels
+
+    def cost(step):
+        return sum(REFERENCE_SECONDS.get(key, 5.0) for key in step.keys)
+
+    steps = list(STEPS)
+    for jobs in (1, 2, 3):
+        shares = _shares(steps, jobs)
+        assert len(shares) == jobs and shares[0][0] is steps[0]
+        assert sorted(s.name for share in shares for s in share) == sorted(s.name for s in steps)
+        total = sum(cost(s) for s in steps)
+        assert max(sum(cost(s) for s in share) for share in shares) <= \
+            total / jobs + max(cost(s) for s in steps)
+    with pytest.raises(ValueError, match="jobs must be a positive integer, got 0"):
+        compile_kernels(all=True, jobs=0)

@@ -14,7 +14,6 @@ while the other worker runs everything else; tests/conftest.py puts this file fi
 
 from __future__ import annotations
 
-import os
 import subprocess
 import sys
 from dataclasses import dataclass
@@ -46,12 +45,7 @@ class _Runs:
 
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory) -> _Runs:
-    """The commands, in a new empty folder; or in ``$SOFTARM_FRESH_NUMBA_CACHE``, which must be
-    empty (.ci/run runs this file first in the numba cache of the runs after it, which then
-    find every kernel compiled: the compile is paid once)."""
-    given = os.environ.get("SOFTARM_FRESH_NUMBA_CACHE")
-    cache = Path(given) if given else tmp_path_factory.mktemp("numba-cache")
-    assert not any(cache.rglob("*")), f"SOFTARM_FRESH_NUMBA_CACHE={given} is not empty"
+    cache = tmp_path_factory.mktemp("numba-cache")
     first = softarm_with("compile", cache=cache)
     solve = python_with(PASSIVE_SOLVE, "_steps", cache=cache)
     again = softarm_with("compile", cache=cache, notice=False)

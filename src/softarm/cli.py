@@ -312,6 +312,9 @@ def _parser() -> argparse.ArgumentParser:
         "otherwise compiles on its first use; a cached one loads in a fraction of a second.")
     compile_.add_argument("--all", action="store_true",
                           help="every capability, not only what a first solve needs")
+    compile_.add_argument("--jobs", type=_positive, default=None, metavar="N",
+                          help="with --all, compile on N cores at once (default: every core "
+                          "of this machine, at most 4)")
     compile_.set_defaults(run=_run_compile)
 
     from .validation import add_parser as add_reproduce  # softarm reproduce [--out DIR] (#6)
@@ -1019,7 +1022,8 @@ def _run_compile(args) -> int:
 
     bar = _CompileBar(sys.stderr)
     start = time.perf_counter()
-    done = compile_kernels(all=args.all, progress=bar)
+    jobs = args.jobs or min(os.cpu_count() or 1, 4)
+    done = compile_kernels(all=args.all, progress=bar, jobs=jobs if args.all else 1)
     compiled = sum(len(keys) for _, _, keys in done)
     print(f"{compiled} kernel{'s' if compiled != 1 else ''} compiled in "
           f"{time.perf_counter() - start:.0f} s; later runs load them from numba's cache"

@@ -215,19 +215,34 @@ STEPS: tuple[Step, ...] = (
 )
 
 
-def compile_kernels(all: bool = False, progress: Callable | None = None) -> list[tuple]:
+def compile_kernels(all: bool = False, progress: Callable | None = None,
+                    jobs: int = 1) -> list[tuple]:
     """Compile (or load from the cache) every kernel a first solve needs, or with ``all``
     every capability of :data:`STEPS`. ``progress(step, index, count, elapsed, estimate)``
     is called about five times a second while a step runs and once when it ends (``elapsed``
     None at the start). Returns [(step, seconds, compiled keys)] (compiled keys: what missed
-    the cache, with its time: ``[(key, text, seconds)]``)."""
+    the cache, with its time: ``[(key, text, seconds)]``).
+
+    ``jobs`` > 1: the steps are shared among this process and ``jobs - 1`` helper processes
+    (each a numba compile on one core), balanced by their reference times; a helper's steps
+    are reported when it ends. Design note: two processes that write the same function's
+    cache index at the same moment can lose one entry (numba reads, updates and replaces the
+    index file), so this process then runs the helpers' steps once more, from the cache:
+    whatever was lost compiles again, and ``softarm compile --all`` leaves nothing to
+    compile."""
+    if not isinstance(jobs, int) or isinstance(jobs, bool) or jobs < 1:
+        raise ValueError(f"jobs must be a positive integer, got {jobs!r}")
     from . import _jit  # the compiled modules' helper: imports numba (an optional heavy import)
 
     steps = [step for step in STEPS if all or step.first]
+    groups = _shares(steps, min(jobs, len(steps)))
+    helpers = [_start_helper(group) for group in groups[1:]]
     done = []
     previous, _jit.notices = _jit.notices, progress is None and _jit.notices
     try:
         for index, step in enumerate(steps):
+            if step not in groups[0]:
+                continue
             estimate = sum(_jit.compile_seconds(key, _dispatcher(key))[0] or 0.0
                            for key in step.keys)
             before = len(_jit.COMPILED)
@@ -239,9 +254,79 @@ def compile_kernels(all: bool = False, progress: Callable | None = None) -> list
             if progress is not None:
                 progress(step, index, len(steps), seconds, -1.0)
             done.append((step, seconds, list(_jit.COMPILED[before:])))
+        for helper, group in zip(helpers, groups[1:], strict=True):
+            for name, seconds, compiled in _finish_helper(helper):
+                step = next(step for step in group if step.name == name)
+                if progress is not None:
+                    progress(step, steps.index(step), len(steps), seconds, -1.0)
+                done.append((step, seconds, [tuple(entry) for entry in compiled]))
+            for step in group:  # (from the cache: see the design note)
+                with np.errstate(all="ignore"):
+                    step.run()
     finally:
         _jit.notices = previous
+        for helper in helpers:
+            if helper.poll() is None:
+                helper.kill()
+                helper.wait()
+    done.sort(key=lambda entry: steps.index(entry[0]))
     return done
+
+
+def _shares(steps: list[Step], jobs: int) -> list[list[Step]]:
+    """``steps`` in ``jobs`` groups of about equal reference compile time (longest first, each
+    to the group with the least so far); the first group holds the first step."""
+    from ._jit import REFERENCE_SECONDS
+
+    def cost(step: Step) -> float:
+        return sum(REFERENCE_SECONDS.get(key, 5.0) for key in step.keys)
+
+    groups: list[list[Step]] = [[] for _ in range(jobs)]
+    totals = [0.0] * jobs
+    for step in sorted(steps, key=cost, reverse=True):
+        share = 0 if step is steps[0] else int(np.argmin(totals))
+        groups[share].append(step)
+        totals[share] += cost(step)
+    return [sorted(group, key=steps.index) for group in groups]
+
+
+#: a helper process of compile_kernels: runs the steps named on its command line, prints
+#: [[name, seconds, compiled keys], ...] as JSON on its last line
+_HELPER = """
+import json, sys, time
+import numpy as np
+from softarm import _jit
+from softarm.warmup import STEPS
+out = []
+for name in sys.argv[1:]:
+    step = next(step for step in STEPS if step.name == name)
+    before, start = len(_jit.COMPILED), time.perf_counter()
+    with np.errstate(all="ignore"):
+        step.run()
+    out.append([name, time.perf_counter() - start, [list(c) for c in _jit.COMPILED[before:]]])
+print(json.dumps(out))
+"""
+
+
+def _start_helper(group: list[Step]):
+    import os
+    import subprocess
+    import sys
+
+    return subprocess.Popen([sys.executable, "-c", _HELPER, *(step.name for step in group)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            env=dict(os.environ, SOFTARM_COMPILE_NOTICE="0"))
+
+
+def _finish_helper(helper) -> list:
+    import json
+
+    out, err = helper.communicate()
+    if helper.returncode != 0:
+        last = (err.strip().splitlines() or ["(no message)"])[-1]
+        raise RuntimeError(f"a helper process of softarm compile failed (exit "
+                           f"{helper.returncode}): {last}")
+    return json.loads(out.strip().splitlines()[-1])
 
 
 class _Ticker:
