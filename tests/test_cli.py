@@ -329,7 +329,7 @@ def _frames(stderr: str) -> list[str]:
 @pytest.mark.skipif(sys.platform == "win32", reason="SIGINT to a child process")
 @pytest.mark.skipif(not entry_point().exists(), reason="softarm entry point not installed")
 def test_ctrl_c_wherever_it_lands_in_the_first_seconds(tmp_path):
-    """SIGINT to ``softarm solve examples/demo.toml -o out.csv`` at 25 moments from 0.05 s to
+    """SIGINT to ``softarm solve examples/demo.toml -o out.csv`` at 16 moments from 0.05 s to
     3 s: while Python starts, numpy/scipy/numba are imported (a KeyboardInterrupt there may
     come back as numpy's ImportError), the kernels load from numba's cache (LLVM's ctypes
     callbacks swallow a KeyboardInterrupt), the case solves, the file is written. Either the
@@ -352,7 +352,7 @@ def test_ctrl_c_wherever_it_lands_in_the_first_seconds(tmp_path):
     assert warm.returncode == 0, warm.stderr
     ours = (str(Path(softarm.__file__).parent), "_softarm_cli.py")
     outcomes = []
-    for k, delay in enumerate(np.linspace(0.05, 3.0, 25)):
+    for k, delay in enumerate(np.linspace(0.05, 3.0, 16)):
         folder = tmp_path / f"run{k}"
         folder.mkdir()
         out = folder / "out.csv"
@@ -388,4 +388,4 @@ def test_ctrl_c_wherever_it_lands_in_the_first_seconds(tmp_path):
             assert delay < 0.5 and frames and not any(f.startswith(ours[0]) or
                                                       f.endswith(ours[1]) for f in frames), where
             outcomes.append("interpreter start-up")
-    assert outcomes.count("stopped") >= 6, outcomes  # most moments are inside the command
+    assert outcomes.count("stopped") >= 4, outcomes  # most moments are inside the command
