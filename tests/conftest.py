@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import os
 import signal
+from collections import Counter
 from pathlib import Path
 
 import numpy as np
@@ -85,13 +86,12 @@ def _order_files(config, items) -> None:
         return path.relative_to(config.rootpath).as_posix() \
             if path.is_relative_to(config.rootpath) else path.as_posix()
 
-    counts: dict[str, int] = {}
-    for item in items:
-        counts[file_of(item)] = counts.get(file_of(item), 0) + 1
+    files = {id(item): file_of(item) for item in items}
+    counts = Counter(files.values())  # (in the order the files were collected)
     first = {name: position for position, name in enumerate(STARTS_FIRST)}
     rank = {name: (first.get(name, len(first)), -count, position)
             for position, (name, count) in enumerate(counts.items())}
-    items.sort(key=lambda item: rank[file_of(item)])
+    items.sort(key=lambda item: rank[files[id(item)]])
 
 
 def _leave_out_slow(config, items) -> None:

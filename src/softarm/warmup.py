@@ -236,24 +236,21 @@ def compile_kernels(all: bool = False, progress: Callable | None = None,
 
     steps = [step for step in STEPS if all or step.first]
     groups = _shares(steps, min(jobs, len(steps)))
-    helpers = [_start_helper(group) for group in groups[1:]]
+    helpers = []
     done = []
     previous, _jit.notices = _jit.notices, progress is None and _jit.notices
     try:
+        helpers += [_start_helper(group) for group in groups[1:]]
         for index, step in enumerate(steps):
             if step not in groups[0]:
                 continue
             estimate = sum(_jit.compile_seconds(key, _dispatcher(key))[0] or 0.0
                            for key in step.keys)
-            before = len(_jit.COMPILED)
-            start = time.perf_counter()
             with _Ticker(progress, (step, index, len(steps)), estimate):
-                with np.errstate(all="ignore"):
-                    step.run()
-            seconds = time.perf_counter() - start
+                seconds, compiled = _run_step(step)
             if progress is not None:
                 progress(step, index, len(steps), seconds, -1.0)
-            done.append((step, seconds, list(_jit.COMPILED[before:])))
+            done.append((step, seconds, compiled))
         for helper, group in zip(helpers, groups[1:], strict=True):
             for name, seconds, compiled in _finish_helper(helper):
                 step = next(step for step in group if step.name == name)
@@ -261,8 +258,7 @@ def compile_kernels(all: bool = False, progress: Callable | None = None,
                     progress(step, steps.index(step), len(steps), seconds, -1.0)
                 done.append((step, seconds, [tuple(entry) for entry in compiled]))
             for step in group:  # (from the cache: see the design note)
-                with np.errstate(all="ignore"):
-                    step.run()
+                _run_step(step)
     finally:
         _jit.notices = previous
         for helper in helpers:
@@ -271,6 +267,16 @@ def compile_kernels(all: bool = False, progress: Callable | None = None,
                 helper.wait()
     done.sort(key=lambda entry: steps.index(entry[0]))
     return done
+
+
+def _run_step(step: Step) -> tuple[float, list]:
+    """Run one step: (its seconds, what it compiled: ``[(key, text, seconds)]``)."""
+    from . import _jit
+
+    before, start = len(_jit.COMPILED), time.perf_counter()
+    with np.errstate(all="ignore"):
+        step.run()
+    return time.perf_counter() - start, list(_jit.COMPILED[before:])
 
 
 def _shares(steps: list[Step], jobs: int) -> list[list[Step]]:
@@ -293,18 +299,10 @@ def _shares(steps: list[Step], jobs: int) -> list[list[Step]]:
 #: a helper process of compile_kernels: runs the steps named on its command line, prints
 #: [[name, seconds, compiled keys], ...] as JSON on its last line
 _HELPER = """
-import json, sys, time
-import numpy as np
-from softarm import _jit
-from softarm.warmup import STEPS
-out = []
-for name in sys.argv[1:]:
-    step = next(step for step in STEPS if step.name == name)
-    before, start = len(_jit.COMPILED), time.perf_counter()
-    with np.errstate(all="ignore"):
-        step.run()
-    out.append([name, time.perf_counter() - start, [list(c) for c in _jit.COMPILED[before:]]])
-print(json.dumps(out))
+import json, sys
+from softarm.warmup import STEPS, _run_step
+steps = {step.name: step for step in STEPS}
+print(json.dumps([[name, *_run_step(steps[name])] for name in sys.argv[1:]]))
 """
 
 
