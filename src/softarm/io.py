@@ -113,6 +113,10 @@ def _meta(result: Equilibrium, case: Case | None) -> dict:
         "rotation": _ROTATION_NOTE,
         "case": _case_dict(result, case),
         "contact": _contact_law(result.loads),
+        # the solver's exact total (Equilibrium.contact_wrench): the stations saved may not
+        # resolve a contact zone, so it is not recomputed from them when read back
+        "contact_wrench": None if result.contact_resultant is None else
+        np.asarray(result.contact_resultant).tolist(),
     }
 
 
@@ -140,6 +144,21 @@ def _with_contact_law(loads: tuple, law, path) -> tuple:
     except (TypeError, ValueError) as error:
         raise CaseError(f"{path}: not a softarm result file ('contact' {_brief(error)})"
                         ) from None
+
+
+def _saved_contact_wrench(value, batch, path) -> np.ndarray | None:
+    """The saved Equilibrium.contact_wrench (``batch`` + (6,)), or None if none was saved
+    (CaseError if it is not one)."""
+    if value is None:
+        return None
+    try:
+        wrench = _numbers(value, "contact_wrench")
+        if wrench.size != 6 * math.prod(batch):
+            raise ValueError(f"{wrench.size} numbers for the batch shape {tuple(batch)}")
+    except (TypeError, ValueError) as error:
+        raise CaseError(f"{path}: not a softarm result file ('contact_wrench': "
+                        f"{_brief(error)})") from None
+    return wrench.reshape(*batch, 6)
 
 
 def _verdict(stability: Stability | None) -> dict | None:
@@ -355,7 +374,8 @@ def load_saved(path: str | os.PathLike) -> SavedResult:
         residual=residual.reshape(batch) if batch else float(residual),
         error_estimate=estimate.reshape(batch) if batch else float(estimate),
         stability=None if verdict is None else Stability.of(verdict["index"],
-                                                            verdict["conservative"], batch))
+                                                            verdict["conservative"], batch),
+        contact_resultant=_saved_contact_wrench(meta.get("contact_wrench"), batch, path))
     sweep = None if sweep is None else np.asarray(sweep, dtype=float)
     return SavedResult(result, case, str(meta.get("softarm_version", "")), sweep,
                        meta.get("sweep_label"), path)

@@ -40,6 +40,7 @@ __all__ = [
     "PointLoad",
     "Tendon",
     "TipLoad",
+    "applied_wrench",
     "as_loads",
     "batch_shape",
     "check_magnitudes",
@@ -1162,6 +1163,135 @@ class _Forces:
         magnets = sum(_norm(getattr(seg, "magnetization", None)) * seg.length
                       + _norm(getattr(seg, "tip_magnet", None)) for seg in self.arm.segments)
         self.force = self.force + np.abs(np.asarray(gradient)).sum((-1, -2)) * magnets
+
+
+def applied_wrench(arm, loads, s, poses) -> np.ndarray:
+    """(B..., 6): the resultant of every force the loads apply to the arm from outside,
+    contact excepted, on an equilibrium with ``poses`` (B..., S, 4, 4) at stations ``s``
+    (S,): the force (N) and its moment about the spatial origin (N m), spatial components.
+
+    Actuators count nothing (a tendon's pull and a chamber's pressure are internal to the
+    arm and its actuators, their reaction on the base included in the solver's base wrench),
+    nor does a Contact (what this balances: the solver's contact wrench is the base wrench
+    less this, docs/contact.md). Each load is read through its own :meth:`Load.apply`.
+
+    ``s`` must hold every cut (the segments' joints, the spans' ends and the point loads'
+    stations): a distributed load is integrated on each smooth piece between two cuts by
+    Simpson's rule on the stations (fourth order in their spacing)."""
+    target = _Applied(arm, np.asarray(s, dtype=np.float64), np.asarray(poses))
+    for load in loads if type(loads) is tuple else as_loads(loads):
+        load.apply(target)
+    return target.wrench
+
+
+class _Applied:
+    """A :class:`LoadTarget` that sums the wrench loads apply at an equilibrium's poses
+    (:func:`applied_wrench`): ``wrench`` (B..., 6), about the spatial origin."""
+
+    def __init__(self, arm, s, poses):
+        self.arm, self.length, self.s = arm, float(arm.length), s
+        self.R, self.p = poses[..., :3, :3], poses[..., :3, 3]
+        self.wrench = np.zeros((*poses.shape[:-3], 6))
+        bounds = np.asarray(arm.boundaries, dtype=np.float64)
+        self.segment = np.clip(np.searchsorted(bounds, s, side="right") - 1, 0,
+                               len(arm.segments) - 1)
+
+    def _at(self, s: float) -> int:
+        i = int(np.argmin(np.abs(self.s - s)))
+        if abs(self.s[i] - s) > 1e-12 * self.length:
+            raise ValueError(f"applied_wrench: the stations lack the cut s = {s!r} m")
+        return i
+
+    def _add(self, force, moment, at) -> None:
+        """A force (B..., 3) at the point ``at`` (B..., 3) and a couple (B..., 3)."""
+        self.wrench[..., :3] += force
+        self.wrench[..., 3:] += np.cross(at, force) + moment
+
+    def _integrated(self, density, lo: float, hi: float) -> np.ndarray:
+        """∫ density over [lo, hi] (density (B..., S, k) on the stations), piece by piece
+        between the cuts inside (the segments' joints)."""
+        from scipy.integrate import simpson  # (scipy: a dependency; loaded on first use)
+
+        cuts = [b for b in self.arm.boundaries if lo < b < hi]
+        total = 0.0
+        for a, b in zip([lo, *cuts], [*cuts, hi], strict=True):
+            i, k = self._at(a), self._at(b)
+            if k > i:
+                total = total + simpson(density[..., i:k + 1, :], x=self.s[i:k + 1], axis=-2)
+        return total
+
+    def distributed(self, *, force=None, moment=None, follower=False, span=None,
+                    per_mass=False):
+        lo, hi = (0.0, self.length) if span is None else span
+        density = np.zeros((*self.p.shape[:-1], 6))
+        rotate = (lambda v: np.einsum("...ij,...j->...i", self.R,
+                                      np.asarray(v)[..., None, :])) if follower else \
+            (lambda v: np.broadcast_to(np.asarray(v)[..., None, :], self.p.shape))
+        if force is not None:
+            f = rotate(force)
+            if per_mass:
+                mass = np.array([seg.linear_density or 0.0 for seg in self.arm.segments])
+                f = f * mass[self.segment][:, None]
+            density = density + np.concatenate([f, np.cross(self.p, f)], axis=-1)
+        if moment is not None:
+            density = density + np.concatenate([np.zeros(self.p.shape), rotate(moment)], -1)
+        self.wrench += self._integrated(density, lo, hi)
+
+    def point(self, s, *, force=None, moment=None):
+        i = self._at(s)
+        self._add(np.zeros(3) if force is None else np.asarray(force, dtype=np.float64),
+                  np.zeros(3) if moment is None else np.asarray(moment, dtype=np.float64),
+                  self.p[..., i, :])
+
+    def tip(self, *, force=None, moment=None, follower=False):
+        R = self.R[..., -1, :, :]
+        turn = (lambda v: np.einsum("...ij,...j->...i", R, np.asarray(v))) if follower \
+            else np.asarray
+        self._add(np.zeros(3) if force is None else turn(force),
+                  np.zeros(3) if moment is None else turn(moment), self.p[..., -1, :])
+
+    def actuator(self, kind, magnitude, routing, span):
+        pass  # internal (applied_wrench)
+
+    def displaced_tendon(self, displacement, routing, span):
+        pass  # internal
+
+    def contact(self, load):
+        pass  # what applied_wrench balances
+
+    def field(self, field, gradient=None):
+        # a magnetisation m (material) per length feels the couple (R m) × B(p) and the
+        # force Gᵀ (R m); a dipole at its segment's distal end the same, concentrated
+        B0 = np.asarray(field, dtype=np.float64)
+        G = None if gradient is None else np.asarray(gradient, dtype=np.float64)
+
+        def wrench(m, R, p, along):  # (force, couple) on magnets m (material) at R, p
+            mu = np.einsum("...ij,j->...i", R, m)  # (``along``: p has a station axis)
+            B = B0[..., None, :] if along else B0
+            force = np.zeros(mu.shape)
+            if G is not None:
+                Gs = G[..., None, :, :] if along else G
+                B = B + np.einsum("...ij,...j->...i", Gs, p)
+                force = np.einsum("...ji,...j->...i", Gs, mu)
+            return force, np.cross(mu, B)
+
+        bounds = self.arm.boundaries
+        for k, segment in enumerate(self.arm.segments):
+            m = getattr(segment, "magnetization", None)
+            if m is not None:
+                i, e = self._at(bounds[k]), self._at(bounds[k + 1])
+                f, c = wrench(np.asarray(m, dtype=np.float64), self.R[..., i:e + 1, :, :],
+                              self.p[..., i:e + 1, :], True)
+                density = np.zeros((*self.p.shape[:-1], 6))
+                density[..., i:e + 1, :] = np.concatenate(
+                    [f, np.cross(self.p[..., i:e + 1, :], f) + c], axis=-1)
+                self.wrench += self._integrated(density, bounds[k], bounds[k + 1])
+            dipole = getattr(segment, "tip_magnet", None)
+            if dipole is not None:
+                e = self._at(bounds[k + 1])
+                f, c = wrench(np.asarray(dipole, dtype=np.float64), self.R[..., e, :, :],
+                              self.p[..., e, :], False)
+                self._add(f, c, self.p[..., e, :])
 
 
 def _norm(vector) -> float:

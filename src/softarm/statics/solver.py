@@ -30,13 +30,13 @@ from .._validate import (
     rigid_transform,
     stations,
 )
-from ..contact import resultant
 from ..equilibrium import Equilibrium, Stability
 from ..errors import ApproximationWarning, ConvergenceError, InadmissibleStateError
 from ..lie import se3
 from ..loads import (
     Gravity,
     Tendon,
+    applied_wrench,
     as_loads,
     batch_shape,
     check_magnitudes,
@@ -274,15 +274,37 @@ def _widened_contact(solver, loads, contact, widened: int) -> tuple | None:
 
 
 #: Stations of a solve in contact at the least (uniform, with the ones asked for): the
-#: contact's total and the penetration check need its zones resolved (about √(EI/GA)).
+#: penetration check needs the contact zones resolved (about √(EI/GA) wide).
 CONTACT_STATIONS = 2001
 
 
-def _contact_stations(s: np.ndarray, length: float) -> tuple[np.ndarray, np.ndarray]:
-    """(the solver's stations: ``s`` and CONTACT_STATIONS uniform ones, the index of each
-    of ``s`` among them)."""
-    fine = np.union1d(s, np.linspace(0.0, length, CONTACT_STATIONS))
+def _contact_stations(s: np.ndarray, length: float, cuts) -> tuple[np.ndarray, np.ndarray]:
+    """(the solver's stations: ``s``, CONTACT_STATIONS uniform ones and the pieces' ``cuts``
+    (the contact wrench's balance integrates the other loads piece by piece), the index of
+    each of ``s`` among them)."""
+    fine = np.union1d(np.union1d(s, np.linspace(0.0, length, CONTACT_STATIONS)), cuts)
     return fine, np.searchsorted(fine, s)
+
+
+def _contact_wrench(solver, contact, loads, shape, s, poses, base_wrench) -> np.ndarray:
+    """(*shape, 6): the obstacles' total force on the arm (N) and its moment about the
+    spatial origin (N m), from the global balance: the base wrench (every force applied to
+    the arm, moved to the origin) less the other loads' resultant (loads.applied_wrench).
+    Exact to the solve's tolerance however narrow the contact zones: a sum of the pressure
+    on stations is not, where a zone is narrower than their spacing (docs/contact.md).
+    ``contact``: the law solved with (its stiffness per case); ``poses`` (B, S, 4, 4)."""
+    _, forces = contact.gaps(poses[..., :3, 3], contact.station_radii(solver.arm, s))
+    touching = np.any(forces != 0.0, axis=(-1, -2)).reshape(shape)
+    S = s.size
+    poses = poses.reshape(*shape, S, 4, 4)
+    force = base_wrench[:, :3].reshape(*shape, 3)
+    moment = base_wrench[:, 3:].reshape(*shape, 3) + np.cross(poses[..., 0, :3, 3], force)
+    others = tuple(load for load in loads if load.kind != "contact")
+    wrench = np.concatenate([force, moment], axis=-1) - applied_wrench(solver.arm, others, s,
+                                                                        poses)
+    # exactly zero where no station is within the contact distance (the balance leaves
+    # round-off there): the stations resolve the zones, as the penetration check assumes
+    return np.where(touching[..., None], wrench, 0.0)
 
 
 def unloaded_poses(arm, s, base) -> np.ndarray:
@@ -1335,7 +1357,8 @@ class Solver:
         s_kernel = self._s_kernel if outputs else np.array([self.length])
         asked = None  # with contact: the stations asked for, among the solver's finer ones
         if contact is not None and outputs:
-            s_kernel, asked = _contact_stations(s_kernel, self.length)
+            s_kernel, asked = _contact_stations(s_kernel, self.length,
+                                               np.append(pieces[0], self.length))
         S = s_kernel.size
         poses = np.empty((count, S, 4, 4))
         strains = np.empty((count, S, 6))
@@ -1413,12 +1436,9 @@ class Solver:
                                    contact_retry=(stiffer, attempt + 1, widened))
         _admissible(self, strains, stresses, s_kernel, shape, info[:, 0], chained)
         contact_resultant = None
-        if asked is not None:  # the contact's total on the fine stations, then the asked
-            contact_resultant = resultant(s_kernel, poses[..., :3, 3], channels.contact_load
-                                          .gaps(poses[..., :3, 3],
-                                                channels.contact_load.station_radii(
-                                                    self.arm, s_kernel))[1])
-            contact_resultant = contact_resultant.reshape(*shape, 6)
+        if asked is not None:  # the contact's total from the balance, then the asked stations
+            contact_resultant = _contact_wrench(self, channels.contact_load, loads, shape,
+                                                s_kernel, poses, base_wrench)
             poses, strains, stresses = (np.ascontiguousarray(a[:, asked])
                                         for a in (poses, strains, stresses))
             if jacobians:
