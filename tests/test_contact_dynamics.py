@@ -209,3 +209,40 @@ def test_an_arm_starting_inside_an_obstacle_is_refused_as_the_statics_refuse_it(
     assert str(start.value).startswith(
         f"Contact: the initial equilibrium starts inside an obstacle (its surface "
         f"{-gaps[first]:.3g} m deep at station s = {hanging.s[first]:.6g} m)")
+
+
+def test_a_simulation_starts_at_rest_from_a_static_contact_equilibrium():
+    """Issue 39: ``initial=eq`` with the same Contact failed ("residual 1.53e+07"): the
+    step's Jacobian left out the penalty's ∂f/∂p, so Newton from the static answer crept and
+    stopped. Now the arm starts at rest under the steps' law and stays there; the start is
+    the statics' answer with that law given explicitly (a second route: the shooting
+    solver), to the steps' grid error O(h²), and the warning says how far the tip is from
+    the Equilibrium solved with the statics' stiffer law."""
+    arm = _arm()
+    loads = [sa.Gravity(), TABLE]
+    eq = sa.solve(arm, loads)
+    with pytest.warns(sa.ApproximationWarning, match=r"another contact law \(distance 5e-06 "
+                      r"m\).*its tip 0\.000\d+ m from the Equilibrium's"):
+        path = sa.simulate(arm, loads, duration=0.05, dt=1e-3, initial=eq)
+    law = path.contact
+    assert law.distance > 100 * eq.loads[-1].distance  # (the time step's cap: contact.md)
+    assert np.abs(path.positions - path.positions[0]).max() < 1e-9 * arm.length
+    rest = sa.solve(arm, [sa.Gravity(), law], s=path.s)
+    assert np.abs(path.positions[0] - rest.positions).max() < 1e-4 * arm.length
+    tip = np.linalg.norm(path.positions[0, -1] - eq.positions[-1])
+    assert 0.2 * law.distance < tip < 2 * law.distance  # the bands' difference
+
+
+def test_the_same_given_law_starts_at_the_statics_answer_without_a_word():
+    """A Contact with its own stiffness and distance is one law in statics and dynamics:
+    the simulation starts at the Equilibrium's shape (to the grid's O(h²)) and stays."""
+    arm = _arm()
+    loads = [sa.Gravity(), sa.Contact(TABLE.obstacles, stiffness=3e5, distance=1e-3)]
+    eq = sa.solve(arm, loads, s=np.linspace(0.0, 0.5, 101))
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", sa.ApproximationWarning)
+        path = sa.simulate(arm, loads, duration=0.02, dt=1e-3, initial=eq)
+    assert np.abs(path.positions[0] - eq.positions).max() < 1e-4 * arm.length
+    assert np.abs(path.positions - path.positions[0]).max() < 1e-9 * arm.length

@@ -3,6 +3,7 @@ section "dynamics"). The equations, the scheme and its accuracy: docs/dynamics.m
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -19,7 +20,7 @@ from .._validate import (
     rigid_transform,
 )
 from ..equilibrium import Equilibrium, _frozen
-from ..errors import ConvergenceError
+from ..errors import ApproximationWarning, ConvergenceError
 from ..loads import Gravity, InputRules, as_actuators, as_loads
 from ..statics import Solver
 from ..statics.solver import _check_outside, _kernels, check_tol
@@ -457,9 +458,10 @@ class Simulator:
             _check_outside(Solver(self.arm, s=2, base=pose0, stability=False, tol=self.tol),
                            self._contact.replace(stiffness=None))
         solver = Solver(self.arm, s=unique, base=pose0, stability=False, tol=1e-10)
-        eq = solver.solve_from_unloaded([] if initial is None else initial.loads)
+        eq = solver.solve_from_unloaded([] if initial is None else self._stepped(initial.loads))
         if initial is not None and self._contact is not None:
             self._check_start(eq, unique)
+            self._say_the_law_differs(initial, eq)
         S = unique.size
         poses = np.broadcast_to(eq.poses, (*self.shape, S, 4, 4)).reshape(B, S, 4, 4)
         stresses = np.broadcast_to(eq.stresses, (*self.shape, S, 6)).reshape(B, S, 6)
@@ -501,6 +503,35 @@ class Simulator:
             f"station s = {float(s[station]):.6g} m): no motion from it is defined; move the "
             "obstacles or the base, or start from another shape")
 
+    def _say_the_law_differs(self, initial, start) -> None:
+        """An ApproximationWarning where the Equilibrium ``initial`` was solved with another
+        contact law than the steps' (the statics' default is stiffer, in a narrower band):
+        the arm starts at rest under the steps' law (``start``), off the Equilibrium's shape
+        by about the difference of the bands, which it says for the tip."""
+        given = next(load for load in initial.loads if load.kind == "contact")
+        law = self._contact
+        if given.distance == law.distance and given.stiffness is not None and \
+                np.array_equal(np.broadcast_to(given.stiffness, np.shape(law.stiffness)),
+                               law.stiffness):
+            return
+        off = float(np.max(np.linalg.norm(start.positions[..., -1, :]
+                                          - initial.positions[..., -1, :], axis=-1)))
+        warnings.warn(
+            f"initial: the Equilibrium was solved with another contact law (distance "
+            f"{given.distance:.3g} m) than the time steps use (distance "
+            f"{float(np.max(law.distance)):.3g} m, the stiffness at most μ/Δt²: "
+            f"docs/contact.md, \"Dynamics\"); the arm starts at rest under the steps' law, "
+            f"its tip {off:.3g} m from the Equilibrium's", ApproximationWarning, stacklevel=4)
+
+    def _stepped(self, loads) -> tuple:
+        """``loads`` with their Contact's law replaced by the one the steps use: an
+        equilibrium solved with the statics' law (stiffer, in a narrower band) is balanced
+        again with the steps', so that the arm starts at rest under the law that moves it
+        (contact.md, "Dynamics"), not pushed off by the difference."""
+        if self._contact is None:
+            return tuple(loads)
+        return tuple(self._contact if load.kind == "contact" else load for load in loads)
+
     def _settle(self, initial, Z, H, base0) -> None:
         """Z, H ← the equilibrium of ``initial``'s loads at rest on this grid: the equations
         of a step without inertia (c0 = 0: no time derivative), by Newton from the solver's
@@ -508,7 +539,7 @@ class Simulator:
         (the solver's own answer differs from it by the grid's O(h²) error), and the
         total wrench of rod and actuators is the state's."""
         k = _kernels()
-        _, shape, _, pieces, channels = self._solver._prepare(initial.loads,
+        _, shape, _, pieces, channels = self._solver._prepare(self._stepped(initial.loads),
                                                                   tuple(self._pieces[0]))
         if not np.array_equal(pieces[0], self._pieces[0]):
             raise ValueError("initial: the Equilibrium's loads cut the arm where this "

@@ -4695,6 +4695,16 @@ def _dyn_put(Bm, kl, row, col, value):
 
 
 @_jit
+def _magnetised(act):
+    """Whether any piece of the arm carries a magnetisation (act[3])."""
+    for j in range(act[3].shape[0]):
+        for i in range(3):
+            if act[3][j, i] != 0.0:
+                return True
+    return False
+
+
+@_jit
 def _dyn_jacobian(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, rates, Gk, Bm,
                   kl):
     """The scaled Jacobian of :func:`_dyn_residual` in band storage (``rates`` as the
@@ -4711,12 +4721,20 @@ def _dyn_jacobian(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, rat
     Ja = np.empty((3, 3))
     Jb = np.empty((3, 3))
     lg = np.empty(3)
+    # the rates depend on the position p only through loads that depend on where the
+    # section is: contact (the penalty's stiffness ∂f/∂p, the largest term of a touching
+    # node's Jacobian: without it Newton crept and failed on touchdown, friction or a
+    # start at rest on an obstacle) and a magnetisation in a field with a gradient
+    placed = act is not None and (act[5].shape[0] > 0 or _magnetised(act))
+    first = 0 if placed else 3
     for k in range(G):
-        for c in range(3, DUNK):  # (rates do not depend on p)
+        for c in range(first, DUNK):
             for i in range(DYN):
                 zp[i] = Z[k, i]
             d = 1e-7 * S[c]
-            if c < 6:
+            if c < 3:
+                zp[_DP + c] += d
+            elif c < 6:
                 a0 = d if c == 3 else 0.0
                 a1 = d if c == 4 else 0.0
                 a2 = d if c == 5 else 0.0
@@ -4728,7 +4746,7 @@ def _dyn_jacobian(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, rat
             for i in range(DUNK):
                 Gk[k, i, c] = (g1[i] - rates[k, i]) / d
         for i in range(DUNK):
-            for c in range(3):
+            for c in range(first):
                 Gk[k, i, c] = 0.0
     jw = np.empty(6)
     for k in range(G - 1):
