@@ -246,3 +246,23 @@ def test_the_same_given_law_starts_at_the_statics_answer_without_a_word():
         path = sa.simulate(arm, loads, duration=0.02, dt=1e-3, initial=eq)
     assert np.abs(path.positions[0] - eq.positions).max() < 1e-4 * arm.length
     assert np.abs(path.positions - path.positions[0]).max() < 1e-9 * arm.length
+
+
+def test_an_arm_at_rest_in_a_corner_with_friction_stays_at_rest():
+    """Sections touching two obstacles at once, with friction: an arm pressed by a tilted
+    gravity onto a floor and against a wall. The statics' frictionless equilibrium is a
+    Coulomb one (no sliding, no tangential force), so the simulation started there stays.
+    Found with it: the friction's factor overwrote the penalty's scale for the obstacles
+    after the first (-μ φ/w_ε at rest: the wall pulled the arm in)."""
+    arm = sa.Arm(0.5, sa.Circle(0.01),
+                 sa.Material(youngs_modulus=2e7, poisson_ratio=0.5, density=1000.0))
+    floor = sa.Plane((0.0, 0.0, -0.03), (0.0, 0.0, 1.0))
+    wall = sa.Plane((0.0, -0.015, 0.0), (0.0, 1.0, 0.0))
+    contact = sa.Contact([floor, wall], friction=0.5, stiffness=3e5, distance=1e-3)
+    gravity = sa.Gravity((0.0, -3.0, -9.81))
+    eq = sa.solve(arm, [gravity, contact], s=np.linspace(0.0, 0.5, 101))
+    both = ((eq.positions[:, 2] + 0.03 - 0.01 < 1e-3)
+            & (eq.positions[:, 1] + 0.015 - 0.01 < 1e-3))
+    assert both.sum() >= 5  # sections on the floor and against the wall
+    path = sa.simulate(arm, [gravity, contact], duration=0.03, dt=1e-3, initial=eq)
+    assert np.abs(path.positions - path.positions[0]).max() < 1e-9 * arm.length

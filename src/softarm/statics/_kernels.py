@@ -4604,8 +4604,9 @@ def _moving_contact(z, obstacles, params, scale, out):
         s2 = vz + wx * a1 - wy * a0
         normal = s0 * n0 + s1 * n1 + s2 * n2
         s0, s1, s2 = s0 - normal * n0, s1 - normal * n1, s2 - normal * n2
-        scale = -mu * phi / math.sqrt(s0 * s0 + s1 * s1 + s2 * s2 + slip * slip)
-        t0, t1, t2 = scale * s0, scale * s1, scale * s2
+        # (its own name: ``scale``, the penalty's, holds for the next obstacles)
+        slide = -mu * phi / math.sqrt(s0 * s0 + s1 * s1 + s2 * s2 + slip * slip)
+        t0, t1, t2 = slide * s0, slide * s1, slide * s2
         out[0] += t0
         out[1] += t1
         out[2] += t2
