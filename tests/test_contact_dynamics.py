@@ -266,3 +266,21 @@ def test_an_arm_at_rest_in_a_corner_with_friction_stays_at_rest():
     assert both.sum() >= 5  # sections on the floor and against the wall
     path = sa.simulate(arm, [gravity, contact], duration=0.03, dt=1e-3, initial=eq)
     assert np.abs(path.positions - path.positions[0]).max() < 1e-9 * arm.length
+
+
+def test_a_touchdown_with_friction_that_fails_names_the_regularisation():
+    """Issue 39: the docs' table arm dropped with μ = 0.5 fails on touchdown at the default
+    slip_velocity (the error used to advise a smaller dt, which fails as soon) and runs at
+    1e-3 m/s (it failed at 0.094 s before the step's Jacobian held the penalty's ∂f/∂p)."""
+    arm = _arm()
+    table = TABLE.obstacles
+    with pytest.raises(sa.ConvergenceError, match=r"t = 0\.08\d+ s .*with friction, a larger "
+                       r"Contact\.slip_velocity may help \(now 0\.0001 m/s"):
+        sa.simulate(arm, [sa.Gravity(), sa.Contact(table, friction=0.5)], duration=0.1,
+                    dt=1e-3)
+    path = sa.simulate(arm, [sa.Gravity(), sa.Contact(table, friction=0.5,
+                                                      slip_velocity=1e-3)],
+                       duration=0.12, dt=1e-3)
+    law = path.contact
+    assert (path.gaps.min(axis=-1) < law.distance).any()  # it lands (and bounces)
+    assert path.gaps.min() > -2e-3 * arm.length  # the impact's depth, about v Δt

@@ -874,8 +874,19 @@ class Simulator:
                 f"for case {self._case(b)}: Newton "
                 f"did not converge to tol {self.tol:g} in {MAX_ITERATIONS} iterations, or "
                 "its answer left the model (an axial stretch v₁ <= 0: a section turned inside "
-                "out); a smaller dt, a looser tol or damping may help; the state is unchanged",
+                f"out); {self._advice()}; the state is unchanged",
                 float(info[b, t, 0]), f"{MAX_ITERATIONS} Newton iterations")
+
+    def _advice(self) -> str:
+        """What may help a step that failed. With friction, a wider regularisation: the
+        docs' table drop at μ = 0.5 fails on touchdown at the default slip_velocity 1e-4 m/s
+        whatever dt (sooner at a smaller one) and runs at 1e-3 (docs/contact.md)."""
+        contact = self._contact
+        if contact is not None and contact.friction > 0.0:
+            return (f"with friction, a larger Contact.slip_velocity may help (now "
+                    f"{contact.slip_velocity:g} m/s; 1e-3 ran where 1e-4 failed on a "
+                    "touchdown, whatever dt: docs/contact.md), or damping")
+        return "a smaller dt, a looser tol or damping may help"
 
     # ------------------------------------------------------------------ results
 
