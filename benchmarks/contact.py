@@ -133,8 +133,8 @@ def measure(repeats: int) -> list[str]:
              f"`python benchmarks/contact.py --repeats {repeats}` "
              f"({time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}): best of {repeats} after "
              "a warm-up, CPU time beside wall time; shape errors against the hard-contact "
-             "references of tests/. The issue's targets are in the last column: every one "
-             "is missed (docs/contact.md, \"Limits\").", "",
+             "references of tests/. The issue's targets are in the last column "
+             "(docs/contact.md, \"Limits\": the statics' are missed).", "",
              "| case | wall | CPU | shape error | target |", "|---|---|---|---|---|"]
     for name, wall, cpu, error, target in rows:
         unit, scale = ("ms", 1e3) if wall < 1.0 else ("s", 1.0)
