@@ -94,6 +94,50 @@ def test_the_picture_draws_the_obstacles_and_the_contact_forces(table, tmp_path)
     assert (tmp_path / "table.png").stat().st_size > 10_000
 
 
+@pytest.mark.slow  # (2.5 s)
+def test_a_trajectory_picture_draws_the_obstacles_forces_and_contact_energy(tmp_path):
+    """Issue 39: a motion's picture draws the obstacles in its side view, the contact forces
+    at its last time, and the penalty's stored energy, with a total that holds it (the
+    energy Energy.total leaves out while the arm presses on an obstacle)."""
+    pytest.importorskip("matplotlib")
+    from softarm import plot
+
+    pin = softarm.Capsule((0.3, -0.1, -0.04), (0.3, 0.1, -0.04), 0.01)
+    path = softarm.simulate(ARM, [softarm.Gravity(), softarm.Contact([OBSTACLES[0], pin])],
+                            duration=0.12, dt=1e-3, stations=51)
+    fig = plot.plot_trajectory(path, path=tmp_path / "drop.png")
+    side, energy = fig.axes[0], fig.axes[2]  # (fig.axes[1]: the tip; [3]: the colour bar)
+    gids = [a.get_gid() for a in side.get_children() if a.get_gid()]
+    assert gids == ["obstacle 1 plane", "obstacle 2 capsule", "contact forces"]
+    table = next(a for a in side.get_children() if a.get_gid() == "obstacle 1 plane")
+    np.testing.assert_allclose(table.get_ydata(), -0.05)  # the x–z view: z = -0.05
+    quiver = next(a for a in side.get_children() if a.get_gid() == "contact forces")
+    on = np.linalg.norm(path.contact_forces[-1], axis=-1) > 0
+    np.testing.assert_allclose(quiver.get_offsets(), path.positions[-1][on][:, [0, 2]])
+    lines = {a.get_gid(): a for a in energy.get_lines()}
+    stored = path.contact_energy
+    assert stored.max() > 0.0
+    np.testing.assert_allclose(lines["energy contact"].get_ydata(), stored - stored[0])
+    e = path.energy
+    total = e.total - e.total[0] + stored - stored[0]
+    np.testing.assert_allclose(lines["energy total"].get_ydata(), total)
+    assert (tmp_path / "drop.png").stat().st_size > 10_000
+    # the browser page: the obstacles (after the moving traces, outside the frames) and the
+    # contact energy among the curves, the total holding it
+    pytest.importorskip("plotly")
+    from softarm import view
+
+    page = view.trajectory_figure(path, arm=ARM)
+    names = [trace.get("name") for trace in page["data"]]
+    assert names[-2:] == ["obstacle 1: plane", "obstacle 2: capsule"]
+    assert all(len(frame["traces"]) < len(names) - 2 for frame in page["frames"])
+    curves = {trace["name"]: np.asarray(trace["y"]) for trace in page["energy"]["data"]
+              if trace.get("name")}
+    np.testing.assert_allclose(curves["contact"], stored)
+    np.testing.assert_allclose(curves["total"], e.kinetic + e.elastic + e.gravity
+                               + e.dissipated + stored)
+
+
 @pytest.mark.slow
 def test_a_sweep_picture_draws_the_obstacles(tmp_path):
     pytest.importorskip("matplotlib")

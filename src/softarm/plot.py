@@ -257,15 +257,7 @@ def _draw_contact(ax3, side, loads, extent, arrows=None, scale: float = 0.0) -> 
                                       linewidth=0, shade=obstacle.kind != "plane")
             artist.set_gid(gid)
             for ax, ((_, i), (_, j)) in zip(side, _PLANES, strict=True):
-                outline = obstacle_outline(obstacle, (i, j), centre, half / 1.1)
-                if outline is None:
-                    continue
-                if obstacle.kind == "plane":
-                    line, = ax.plot(*outline.T, color=_OBSTACLE_COLOR, linewidth=2.5)
-                else:
-                    line, = ax.fill(*outline.T, color=_OBSTACLE_COLOR, alpha=0.35,
-                                    linewidth=0.8, edgecolor="0.35")
-                line.set_gid(gid)
+                _draw_outline(ax, obstacle, (i, j), centre, half / 1.1, gid)
     if arrows is None or not len(arrows.origins):
         return ""
     tips = arrows.vectors * scale
@@ -356,6 +348,46 @@ def plot_result_file(source, path: str | os.PathLike | None = None, *, fig=None)
     return plot_equilibrium(result, fig=fig, path=path, name=name)
 
 
+def _draw_outline(ax, obstacle, axes: tuple[int, int], centre, half: float, gid: str):
+    """An obstacle in a side view of the spatial ``axes`` (i, j): a plane seen edge-on as
+    its line, a ball or capsule as its filled outline (nothing where the view shows no edge:
+    :func:`softarm.geometry.obstacle_outline`)."""
+    outline = obstacle_outline(obstacle, axes, centre, half)
+    if outline is None:
+        return
+    if obstacle.kind == "plane":
+        line, = ax.plot(*outline.T, color=_OBSTACLE_COLOR, linewidth=2.5)
+    else:
+        line, = ax.fill(*outline.T, color=_OBSTACLE_COLOR, alpha=0.35, linewidth=0.8,
+                        edgecolor="0.35")
+    line.set_gid(gid)
+
+
+def _draw_trajectory_contact(ax, axes: tuple[int, int], trajectory, positions) -> None:
+    """The obstacles of a trajectory's contact law in its side view of the spatial ``axes``
+    (:func:`softarm.geometry.obstacle_outline`) and the contact forces per length at its
+    last time as arrows (0.15 L for the largest); ``positions`` (T, S, 3). Artists have the
+    equilibrium picture's ``gid``s: "obstacle K kind", "contact forces"."""
+    contact = getattr(trajectory, "contact", None)
+    if contact is None:
+        return
+    i, j = axes
+    centre, half = cube_limits(positions)
+    for k, obstacle in enumerate(contact.obstacles):
+        _draw_outline(ax, obstacle, (i, j), centre, half, f"obstacle {k + 1} {obstacle.kind}")
+    forces = np.asarray(trajectory.contact_forces).reshape(-1, *positions.shape)
+    last = forces[0, -1]
+    on = np.linalg.norm(last, axis=-1) > 0.0
+    if not on.any():
+        return
+    length = float(np.sum(np.linalg.norm(np.diff(positions[0], axis=0), axis=-1)))
+    tips = last[on] * (0.15 * length / float(np.max(np.linalg.norm(last[on], axis=-1))))
+    artist = ax.quiver(positions[-1, on, i], positions[-1, on, j], tips[:, i], tips[:, j],
+                       color=_CONTACT_COLOR, angles="xy", scale_units="xy", scale=1.0,
+                       width=0.004, zorder=4, label="contact forces at the end")
+    artist.set_gid("contact forces")
+
+
 def _motion_plane(points: np.ndarray) -> tuple[int, int]:
     """The two spatial axes (indices) along which ``points`` (..., 3) spread the most, in
     increasing order: the plane a side view of a motion shows best."""
@@ -371,7 +403,9 @@ def plot_trajectory(trajectory, *, name: str = "", sweep=None, snapshots: int = 
     spaced times coloured by time, with the tip's path, in the side view of the two spatial
     axes it moves along most; the tip's coordinates over time; and the change of each
     energy since t = 0 (kinetic, elastic, gravity, dissipated and their total, which the
-    base's and actuators' work changes).
+    base's and actuators' work changes). With contact, the side view shows the obstacles
+    and the contact forces at the last time, and the energies the penalty's stored energy
+    (``Trajectory.contact_energy``), which the total drawn then holds.
 
     A batch (a sweep) shows the tip paths and final shapes of every case, coloured by case
     (``sweep``: the case's :class:`softarm.sweep.Sweep`, for the colour bar's label), the
@@ -404,6 +438,7 @@ def plot_trajectory(trajectory, *, name: str = "", sweep=None, snapshots: int = 
                 linestyle="--", label="tip path")
         ax.plot(positions[0, :, 0, a], positions[0, :, 0, b], color="k", linewidth=2.5,
                 marker="s", markersize=4, label="base")
+        _draw_trajectory_contact(ax, (a, b), trajectory, positions[0])
         mappable = matplotlib.cm.ScalarMappable(
             norm=matplotlib.colors.Normalize(times[0], times[-1]), cmap=cmap)
         fig.colorbar(mappable, ax=ax, label=f"t (s) of the {picks.size} snapshots",
@@ -414,9 +449,19 @@ def plot_trajectory(trajectory, *, name: str = "", sweep=None, snapshots: int = 
         ax_tip.set_ylabel("tip displacement (m)")
         styles = {"kinetic": "tab:orange", "elastic": "tab:blue", "gravity": "tab:green",
                   "dissipated": "tab:purple", "total": "k"}
+        labels = dict(zip(styles, styles, strict=True))
+        if getattr(trajectory, "contact", None) is not None:
+            # the penalty's stored energy, which Energy.total leaves out: the total drawn
+            # holds it, so that an impact's exchange shows as one conserved sum
+            stored = np.asarray(trajectory.contact_energy).reshape(-1, times.size)[0]
+            styles = {**styles, "contact": _CONTACT_COLOR}
+            change["contact"] = (stored - stored[0])[None]
+            change["total"] = change["total"] + change["contact"]
+            labels.update(contact="contact (penalty)", total="total with contact")
+            styles["total"] = styles.pop("total")  # (drawn last, on top)
         for key, colour in styles.items():
-            ax_energy.plot(times, change[key][0], color=colour, label=key,
-                           linewidth=2.0 if key == "total" else 1.2)
+            ax_energy.plot(times, change[key][0], color=colour, label=labels[key],
+                           linewidth=2.0 if key == "total" else 1.2, gid=f"energy {key}")
         ax.legend(fontsize=8, loc="best")
     else:
         cases = positions.shape[0]

@@ -793,6 +793,8 @@ PLAYBACK_RATES = (("real time", 1.0), ("1/2 ×", 0.5), ("1/4 ×", 0.25), ("1/10 
 _ENERGIES = (("kinetic", "rgb(31,119,180)"), ("elastic", "rgb(44,160,44)"),
              ("gravity", "rgb(140,86,75)"), ("dissipated", "rgb(214,39,40)"),
              ("total", "rgb(0,0,0)"))
+#: each energy curve's colour; "contact": the penalty's stored energy (with a Contact)
+_ENERGY_COLORS = {**dict(_ENERGIES), "contact": "rgb(214,0,154)"}
 
 
 def frame_indices(times, frames: int = TRAJECTORY_FRAMES) -> np.ndarray:
@@ -847,6 +849,9 @@ def _trajectory_arrays(trajectory):
     energy = trajectory.energy
     energies = {name: np.asarray(getattr(energy, name), dtype=float)
                 for name, _ in _ENERGIES[:4]}
+    if getattr(trajectory, "contact", None) is not None:
+        # the penalty's stored energy, which Energy.total leaves out: the total holds it
+        energies["contact"] = np.asarray(trajectory.contact_energy, dtype=float)
     energies["total"] = sum(energies.values())
     for name, values in energies.items():
         if values.shape != (T,):
@@ -945,6 +950,8 @@ def trajectory_figure(trajectory, *, arm=None, radii=None, name: str | None = No
                  "hovertemplate": "tip at t = %{customdata:.4g} s<br>(%{x:.4g}, %{y:.4g}, "
                                   "%{z:.4g}) m<extra></extra>"})
     data.append(_cube_anchor(centre, half))
+    contact = getattr(trajectory, "contact", None)  # (its obstacles stay: not in the frames)
+    data += _obstacle_traces([] if contact is None else [contact], centre, half)
     head = name or "softarm"
     duration = times[-1] - times[0]
     subtitle = (f"{times.size} times over {duration:.4g} s"
@@ -988,11 +995,12 @@ def trajectory_figure(trajectory, *, arm=None, radii=None, name: str | None = No
                      for label, _ in PLAYBACK_RATES]}]
     # the energy budget, with a cursor (a vertical line) at the shown time
     energy = [{"type": "scatter", "mode": "lines", "x": times[curve], "y": values[curve],
-               "name": label, "line": {"color": color, "width": 2.5 if label == "total"
+               "name": label, "line": {"color": _ENERGY_COLORS[label],
+                                       "width": 2.5 if label == "total"
                                        else 1.5, "dash": "dash" if label == "total"
                                        else "solid"},
                "hovertemplate": f"t = %{{x:.4g}} s<br>{label} = %{{y:.4g}} J<extra></extra>"}
-              for (label, color), values in zip(_ENERGIES, energies.values(), strict=True)]
+              for label, values in energies.items()]
     every = np.concatenate(list(energies.values()))
     low, high = float(np.min(every)), float(np.max(every))
     pad = 0.05 * max(high - low, 1e-12 * max(abs(low), abs(high)), 1e-300)
