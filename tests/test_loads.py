@@ -130,3 +130,58 @@ def test_loads_are_frozen():
         TipLoad().force = np.ones(3)
     with pytest.raises(dataclasses.FrozenInstanceError):
         Gravity().acceleration = np.ones(3)
+
+
+def _applied_cases():
+    import softarm as sa
+    from softarm.routing import Straight
+
+    soft = sa.Material(youngs_modulus=1e6, poisson_ratio=0.5, density=1000.0)
+    arm = sa.Arm(0.5, sa.Circle(0.01), soft)
+    two = sa.SegmentedArm([sa.Arm(0.3, sa.Circle(0.012), sa.Material(
+        youngs_modulus=2e6, poisson_ratio=0.5, density=1000.0)), sa.Arm(0.2, sa.Circle(0.008),
+        sa.Material(youngs_modulus=1e6, poisson_ratio=0.5, density=3000.0))])
+    magnet = sa.Arm(0.5, sa.Circle(0.01), soft, magnetization=(0.5, 0.0, 0.0),
+                    tip_magnet=(0.01, 0.02, 0.0))
+    gradient = [[0.1, 0.2, 0.0], [0.2, -0.3, 0.05], [0.0, 0.05, 0.2]]
+    base = np.eye(4)
+    base[:3, 3] = (0.1, 0.2, 0.3)
+    base[:3, :3] = [[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]
+    return {
+        "gravity, tip follower, base pose": (arm, [Gravity(), TipLoad(
+            (0.1, 0.2, 0.0), (0.0, 0.01, 0.0), follower=True)], base),
+        "point and distributed follower": (arm, [PointLoad(0.2, (0.1, 0.0, 0.3)),
+                                                 DistributedForce((0.0, 0.3, 0.0),
+                                                                  follower=True)], None),
+        "two segments of two densities": (two, [Gravity(), DistributedForce((0, 0.2, 0))],
+                                          None),
+        "magnets in a field gradient": (magnet, [sa.MagneticField((0.01, 0.02, 0.0),
+                                                                  gradient)], None),
+        "tendon and chamber (internal)": (arm, [Gravity(), sa.Tendon(0.3, Straight(0.006, 0.0),
+                                                                     0.4),
+                                                sa.Chamber(2000.0, 1e-5, Straight(0.0, 0.005),
+                                                           0.1, 0.45)], None),
+        "a batch": (arm, [Gravity(), TipLoad([[0.1, 0.0, 0.0], [0.0, 0.0, 0.1]])], None),
+    }
+
+
+@pytest.mark.parametrize("name", list(_applied_cases()))
+def test_applied_wrench_balances_the_solvers_base_wrench(name):
+    """loads.applied_wrench (each load's resultant from the equilibrium's poses, the base
+    of Equilibrium.contact_wrench) against a second method, the solver's base reaction:
+    without contact they are the same wrench (forces applied to the arm and their moment
+    about the origin) to 1e-8 of the loads."""
+    import softarm as sa
+    from softarm.loads import applied_wrench
+
+    arm, loads, base = _applied_cases()[name]
+    cuts = np.concatenate([np.asarray(load.cuts(arm), float) for load in loads]
+                          + [np.asarray(arm.boundaries, float)])
+    s = np.union1d(np.linspace(0.0, arm.length, 201), cuts)
+    eq = sa.solve(arm, loads, s=s, method="numeric", base=base)
+    force = eq.base_wrench[..., :3]
+    moment = eq.base_wrench[..., 3:] + np.cross(eq.positions[..., 0, :], force)
+    balance = np.concatenate([force, moment], -1) - applied_wrench(arm, tuple(loads), s,
+                                                                   eq.poses)
+    scale = np.abs(eq.base_wrench).max() + 1e-3
+    assert np.abs(balance).max() < 1e-8 * scale

@@ -1192,9 +1192,6 @@ class _Applied:
         self.arm, self.length, self.s = arm, float(arm.length), s
         self.R, self.p = poses[..., :3, :3], poses[..., :3, 3]
         self.wrench = np.zeros((*poses.shape[:-3], 6))
-        bounds = np.asarray(arm.boundaries, dtype=np.float64)
-        self.segment = np.clip(np.searchsorted(bounds, s, side="right") - 1, 0,
-                               len(arm.segments) - 1)
 
     def _at(self, s: float) -> int:
         i = int(np.argmin(np.abs(self.s - s)))
@@ -1207,35 +1204,42 @@ class _Applied:
         self.wrench[..., :3] += force
         self.wrench[..., 3:] += np.cross(at, force) + moment
 
-    def _integrated(self, density, lo: float, hi: float) -> np.ndarray:
+    def _integrated(self, density, lo: float, hi: float, per_segment=None) -> np.ndarray:
         """∫ density over [lo, hi] (density (B..., S, k) on the stations), piece by piece
-        between the cuts inside (the segments' joints)."""
+        between the segments' joints inside, each piece's density times its segment's
+        ``per_segment`` factor if given (a joint's station belongs to both pieces: one
+        array for every station cannot hold its two linear densities)."""
         from scipy.integrate import simpson  # (scipy: a dependency; loaded on first use)
 
-        cuts = [b for b in self.arm.boundaries if lo < b < hi]
+        bounds = self.arm.boundaries
+        cuts = [b for b in bounds if lo < b < hi]
         total = 0.0
         for a, b in zip([lo, *cuts], [*cuts, hi], strict=True):
             i, k = self._at(a), self._at(b)
-            if k > i:
-                total = total + simpson(density[..., i:k + 1, :], x=self.s[i:k + 1], axis=-2)
+            if k <= i:
+                continue
+            piece = density[..., i:k + 1, :]
+            if per_segment is not None:  # (the segment holding the piece's middle)
+                segment = int(np.searchsorted(bounds, 0.5 * (a + b), side="right")) - 1
+                piece = piece * per_segment[min(segment, len(per_segment) - 1)]
+            total = total + simpson(piece, x=self.s[i:k + 1], axis=-2)
         return total
 
     def distributed(self, *, force=None, moment=None, follower=False, span=None,
                     per_mass=False):
         lo, hi = (0.0, self.length) if span is None else span
-        density = np.zeros((*self.p.shape[:-1], 6))
         rotate = (lambda v: np.einsum("...ij,...j->...i", self.R,
                                       np.asarray(v)[..., None, :])) if follower else \
             (lambda v: np.broadcast_to(np.asarray(v)[..., None, :], self.p.shape))
         if force is not None:
             f = rotate(force)
-            if per_mass:
-                mass = np.array([seg.linear_density or 0.0 for seg in self.arm.segments])
-                f = f * mass[self.segment][:, None]
-            density = density + np.concatenate([f, np.cross(self.p, f)], axis=-1)
+            mass = np.array([seg.linear_density or 0.0 for seg in self.arm.segments]) \
+                if per_mass else None
+            density = np.concatenate([f, np.cross(self.p, f)], axis=-1)
+            self.wrench += self._integrated(density, lo, hi, mass)
         if moment is not None:
-            density = density + np.concatenate([np.zeros(self.p.shape), rotate(moment)], -1)
-        self.wrench += self._integrated(density, lo, hi)
+            density = np.concatenate([np.zeros(self.p.shape), rotate(moment)], -1)
+            self.wrench += self._integrated(density, lo, hi)
 
     def point(self, s, *, force=None, moment=None):
         i = self._at(s)
