@@ -29,9 +29,9 @@ from typing import ClassVar
 import numpy as np
 
 from ._validate import MAX_STEPS, as_array, format_value, real
-from .loads import Key, Load
+from .loads import Key, Load, applied_wrench
 
-__all__ = ["Capsule", "Contact", "Obstacle", "Plane", "Sphere", "along_the_arm",
+__all__ = ["Capsule", "Contact", "Obstacle", "Plane", "Sphere", "along_the_arm", "balance",
            "penalty_energy", "pressure", "resultant"]
 
 # The kernel's obstacle kinds (statics/_kernels.py: PLANE, SPHERE, CAPSULE, one row of 8).
@@ -477,3 +477,17 @@ def resultant(s, positions, forces) -> np.ndarray:
     wrench = np.concatenate([forces, np.cross(positions, forces)], axis=-1)
     ds = np.diff(np.asarray(s))[:, None]
     return (0.5 * (wrench[..., 1:, :] + wrench[..., :-1, :]) * ds).sum(-2)
+
+
+def balance(arm, loads, s, poses, base_wrench) -> np.ndarray:
+    """(B..., 6): the obstacles' total force on the arm (N) and its moment about the spatial
+    origin (N m) from the global balance of an equilibrium with ``poses`` (B..., S, 4, 4) at
+    stations ``s`` (S,) and base wrench ``base_wrench`` (B..., 6; every force applied to the
+    arm and its moment about the base, as the solver returns it): that wrench moved to the
+    origin, less the other loads' resultant (:func:`softarm.loads.applied_wrench`, which
+    needs every cut among ``s``). Exact to the solve's tolerance however narrow the contact
+    zones, where a sum of the pressure on stations is not (docs/contact.md)."""
+    force = base_wrench[..., :3]
+    moment = base_wrench[..., 3:] + np.cross(poses[..., 0, :3, 3], force)
+    others = tuple(load for load in loads if load.kind != "contact")
+    return np.concatenate([force, moment], axis=-1) - applied_wrench(arm, others, s, poses)

@@ -302,7 +302,7 @@ class ForwardSolver:
     def equilibrium(self) -> Equilibrium:
         """The full :class:`~softarm.Equilibrium` of the last call (every station of ``s``,
         strains, stresses, tendon fields, Jacobians)."""
-        if self._prepared._last is None:
+        if not self._prepared.solved:
             raise ValueError("ForwardSolver.equilibrium: no solution yet (call solve first, "
                              "or the last call failed)")
         return self._prepared.equilibrium()

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .contact import along_the_arm, resultant
+from .contact import along_the_arm, balance, resultant
 
 __all__ = ["Equilibrium", "Stability"]
 
@@ -285,14 +285,31 @@ class Equilibrium:
     @property
     def contact_wrench(self) -> np.ndarray:
         """(B..., 6): the total contact force (N) and its moment about the spatial origin
-        (N m) on the arm: the contact forces and p × them integrated along the arm. The
-        solver integrates them on stations of its own, at least 2001 (a contact zone is
-        about √(EI/GA) wide, a few mm: the stations asked for may miss it); an Equilibrium
-        without them (read from a file) integrates :attr:`contact_forces` over its stations
-        (docs/contact.md)."""
+        (N m) on the arm, from the global balance (:func:`softarm.contact.balance`: the base
+        wrench less the other loads), exact however narrow a contact zone. ``softarm.solve``
+        computes it on stations of its own (at least 2001); an Equilibrium without it (a
+        ForwardSolver's, a file's of an older version) takes the balance on its own stations
+        where they run from base to tip through every cut of the loads, else integrates
+        :attr:`contact_forces` over them, which is right only where they resolve every
+        contact zone (docs/contact.md). ValueError where its stations do not span the arm
+        (a ForwardSolver's default, the tip alone): no total can be formed."""
         if self.contact_resultant is not None:
             return self.contact_resultant
-        return resultant(self.s, self.positions, self.contact_forces)
+        if self._contact() is None:
+            return np.zeros((*self.batch_shape, 6))
+        s, length = self.s, float(self.arm.length)
+        if s[0] != 0.0 or abs(s[-1] - length) > 1e-12 * length:
+            raise ValueError(
+                f"Equilibrium.contact_wrench: its stations must run from the base to the "
+                f"tip (s from 0 to L = {length:.6g} m) to form the total, got "
+                f"{s.size} from {s[0]:.6g} to {s[-1]:.6g} m; solve with s=... or "
+                "ForwardSolver(..., s=None) for 101 stations")
+        cuts = {float(c) for load in self.loads for c in load.cuts(self.arm)} | \
+            {float(b) for b in self.arm.boundaries}
+        if self.base_wrench is not None and all(
+                np.min(np.abs(s - c)) <= 1e-12 * length for c in cuts):
+            return balance(self.arm, self.loads, s, self.poses, self.base_wrench)
+        return resultant(s, self.positions, self.contact_forces)
 
     def _contact_state(self) -> tuple[np.ndarray, np.ndarray]:
         contact = self._contact()

@@ -30,13 +30,13 @@ from .._validate import (
     rigid_transform,
     stations,
 )
+from ..contact import balance
 from ..equilibrium import Equilibrium, Stability
 from ..errors import ApproximationWarning, ConvergenceError, InadmissibleStateError
 from ..lie import se3
 from ..loads import (
     Gravity,
     Tendon,
-    applied_wrench,
     as_loads,
     batch_shape,
     check_magnitudes,
@@ -287,23 +287,15 @@ def _contact_stations(s: np.ndarray, length: float, cuts) -> tuple[np.ndarray, n
 
 
 def _contact_wrench(solver, contact, loads, shape, s, poses, base_wrench) -> np.ndarray:
-    """(*shape, 6): the obstacles' total force on the arm (N) and its moment about the
-    spatial origin (N m), from the global balance: the base wrench (every force applied to
-    the arm, moved to the origin) less the other loads' resultant (loads.applied_wrench).
-    Exact to the solve's tolerance however narrow the contact zones: a sum of the pressure
-    on stations is not, where a zone is narrower than their spacing (docs/contact.md).
-    ``contact``: the law solved with (its stiffness per case); ``poses`` (B, S, 4, 4)."""
+    """(*shape, 6): :func:`softarm.contact.balance` on the solver's fine stations ``s``
+    (``poses`` (B, S, 4, 4), B the flattened cases; ``contact`` the law solved with, its
+    stiffness per case), exactly zero for a case where no station is within the contact
+    distance (the balance leaves round-off there: the stations resolve the zones, as the
+    penetration check assumes)."""
     _, forces = contact.gaps(poses[..., :3, 3], contact.station_radii(solver.arm, s))
     touching = np.any(forces != 0.0, axis=(-1, -2)).reshape(shape)
-    S = s.size
-    poses = poses.reshape(*shape, S, 4, 4)
-    force = base_wrench[:, :3].reshape(*shape, 3)
-    moment = base_wrench[:, 3:].reshape(*shape, 3) + np.cross(poses[..., 0, :3, 3], force)
-    others = tuple(load for load in loads if load.kind != "contact")
-    wrench = np.concatenate([force, moment], axis=-1) - applied_wrench(solver.arm, others, s,
-                                                                        poses)
-    # exactly zero where no station is within the contact distance (the balance leaves
-    # round-off there): the stations resolve the zones, as the penetration check assumes
+    wrench = balance(solver.arm, loads, s, poses.reshape(*shape, s.size, 4, 4),
+                     base_wrench.reshape(*shape, 6))
     return np.where(touching[..., None], wrench, 0.0)
 
 
@@ -803,6 +795,8 @@ class PreparedSolve:
         self._flags = np.zeros(1, dtype=np.bool_)
         self.index, self.conservative = 0, True
         self._last = None  # what this object last wrote as the Solver's _last
+        #: whether the last call succeeded (its answer is in the buffers), on either route
+        self.solved = False
         self._q_last, self._dq = np.empty(n), np.empty(n)  # its inputs; their change
         # The route (_stiff.py): fixed when no input changes the loads' largest force (a
         # tendon's tension, a chamber's pressure and a field's B0 do not: measured at zero
@@ -835,6 +829,7 @@ class PreparedSolve:
         loads (:meth:`Solver.solve_near`). Writes the buffers; a ConvergenceError if the
         kernel fails (the Solver then returns to the unloaded arm)."""
         k, solver = self._k, self._solver
+        self.solved = False
         np.copyto(self.inputs, q)
         piece, tip = self._piece, self._tip
         np.dot(self.inputs, self._unit_flat, out=piece.reshape(-1))
@@ -897,6 +892,7 @@ class PreparedSolve:
         except InadmissibleStateError:
             self._last = None
             raise
+        self.solved = True
         if stiff:
             solver.reset()
             self._last = None
@@ -922,6 +918,7 @@ class PreparedSolve:
         answer (no prediction from it)."""
         self._solver.reset()
         self._last = None
+        self.solved = False
 
     def loads_at(self, q) -> tuple:
         """The loads with the inputs q (:attr:`inputs`' order), values not validated again."""
