@@ -211,6 +211,7 @@ def test_an_arm_starting_inside_an_obstacle_is_refused_as_the_statics_refuse_it(
         f"{-gaps[first]:.3g} m deep at station s = {hanging.s[first]:.6g} m)")
 
 
+@pytest.mark.slow  # (dynamics from an equilibrium in contact: its compile)
 def test_a_simulation_starts_at_rest_from_a_static_contact_equilibrium():
     """Issue 39: ``initial=eq`` with the same Contact failed ("residual 1.53e+07"): the
     step's Jacobian left out the penalty's ∂f/∂p, so Newton from the static answer crept and
@@ -233,6 +234,7 @@ def test_a_simulation_starts_at_rest_from_a_static_contact_equilibrium():
     assert 0.2 * law.distance < tip < 2 * law.distance  # the bands' difference
 
 
+@pytest.mark.slow  # (dynamics from an equilibrium in contact: its compile)
 def test_the_same_given_law_starts_at_the_statics_answer_without_a_word():
     """A Contact with its own stiffness and distance is one law in statics and dynamics:
     the simulation starts at the Equilibrium's shape (to the grid's O(h²)) and stays."""
@@ -248,6 +250,7 @@ def test_the_same_given_law_starts_at_the_statics_answer_without_a_word():
     assert np.abs(path.positions - path.positions[0]).max() < 1e-9 * arm.length
 
 
+@pytest.mark.slow  # (dynamics from an equilibrium in contact: its compile)
 def test_an_arm_at_rest_in_a_corner_with_friction_stays_at_rest():
     """Sections touching two obstacles at once, with friction: an arm pressed by a tilted
     gravity onto a floor and against a wall. The statics' frictionless equilibrium is a
@@ -268,6 +271,7 @@ def test_an_arm_at_rest_in_a_corner_with_friction_stays_at_rest():
     assert np.abs(path.positions - path.positions[0]).max() < 1e-9 * arm.length
 
 
+@pytest.mark.slow  # (dynamics from an equilibrium in contact: its compile)
 def test_a_touchdown_with_friction_that_fails_names_the_regularisation():
     """Issue 39: the docs' table arm dropped with μ = 0.5 fails on touchdown at the default
     slip_velocity (the error used to advise a smaller dt, which fails as soon) and runs at
