@@ -232,6 +232,11 @@ def test_a_simulation_starts_at_rest_from_a_static_contact_equilibrium():
     assert np.abs(path.positions[0] - rest.positions).max() < 1e-4 * arm.length
     tip = np.linalg.norm(path.positions[0, -1] - eq.positions[-1])
     assert 0.2 * law.distance < tip < 2 * law.distance  # the bands' difference
+    # a batch whose steps size the law per case: one static balance cannot hold them all
+    pressed = [sa.Gravity(), sa.TipLoad([[0.0, 0.0, 0.0], [0.0, 0.0, -0.02]]), TABLE]
+    with pytest.raises(ValueError, match=r"initial: this batch's time steps use a contact "
+                                         r"law per case .* give the Contact its stiffness"):
+        sa.Simulator(arm, [], pressed, dt=1e-3, initial=sa.solve(arm, pressed))
 
 
 @pytest.mark.slow  # (dynamics from an equilibrium in contact: its compile)
@@ -248,6 +253,14 @@ def test_the_same_given_law_starts_at_the_statics_answer_without_a_word():
         path = sa.simulate(arm, loads, duration=0.02, dt=1e-3, initial=eq)
     assert np.abs(path.positions[0] - eq.positions).max() < 1e-4 * arm.length
     assert np.abs(path.positions - path.positions[0]).max() < 1e-9 * arm.length
+    # a batch too: one law for every case
+    batch = [sa.Gravity(), sa.TipLoad([[0.0, 0.0, 0.0], [0.0, 0.0, -0.02]]), loads[1]]
+    eqs = sa.solve(arm, batch, s=np.linspace(0.0, 0.5, 101))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", sa.ApproximationWarning)
+        path = sa.simulate(arm, batch, duration=0.01, dt=1e-3, initial=eqs)
+    assert np.abs(path.positions[:, 0] - eqs.positions).max() < 1e-4 * arm.length
+    assert np.abs(path.positions - path.positions[:, :1]).max() < 1e-9 * arm.length
 
 
 @pytest.mark.slow  # (dynamics from an equilibrium in contact: its compile)

@@ -510,9 +510,12 @@ class Simulator:
         by about the difference of the bands, which it says for the tip."""
         given = next(load for load in initial.loads if load.kind == "contact")
         law = self._contact
-        if given.distance == law.distance and given.stiffness is not None and \
-                np.array_equal(np.broadcast_to(given.stiffness, np.shape(law.stiffness)),
-                               law.stiffness):
+        try:  # (one number or one per case, either side)
+            same = given.distance == law.distance and given.stiffness is not None and \
+                bool(np.all(np.asarray(given.stiffness) == np.asarray(law.stiffness)))
+        except ValueError:  # (batch shapes that do not broadcast: not the same law)
+            same = False
+        if same:
             return
         off = float(np.max(np.linalg.norm(start.positions[..., -1, :]
                                           - initial.positions[..., -1, :], axis=-1)))
@@ -530,7 +533,18 @@ class Simulator:
         (contact.md, "Dynamics"), not pushed off by the difference."""
         if self._contact is None:
             return tuple(loads)
-        return tuple(self._contact if load.kind == "contact" else load for load in loads)
+        law = self._contact
+        k = np.asarray(law.stiffness)
+        if k.ndim:  # one per case: a static solve takes one law (Contact.stiffness)
+            if np.any(k != k.flat[0]):
+                raise ValueError(
+                    f"initial: this batch's time steps use a contact law per case (stiffness "
+                    f"{k.min():.4g} to {k.max():.4g} N/m², sized for each case's loads), and "
+                    "an Equilibrium is balanced again under one law: give the Contact its "
+                    "stiffness and distance (one law for every case, contact.md), or "
+                    "simulate each case from its own equilibrium")
+            law = law.replace(stiffness=float(k.flat[0]))
+        return tuple(law if load.kind == "contact" else load for load in loads)
 
     def _settle(self, initial, Z, H, base0) -> None:
         """Z, H ← the equilibrium of ``initial``'s loads at rest on this grid: the equations
