@@ -458,7 +458,8 @@ class Simulator:
             _check_outside(Solver(self.arm, s=2, base=pose0, stability=False, tol=self.tol),
                            self._contact.replace(stiffness=None))
         solver = Solver(self.arm, s=unique, base=pose0, stability=False, tol=1e-10)
-        eq = solver.solve_from_unloaded([] if initial is None else self._stepped(initial.loads))
+        loads = () if initial is None else self._stepped(initial.loads)
+        eq = solver.solve_from_unloaded(loads)
         if initial is not None and self._contact is not None:
             self._check_start(eq, unique)
             self._say_the_law_differs(initial, eq)
@@ -480,7 +481,7 @@ class Simulator:
                 K, rod[..., None])[..., 0]
         if initial is not None:
             Z[:, :, k._DN:k._DN + 6] = stresses[:, index]  # (the rod's: a first guess)
-            self._settle(initial, Z, H, base0)
+            self._settle(loads, Z, H, base0)
         H[..., 12:24] = H[..., 0:12]
         H[..., 24:36] = 0.0
         return Z, np.stack([Z, Z], axis=1), H, np.zeros((B, 2))
@@ -546,15 +547,15 @@ class Simulator:
             law = law.replace(stiffness=float(k.flat[0]))
         return tuple(law if load.kind == "contact" else load for load in loads)
 
-    def _settle(self, initial, Z, H, base0) -> None:
-        """Z, H ← the equilibrium of ``initial``'s loads at rest on this grid: the equations
+    def _settle(self, loads, Z, H, base0) -> None:
+        """Z, H ← the equilibrium of the initial Equilibrium's ``loads`` (:meth:`_stepped`)
+        at rest on this grid: the equations
         of a step without inertia (c0 = 0: no time derivative), by Newton from the solver's
         answer. The same discretisation as the steps, so the arm starts at rest to tol
         (the solver's own answer differs from it by the grid's O(h²) error), and the
         total wrench of rod and actuators is the state's."""
         k = _kernels()
-        _, shape, _, pieces, channels = self._solver._prepare(self._stepped(initial.loads),
-                                                                  tuple(self._pieces[0]))
+        _, shape, _, pieces, channels = self._solver._prepare(loads, tuple(self._pieces[0]))
         if not np.array_equal(pieces[0], self._pieces[0]):
             raise ValueError("initial: the Equilibrium's loads cut the arm where this "
                              "simulation does not (loads over part of the arm)")

@@ -214,15 +214,16 @@ _NO_CONTACT = (np.zeros((0, 8)), np.zeros((1, 5)))
 _CONTACT_RETRIES = 4
 
 
-def _penetration(solver, contact, poses, s, attempt: int, given: bool) -> np.ndarray | None:
-    """None if no station of the solved cases (poses (B, S, 4, 4) at stations s, with the
-    law ``contact``, its stiffness (B,)) is inside an obstacle by more than tol·L; else each
+def _penetration(solver, contact, gaps, forces, attempt: int,
+                 given: bool) -> np.ndarray | None:
+    """None if no station of the solved cases (their ``gaps`` (B, S) and contact ``forces``
+    (B, S, 3) with the law ``contact``, its stiffness (B,): :meth:`Contact.gaps`) is inside
+    an obstacle by more than tol·L; else each
     case's new stiffness: a case that penetrates gets the one that carries its largest
     pressure within the band (k δ/2 = 1.25 × it, and at least twice its last k), the others
     keep theirs (a case's answer never depends on the others': batch = loop). A
     ConvergenceError when this was the solve's last attempt (``attempt`` counts from 0), or
     at once for a stiffness the user ``given`` (it is theirs to raise)."""
-    gaps, forces = contact.gaps(poses[..., :3, 3], contact.station_radii(solver.arm, s))
     depth = -gaps.min(axis=-1)
     deep = depth > solver.tol * solver.length
     if not deep.any():
@@ -286,13 +287,12 @@ def _contact_stations(s: np.ndarray, length: float, cuts) -> tuple[np.ndarray, n
     return fine, np.searchsorted(fine, s)
 
 
-def _contact_wrench(solver, contact, loads, shape, s, poses, base_wrench) -> np.ndarray:
+def _contact_wrench(solver, forces, loads, shape, s, poses, base_wrench) -> np.ndarray:
     """(*shape, 6): :func:`softarm.contact.balance` on the solver's fine stations ``s``
-    (``poses`` (B, S, 4, 4), B the flattened cases; ``contact`` the law solved with, its
-    stiffness per case), exactly zero for a case where no station is within the contact
-    distance (the balance leaves round-off there: the stations resolve the zones, as the
-    penetration check assumes)."""
-    _, forces = contact.gaps(poses[..., :3, 3], contact.station_radii(solver.arm, s))
+    (``poses`` (B, S, 4, 4), B the flattened cases; ``forces`` (B, S, 3) the contact forces
+    there), exactly zero for a case where no station is within the contact distance (the
+    balance leaves round-off there: the stations resolve the zones, as the penetration
+    check assumes)."""
     touching = np.any(forces != 0.0, axis=(-1, -2)).reshape(shape)
     wrench = balance(solver.arm, loads, s, poses.reshape(*shape, s.size, 4, 4),
                      base_wrench.reshape(*shape, 6))
@@ -1422,8 +1422,10 @@ class Solver:
                 if not chained:
                     error = _tension_limit(self, loads, shape, int(failed[0]), error) or error
             raise error
-        if contact is not None:
-            stiffer = _penetration(self, channels.contact_load, poses, s_kernel, attempt,
+        if contact is not None:  # (the gaps and forces on the solver's stations, once)
+            law = channels.contact_load
+            gaps, forces = law.gaps(poses[..., :3, 3], law.station_radii(self.arm, s_kernel))
+            stiffer = _penetration(self, law, gaps, forces, attempt,
                                    channels.contact_given_stiffness)
             if stiffer is not None:  # raise the penalty until the pressure fits the band
                 if chained:
@@ -1434,8 +1436,8 @@ class Solver:
         _admissible(self, strains, stresses, s_kernel, shape, info[:, 0], chained)
         contact_resultant = None
         if asked is not None:  # the contact's total from the balance, then the asked stations
-            contact_resultant = _contact_wrench(self, channels.contact_load, loads, shape,
-                                                s_kernel, poses, base_wrench)
+            contact_resultant = _contact_wrench(self, forces, loads, shape, s_kernel, poses,
+                                                base_wrench)
             poses, strains, stresses = (np.ascontiguousarray(a[:, asked])
                                         for a in (poses, strains, stresses))
             if jacobians:
