@@ -9,6 +9,8 @@ minimum-effort answer of a redundant arm is checked by its first-order optimalit
 
 from __future__ import annotations
 
+from functools import partial
+
 import numpy as np
 import pytest
 
@@ -757,3 +759,41 @@ def test_the_inverse_table_takes_the_number_of_starts(tmp_path, capsys):
     assert main(["inverse", str(case)]) == 0
     out = capsys.readouterr().out
     assert "reached   NO" in out and "(starts tried 2)" in out
+
+
+def test_progress_reports_every_start_and_ends_at_the_answer(tmp_path, capsys, monkeypatch):
+    """issue 39: an inverse of an arm in contact takes minutes, so ``progress`` reports each
+    forward solve: (start, iterations, task error). Its last report is the answer's own
+    figures, recomputed independently (the tip error of a forward solve of the answer's
+    tensions), and a target missed from the first guess reports each start it tried, in
+    order; ``softarm inverse`` shows the reports on stderr."""
+    from pathlib import Path
+
+    from softarm import cli
+
+    arm = robot()
+    reports = []
+    record = lambda *report: reports.append(report)  # noqa: E731
+    target = forward(arm, [0.5, 2.0, 0.0]).tip_position
+    answer = inverse(arm, tendons(), target, loads=[GRAVITY], progress=record)
+    assert answer.reached and reports[-1] == (1, answer.iterations, answer.error)
+    # (the inverse's forward solves are at tol/10 = 1e-7 L, the reference's at 1e-10 L)
+    again = np.linalg.norm(forward(arm, answer.inputs).tip_position - target) / L
+    assert abs(reports[-1][2] - again) <= 2e-7
+    # missed from the first guess (the test above's target, within bounds (0, 10) N)
+    reports.clear()
+    target = forward(arm, np.array([5.5775, 0.1215, 7.1299])).tip_position
+    answer = inverse(arm, tendons(), target, loads=[GRAVITY], bounds=(0.0, 10.0),
+                     progress=record)
+    starts = [start for start, _, _ in reports]
+    assert starts == sorted(starts) and starts[-1] == answer.starts > 1
+    assert reports[-1][2] == pytest.approx(answer.error, rel=1e-12)
+    with pytest.raises(TypeError, match="progress must be a callable"):
+        InverseSolver(arm, tendons(), progress="yes")
+    # the command's line on stderr (shown from the first report: no delay)
+    monkeypatch.setattr(cli, "_Progress", partial(cli._Progress, delay=0.0))
+    example = Path(__file__).resolve().parents[1] / "examples" / "tendon_robot.toml"
+    assert cli.main(["inverse", str(example)]) == 0
+    err = capsys.readouterr().err
+    assert "inverse: start 1 (of at most 6), iteration " in err and " m, " in err
+    assert err.endswith("\n")

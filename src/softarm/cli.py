@@ -57,18 +57,29 @@ class _Progress:
         self.last = 0.0
 
     def __call__(self, done: int, total: int, failed: int = 0) -> None:
+        if self.first is None:
+            self.first = (time.perf_counter(), done)
+        if done == total and not self.shown:
+            _Interrupt.check()
+            return  # finished before the bar was due: nothing to show
+        self.line(lambda now: self._bar(now, done, total, failed), final=done >= total)
+
+    def line(self, text, final: bool = False) -> None:
+        """Redraw the line ``text(now)`` (a callable: built only when it is drawn) once the
+        delay has passed, at most every 0.1 s unless ``final``."""
         _Interrupt.check()  # a Ctrl-C that something below swallowed
         now = time.perf_counter()
-        if self.first is None:
-            self.first = (now, done)
-        if (now - self.start < self.delay or now - self.last < 0.1) and done < total:
+        if (now - self.start < self.delay or now - self.last < 0.1) and not final:
             return
-        if done == total and not self.shown:
-            return  # finished before the bar was due: nothing to show
         self.last = now
+        self.stream.write("\r" + text(now))
+        self.stream.flush()
+        self.shown = True
+
+    def _bar(self, now: float, done: int, total: int, failed: int) -> str:
         filled = round(self.width * done / max(total, 1))
         bar = "#" * filled + "." * (self.width - filled)
-        text = f"\r{self.label} [{bar}] {done}/{total} {self.unit}"
+        text = f"{self.label} [{bar}] {done}/{total} {self.unit}"
         if self.rate:
             elapsed = now - self.first[0]
             rate = (done - self.first[1]) / elapsed if elapsed > 0 else 0.0
@@ -78,9 +89,7 @@ class _Progress:
             text += f", {now - self.start:.1f} s"
         if failed:
             text += f", {failed} failed"
-        self.stream.write(text)
-        self.stream.flush()
-        self.shown = True
+        return text
 
     def close(self) -> None:
         if self.shown:
@@ -759,10 +768,20 @@ def _run_inverse(args) -> int:
                                s=int(case.solve.stations), solver_tol=float(case.solve.tol))
     except (ValueError, TypeError) as error:
         raise CaseError(f"{args.case}: inverse: {error}") from None
+    # a target can take minutes (an arm in contact: a second or more per forward solve):
+    # after a second, the start, iterations and tip error so far on one line of stderr
+    progress = _Progress()
+    solver.progress = lambda begun, iterations, error: progress.line(
+        lambda now: f"inverse: start {begun} (of at most {solver.starts}), iteration "
+                    f"{iterations}, tip error {error * solver.length:.3g} m, "
+                    f"{now - progress.start:.1f} s")
     start = time.perf_counter()
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", StabilityWarning)
-        answer = solver.solve(target)
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", StabilityWarning)
+            answer = solver.solve(target)
+    finally:
+        progress.close()
     seconds = time.perf_counter() - start
     _report(caught)
     solved = [*others, *solver.actuators_at(answer.inputs)]

@@ -346,6 +346,12 @@ class InverseSolver:
         bounds (docs/control.md, "Local minima"). 1: the first guess only.
     s, solver_tol : stations and the forward solver's tolerance (relative to L; default
         tol / 10).
+    progress : callable, optional
+        ``progress(start, iteration, error)`` after every forward solve of a target: the
+        start (1 for the first guess, up to ``starts``), the Gauss–Newton iterations done
+        from it, and the task error (relative to L) at the last accepted point. A slow
+        target (each forward solve of an arm in contact takes a second or more) can be
+        followed with it; ``softarm inverse`` shows it on stderr.
 
     After a target that is not reached, the next one starts from the last answer that
     reached its target (or the first guess), from the unloaded arm: the closest point to an
@@ -353,8 +359,13 @@ class InverseSolver:
     """
 
     def __init__(self, arm, actuators, loads=(), *, bounds=None, scales=None, tol=1e-6,
-                 max_iterations=10, starts=6, s=None, solver_tol=None):
+                 max_iterations=10, starts=6, s=None, solver_tol=None, progress=None):
         self.arm = arm
+        if progress is not None and not callable(progress):
+            raise TypeError(f"progress must be a callable (start, iteration, error) or None, "
+                            f"got {type(progress).__name__}")
+        self.progress = progress
+        self._start = 1  # the start being tried (reported to progress)
         self.actuators = as_actuators(actuators)
         self.loads = as_loads(loads)
         self.tol = real(tol, "tol")
@@ -701,6 +712,7 @@ class InverseSolver:
         q = np.minimum(np.maximum(self.q, self.lower), self.upper)  # (np.clip: 3× the cost)
         if self._sane is None:
             self._sane = q.copy()  # the first guess, until a target is reached
+        self._start = 1
         result = self._attempt(q, target, orientation, snapshot)
         if not result.reached and self.starts > 1:
             result = self._more_starts(q, target, orientation, snapshot, result)
@@ -709,6 +721,10 @@ class InverseSolver:
         else:
             self._missed = self.q
         return result
+
+    def _report(self, iterations: int, error: float) -> None:
+        if self.progress is not None:
+            self.progress(self._start, iterations, float(error))
 
     def _from_unloaded(self) -> None:
         """Forget the last equilibrium: the next solve starts from the unloaded arm."""
@@ -736,6 +752,7 @@ class InverseSolver:
             failed."""
             nonlocal tried
             tried += 1
+            self._start = tried
             self._from_unloaded()
             self.lower, self.upper = bounds
             try:
@@ -786,10 +803,12 @@ class InverseSolver:
                 self.solver.reset()
         fast = self._shooting_newton(q, target, orientation, snapshot)
         if fast is not None:
+            self._report(fast.iterations, fast.error)
             return fast
         eq, A = self._forward(q)
         e, w = self._task(eq, target, orientation)
         size = _size(e)
+        self._report(0, size)
         redundant = self._redundant(w[:, None] * A[:e.size])
         mu = 0.0  # Gauss–Newton with the exact Jacobian; damped only after a failed step
         iterations = 0
@@ -818,6 +837,7 @@ class InverseSolver:
                 mu = 1e-3 if mu == 0.0 else 10.0 * mu
                 self.solver.reset()
                 eq, A = self._forward(q)  # back to the accepted point (the solver moved)
+            self._report(iterations, size)
         self.q = q
         singular = self._singular(w[:, None] * A[:e.size])
         condition = float(singular[0] / singular[-1]) if singular[-1] > 0 else np.inf
@@ -934,7 +954,7 @@ def _input_count(load) -> int:
 
 
 def inverse(arm, actuators, target, *, loads=(), bounds=None, orientation=None, scales=None,
-            x0=None, tol=1e-6, max_iterations=10, starts=6) -> InverseResult:
+            x0=None, tol=1e-6, max_iterations=10, starts=6, progress=None) -> InverseResult:
     """The actuation inputs that bring the tip of ``arm`` to ``target`` (m, spatial), or to
     the pose (``target``, ``orientation``), under the other ``loads``.
 
@@ -944,7 +964,7 @@ def inverse(arm, actuators, target, *, loads=(), bounds=None, orientation=None, 
     other starts are tried, ``starts`` in all (``InverseResult.starts`` says how many were).
     See :class:`InverseSolver` and :class:`InverseResult`. An unreachable target returns the
     closest reachable point found with ``reached=False``; a ConvergenceError only if the
-    forward solver fails from the first guess.
+    forward solver fails from the first guess. ``progress``: as InverseSolver's.
 
     Examples
     --------
@@ -960,7 +980,7 @@ def inverse(arm, actuators, target, *, loads=(), bounds=None, orientation=None, 
     (True, [1.2, 0.4])
     """
     solver = InverseSolver(arm, actuators, loads, bounds=bounds, scales=scales, tol=tol,
-                           max_iterations=max_iterations, starts=starts)
+                           max_iterations=max_iterations, starts=starts, progress=progress)
     if x0 is not None:
         x0 = np.asarray(x0, dtype=float)
         if x0.shape != (solver.n_inputs,) or not np.all(np.isfinite(x0)):
@@ -969,7 +989,7 @@ def inverse(arm, actuators, target, *, loads=(), bounds=None, orientation=None, 
         if solver._displaced:  # a displacement first guess: its tensions, solved again
             solver = InverseSolver(arm, solver.actuators_at(x0), loads, bounds=bounds,
                                    scales=scales, tol=tol, max_iterations=max_iterations,
-                                   starts=starts)
+                                   starts=starts, progress=progress)
         else:
             solver.q = np.clip(x0, solver.lower, solver.upper)
     result = solver._solve(target, orientation)
