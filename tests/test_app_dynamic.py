@@ -57,6 +57,7 @@ def motion():
     httpd.server_close()
 
 
+@pytest.mark.slow  # two dynamics variants no other default test compiles
 def test_served_states_are_the_simulators(motion):
     url, live = motion
     first = states(url, -1)[0]

@@ -98,6 +98,7 @@ def test_sliding_friction_follows_coulombs_law():
         mass * G * np.sin(theta), rel=1e-2)
 
 
+@pytest.mark.slow  # a dynamics variant no other default test compiles
 def test_far_obstacles_change_nothing_in_motion():
     arm = _arm()
     far = sa.Contact(sa.Sphere((0.0, 5.0, 0.0), 0.1))

@@ -212,6 +212,7 @@ def _settled_error(arm, loads, actuators, stations):
     return error, path, eq
 
 
+@pytest.mark.slow  # a dynamics variant (from an actuated equilibrium) compiled for it alone
 @pytest.mark.parametrize("actuator", [
     softarm.Tendon(tension=0.5, routing=softarm.routing.Straight(0.0, 0.008), end=0.2),
     softarm.Chamber(pressure=2e4, area=2e-5, routing=softarm.routing.Straight(0.0, -0.005)),
@@ -387,6 +388,7 @@ def test_each_case_of_a_batch_takes_its_own_inputs():
         sim.step(np.ones((3, 1)))
 
 
+@pytest.mark.slow  # a dynamics variant no other default test compiles
 def test_runs_after_runs_with_and_without_tendons_carry_their_lengths():
     """A run continues from the last one's state: tendon lengths where there are tendons
     (the kernel's, equal to the quadrature of the state's strains), None where the

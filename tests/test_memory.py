@@ -39,7 +39,7 @@ def _same(a: softarm.Equilibrium, b: softarm.Equilibrium) -> None:
     assert np.array_equal(a.stability.conservative, b.stability.conservative)
 
 
-@pytest.mark.parametrize("chained", [False, True])
+@pytest.mark.parametrize("chained", [False, pytest.param(True, marks=pytest.mark.slow)])
 def test_a_batch_solved_in_parts_is_the_batch_to_the_bit(monkeypatch, chained):
     loads = _loads((5, 8))
     whole = softarm.statics.Solver(ARM, s=11)

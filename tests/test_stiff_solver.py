@@ -88,6 +88,7 @@ def test_the_shooting_route_is_checked():
 
 
 
+@pytest.mark.slow  # the stiff route with Jacobians: a compile no other default test needs
 def test_the_compliance_under_strong_tension_is_the_finite_difference():
     # kL = 100 (F L²/EI = 1e4): the block system's implicit function against central
     # differences of tight solves
@@ -105,6 +106,7 @@ def test_the_compliance_under_strong_tension_is_the_finite_difference():
         assert np.array_equal(eq.compliance[-1], eq.tip_compliance)
 
 
+@pytest.mark.slow  # the stiff actuated route with Jacobians: a compile no other default test needs
 def test_a_tendon_robot_under_large_tensions_solves_alike_on_both_routes():
     # tendons at τ L²/EI = 2500 (kL = 50 by the tension): the backbone is compressed, so
     # single shooting still works; both routes agree, and their actuation Jacobians are
@@ -167,6 +169,7 @@ def test_a_nitinol_guide_wire_in_tension_under_its_weight(radius, length, T):
     assert eq.stability.stable
 
 
+@pytest.mark.slow  # the verdict of a given state: a compile no other default test needs
 @pytest.mark.parametrize("F", [1e3, 1e4])
 def test_the_closed_form_of_a_rod_in_tension_is_stable(F):
     # the elastica's closed form (a tip force alone) under kL = 32 and 100: its verdict's
@@ -179,6 +182,7 @@ def test_the_closed_form_of_a_rod_in_tension_is_stable(F):
     assert eq.stability.stable
 
 
+@pytest.mark.slow  # the stiff actuated route with Jacobians: a compile no other default test needs
 def test_the_control_loop_solves_a_tendon_arm_under_a_strong_pull():
     # a tendon arm pulled at its tip by 3 kN (kL = 55): ForwardSolver's call takes the
     # multiple-shooting route from the unloaded arm; the same equilibrium as softarm.solve,

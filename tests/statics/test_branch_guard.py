@@ -79,7 +79,7 @@ def solved(arm, loads, route):
 # the grid: F L²/EI 30 ... 1000 at 175 ... 179.99°
 
 
-@pytest.mark.parametrize("route", ["auto", "numeric",
+@pytest.mark.parametrize("route", [pytest.param("auto", marks=pytest.mark.slow), "numeric",
                                    pytest.param("multiple", marks=pytest.mark.slow),
                                    pytest.param("stable", marks=pytest.mark.slow)])
 def test_the_near_axial_grid_ends_where_the_path_from_the_unloaded_arm_ends(route):
