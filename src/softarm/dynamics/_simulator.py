@@ -695,6 +695,12 @@ class Simulator:
         count_ = max(1, threads or 1)
         local = [self._storage(False, 1) for _ in range(count_)] if shared else None
         actuations = [self._actuation(self._pieces, props, self._act) for _ in range(count_)]
+        # a step with friction that fails is solved again along a continuation in the
+        # friction's band, which the kernel writes into act[6] (and restores): a thread's own
+        acts = [self._act] * count_
+        if self._act is not None and np.any(self._act[6][:, 3] > 0.0):
+            acts = [(*self._act[:6], self._act[6].copy(), *self._act[7:])
+                    for _ in range(count_)]
         slots = iter(range(count_))
 
         def run(first, last):
@@ -704,7 +710,7 @@ class Simulator:
                             self._options, base, self._gravity, self._at, first, last, mine,
                             out["positions"], out["rotations"], out["velocities"],
                             out["spins"], out["strains"], out["stresses"], energy, info, done,
-                            self._act, actuations[slot], schedule, tendons)
+                            acts[slot], actuations[slot], schedule, tendons)
 
         if shared and threads and threads > 1:
             in_threads(run, B, threads)
@@ -893,14 +899,13 @@ class Simulator:
                 float(info[b, t, 0]), f"{MAX_ITERATIONS} Newton iterations")
 
     def _advice(self) -> str:
-        """What may help a step that failed. With friction, a wider regularisation: the
-        docs' table drop at μ = 0.5 fails on touchdown at the default slip_velocity 1e-4 m/s
-        whatever dt (sooner at a smaller one) and runs at 1e-3 (docs/contact.md)."""
+        """What may help a step that failed. With friction, a wider regularisation (the step
+        has been tried along a band widened and narrowed back already: docs/contact.md)."""
         contact = self._contact
         if contact is not None and contact.friction > 0.0:
             return (f"with friction, a larger Contact.slip_velocity may help (now "
-                    f"{contact.slip_velocity:g} m/s; 1e-3 ran where 1e-4 failed on a "
-                    "touchdown, whatever dt: docs/contact.md), or damping")
+                    f"{contact.slip_velocity:g} m/s; the step was also tried from a band up "
+                    "to 1e4 times wider, narrowed back: docs/contact.md), or damping")
         return "a smaller dt, a looser tol or damping may help"
 
     # ------------------------------------------------------------------ results

@@ -4848,6 +4848,88 @@ def _sum_squares(r):
     return total
 
 
+# Friction's band on a step that does not solve (issue 39): Coulomb's law regularised with
+# the speed w_ε (``slip_velocity``) has the slope μ φ / w_ε in the sliding velocity, steep at
+# a touchdown (φ large, w from 0 to the arrival speed within a step), and Newton fails there
+# from every guess (the docs' table drop, μ = 0.5, at the default 1e-4 m/s). The step is
+# then solved along a continuation in w_ε: from the last state with the band widened 10×,
+# 100×, ... (at most 10^_WIDENINGS) until it solves, then narrowed back towards the band
+# given, each solve from the answer before, by a factor that is halved (in its logarithm)
+# after a narrowing that fails and doubled again (up to 10) after one that solves. The
+# step's answer is the law's own at the band given; it fails as before after _NARROWINGS
+# failed narrowings.
+_WIDENINGS = 4
+_NARROWINGS = 12
+
+
+@_jit
+def _friction(params) -> bool:
+    """Whether any piece has friction (μ > 0; ``params`` = act[6])."""
+    for j in range(params.shape[0]):
+        if params[j, 3] > 0.0:
+            return True
+    return False
+
+
+@_jit
+def _with_band(params, given, exponent):
+    """act[6]'s w_ε column = the given bands × 10^exponent."""
+    for j in range(params.shape[0]):
+        params[j, 4] = given[j] if exponent == 0.0 else given[j] * 10.0 ** exponent
+
+
+@_jit
+def _dyn_widened(Zw, last, pose, grid, props, coef, S, now, tip_now, hh, act, actuation,
+                 tol, max_iter, fac, kl, work):
+    """A step with friction solved along a continuation in the friction's band (above):
+    _dyn_newton's (code, residual, iterations, factorisations), the iterations summed.
+    ``last`` the state before the step, ``pose`` the base's row. Writes act[6]'s w_ε column
+    and restores it (``act`` is a thread's own where friction acts: _simulator)."""
+    params = act[6]
+    given = params[:, 4].copy()
+    code, res, its, nf = DYN_NEWTON, np.inf, 0, 0
+    exponent = 0.0  # the band is given × 10^exponent
+    while code != DYN_OK and exponent < _WIDENINGS:
+        exponent += 1.0
+        _with_band(params, given, exponent)
+        for k in range(Zw.shape[0]):
+            for i in range(Zw.shape[1]):
+                Zw[k, i] = last[k, i]
+        _set_base(Zw, pose)
+        fac[3][0] = 0
+        code, res, more, nf2 = _dyn_newton(Zw, grid, props, coef, S, now, tip_now, hh, act,
+                                           actuation, tol, max_iter, fac, kl, work)
+        its += more
+        nf += nf2
+    if code == DYN_OK:
+        good = Zw.copy()  # the answer at the narrowest band solved so far
+        step, failures = 1.0, 0
+        while exponent > 0.0:
+            trial = max(exponent - step, 0.0)
+            _with_band(params, given, trial)
+            fac[3][0] = 0
+            code, res, more, nf2 = _dyn_newton(Zw, grid, props, coef, S, now, tip_now, hh,
+                                               act, actuation, tol, max_iter, fac, kl, work)
+            its += more
+            nf += nf2
+            if code == DYN_OK:
+                for k in range(Zw.shape[0]):
+                    for i in range(Zw.shape[1]):
+                        good[k, i] = Zw[k, i]
+                exponent = trial
+                step = min(2.0 * step, 1.0)
+                continue
+            failures += 1
+            if failures > _NARROWINGS:
+                break  # (code: the failure)
+            for k in range(Zw.shape[0]):
+                for i in range(Zw.shape[1]):
+                    Zw[k, i] = good[k, i]
+            step *= 0.5
+    _with_band(params, given, 0.0)
+    return code, res, its, nf
+
+
 @_jit
 def _dyn_newton(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, tol, max_iter,
                 factors, kl, work):
@@ -5097,6 +5179,13 @@ def dynamic_steps(Z, Zold, H, aux, props, loads, tip, grid, coef, S, options, ba
                                                     work)
                 its += again
                 nf += nf2
+                if code != DYN_OK and _friction(act[6]):
+                    code, res, again, nf2 = _dyn_widened(Zw, Z[b], base[bb, t], grid, props,
+                                                         coef, S, now, tip_now, hh, act,
+                                                         actuation, tol, max_iter, fac, kl,
+                                                         work)
+                    its += again
+                    nf += nf2
             info[b, t, 0] = res
             info[b, t, 2] = nf
             for k in range(G):  # the model's limit: a section turned inside out (v₁ <= 0)
