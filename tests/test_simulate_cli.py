@@ -228,6 +228,107 @@ def test_the_command_writes_softarm_simulate_s_numbers(small, capsys):
         assert back.case.simulation.steps == 20 and back.complete
 
 
+def test_a_zarr_output_alone_is_written_as_the_run_goes(small, capsys, monkeypatch):
+    """Issue 40 (long runs): with .zarr outputs alone, each part of the run is written to
+    the store as it is done and dropped (softarm.io.TrajectoryStore), so a run of any length
+    fits in memory. The numbers are softarm.simulate's (written here by hand, as above), the
+    summary the same as a kept run's."""
+    from softarm.io import TrajectoryStore
+
+    folder, path, _case, expected = small
+    appended = []
+    append = TrajectoryStore.append
+    monkeypatch.setattr(TrajectoryStore, "append",
+                        lambda self, part: (appended.append(part.times.size),
+                                            append(self, part)))
+    out = folder / "streamed.zarr"
+    code, stdout, err = run(capsys, "simulate", path, "-o", out)
+    assert code == 0, err
+    assert len(appended) >= 2 and sum(appended) == 21  # the parts, as they were done
+    assert "simulated 20 steps of 0.001 s to t = 0.02 s, 11 stations" in stdout
+    back = read_trajectory(out)
+    assert back.complete and back.reason == "" and back.times.size == 21
+    for name in ("positions", "rotations", "velocities", "angular_velocities"):
+        np.testing.assert_allclose(getattr(back, name), getattr(expected, name), rtol=0,
+                                   atol=1e-9, err_msg=name)
+    np.testing.assert_allclose(back.times, expected.times, rtol=0, atol=1e-17)
+    kept = folder / "kept.npz"
+    monkeypatch.undo()
+    assert run(capsys, "simulate", path, "-o", kept)[0] == 0
+    both = read_trajectory(kept)
+    np.testing.assert_allclose(back.energy.total, both.energy.total, rtol=1e-6, atol=1e-12)
+    # Ctrl-C after the first part: the store holds it, marked incomplete
+    monkeypatch.setattr(cli._Progress, "__call__", _interrupt)
+    code, _stdout, stderr = run(capsys, "simulate", path, "-o", folder / "stopped.zarr")
+    assert code == 130 and "wrote the 1 of 20 steps done" in stderr
+    back = read_trajectory(folder / "stopped.zarr")
+    assert not back.complete and back.reason == "interrupted" and back.times.size == 2
+
+
+def _interrupt(self, done, total, failed=0):
+    raise KeyboardInterrupt
+
+
+def test_a_trajectory_store_holds_the_parts_given(small, tmp_path):
+    """softarm.io.TrajectoryStore against the parts joined in memory (join_trajectories):
+    equal to the bit, whole or every third time, written in one chunk or in many (a chunk of
+    3 times); a store left open holds the chunks written, marked incomplete; an error in its
+    block closes it incomplete, with the error."""
+    from softarm.case import join_trajectories, simulation_parts
+    from softarm.io import TrajectoryStore
+
+    _folder, _path, case, _expected = small
+    parts = list(simulation_parts(case, seconds=0.0))  # (20 parts of a step and more)
+    whole = join_trajectories(parts)
+    rotations_per_time = 8 * 9 * whole.s.size
+    for every, chunk in ((1, 1 << 22), (3, 1 << 22), (1, 3 * rotations_per_time),
+                         (3, 3 * rotations_per_time)):
+        with TrajectoryStore(tmp_path / f"run{every}{chunk}.zarr", case, every=every,
+                             chunk_bytes=chunk) as store:
+            for part in parts:
+                store.append(part)
+        back = read_trajectory(store.path)
+        assert back.complete and back.times.size == len(whole.times[::every])
+        for name in ("times", "positions", "rotations", "stresses", "iterations"):
+            # (an unbatched run: time is the first axis)
+            assert np.array_equal(getattr(back, name), getattr(whole, name)[::every]), name
+        assert np.array_equal(back.tendon_lengths, whole.tendon_lengths[::every])
+        assert np.array_equal(back.energy.kinetic, whole.energy.kinetic[::every])
+    # a Simulator's runs, called again and again: each starts at the last one's end
+    sim = softarm.Simulator(case.arm, [case.loads[1]], [case.loads[0]], dt=1e-3,
+                            stations=11)
+    store = TrajectoryStore(tmp_path / "runs.zarr", arm=case.arm, loads=case.loads,
+                            chunk_bytes=6 * rotations_per_time)
+    runs = [sim.run(4) for _ in range(3)]  # 5 times, then 4 new ones twice
+    for one in runs:
+        store.append(one)
+    # left open: what was written when 6 or more times were held (the first 9 of the 13),
+    # marked incomplete
+    back = read_trajectory(store.path)
+    assert not back.complete and back.reason.startswith("the run did not close the store")
+    assert back.times.size == 9
+    store.close()
+    back = read_trajectory(store.path)
+    assert back.complete and np.array_equal(back.positions, np.concatenate(
+        [runs[0].positions, runs[1].positions[1:], runs[2].positions[1:]]))
+    assert back.case.arm == case.arm and [load.kind for load in back.case.loads] == \
+        ["gravity", "tendon"]  # (the arm and loads given, kept as a case)
+    with pytest.raises(RuntimeError, match="a controller crashed"):
+        with TrajectoryStore(tmp_path / "crash.zarr", case) as store:
+            store.append(parts[0])
+            raise RuntimeError("a controller crashed")
+    back = read_trajectory(tmp_path / "crash.zarr")
+    assert not back.complete and back.reason == "RuntimeError: a controller crashed"
+    with pytest.raises(ValueError, match=r"path must name a \.zarr folder"):
+        TrajectoryStore(tmp_path / "run.npz", case)
+    with pytest.raises(ValueError, match="every"):
+        TrajectoryStore(tmp_path / "run.zarr", case, every=0)
+    with pytest.raises(TypeError, match="case must be a softarm Case"):
+        TrajectoryStore(tmp_path / "run.zarr", "arm.toml")
+    with pytest.raises(TypeError, match=r"give case .* or arm"):
+        TrajectoryStore(tmp_path / "run.zarr", case, arm=case.arm)
+
+
 def test_ctrl_c_keeps_the_steps_done(small, capsys, monkeypatch):
     """A KeyboardInterrupt from the progress report after the first chunk (one step): the
     file holds that step, marked incomplete; exit code 130, one line on stderr."""

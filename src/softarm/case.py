@@ -786,7 +786,8 @@ def _simulator(case: Case) -> tuple[Simulator, Callable | None]:
     return simulator, inputs
 
 
-def simulation_parts(case: Case, *, seconds: float = 0.25) -> Iterator[Trajectory]:
+def simulation_parts(case: Case, *, seconds: float = 0.25,
+                     joined: bool = True) -> Iterator[Trajectory]:
     """The case's ``[simulate]`` run in consecutive chunks of steps, each yielded as it is
     done (:func:`join_trajectories` makes them one trajectory; a caller that stops early, on
     Ctrl-C or a ConvergenceError, keeps the chunks it has).
@@ -795,11 +796,14 @@ def simulation_parts(case: Case, *, seconds: float = 0.25) -> Iterator[Trajector
     use of the dynamics kernel compiles it); the next ones take about ``seconds`` each. The
     first chunk includes the initial state (T = steps + 1); the others start after it. A
     sweep's cases go on past a case that fails (its values NaN from its failed step,
-    ``Trajectory.failed``); a single case raises ConvergenceError.
+    ``Trajectory.failed``); a single case raises ConvergenceError. ``joined``: the caller
+    keeps every part (the whole run must fit in memory: checked first); False, a caller
+    that writes each part and drops it (softarm.io.TrajectoryStore): each part is checked.
     """
     simulator, inputs = _simulator(case)
     total = case.simulation.steps
-    simulator._check_run(total, "simulate")  # (the chunks are joined: the whole trajectory)
+    if joined:  # (the chunks are joined: the whole trajectory)
+        simulator._check_run(total, "simulate")
     if inputs is not None:  # one contact law for every chunk, sized for the schedules'
         # largest inputs (at their knots: piecewise linear) as simulate's for its whole run
         knots = sorted({0.0, *(t for schedule in case.simulation.inputs for t in schedule.times)})

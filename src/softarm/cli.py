@@ -648,7 +648,7 @@ def _trajectory_outputs(args) -> tuple[list[Path], Path | None]:
 
 def _run_simulate(args) -> int:
     from .case import join_trajectories, simulation_parts
-    from .io import save_trajectory
+    from .io import TrajectoryStore, save_trajectory
 
     outputs, picture = _trajectory_outputs(args)
     case = load_case(args.case)
@@ -660,14 +660,25 @@ def _run_simulate(args) -> int:
         raise CaseError(f"{where}: sweep: a design ([[sweep.parameter]]) of simulations is not "
                         "supported yet; a one-parameter load [sweep] is")
     total = case.simulation.steps
+    # Zarr outputs alone (no picture, no other format): each part is written as it is done
+    # and dropped, so that a run of any length fits in memory (TrajectoryStore); otherwise
+    # the parts are kept and joined, and written at the end
+    streamed = bool(outputs) and picture is None and \
+        all(out.suffix.lower() == ".zarr" for out in outputs)
+    stores = [TrajectoryStore(out, case) for out in outputs] if streamed else []
     progress = _Progress(label="simulating", unit="steps")
-    parts, done, stopped = [], 0, None
+    parts, figures, done, stopped = [], _RunFigures(), 0, None
     start = time.perf_counter()
     try:
         try:
-            for part in simulation_parts(case):
-                parts.append(part)
-                done += part.times.size - (1 if len(parts) == 1 else 0)
+            for part in simulation_parts(case, joined=not streamed):
+                figures.add(part)
+                if streamed:
+                    for store in stores:
+                        store.append(part)
+                else:
+                    parts.append(part)
+                done = figures.steps
                 progress(done, total)
         except (ValueError, TypeError) as error:  # the simulation rejected the case's data
             raise CaseError(_named(error, where)) from None
@@ -677,59 +688,99 @@ def _run_simulate(args) -> int:
         stopped = ("interrupted", 130)
     except ConvergenceError as error:
         stopped = (f"the solver did not converge: {error}", 1)
+    except BaseException:
+        for store in stores:  # (what was streamed stays, marked incomplete)
+            store.close(complete=False, reason="stopped by an error")
+        raise
     finally:
         progress.close()
     seconds = time.perf_counter() - start
-    if stopped is not None and not parts:
+    if stopped is not None and figures.steps < 0:
         return _fail(stopped[1], f"softarm: {stopped[0]} (no step done; nothing written)")
-    trajectory = join_trajectories(parts)
     reason = "" if stopped is None else _line(stopped[0], 300)
-    for out in outputs:
-        save_trajectory(trajectory, out, case, complete=stopped is None, reason=reason)
-    if picture is not None:
-        from . import plot
+    for store in stores:
+        store.close(complete=stopped is None, reason=reason)
+    if not streamed:
+        trajectory = join_trajectories(parts)
+        for out in outputs:
+            save_trajectory(trajectory, out, case, complete=stopped is None, reason=reason)
+        if picture is not None:
+            from . import plot
 
-        plot.plot_trajectory(trajectory, name=case.name, sweep=case.sweep, path=picture)
-    failed = np.flatnonzero(np.ravel(trajectory.failed)) if trajectory.failed is not None \
-        else ()
+            plot.plot_trajectory(trajectory, name=case.name, sweep=case.sweep, path=picture)
+    failed = np.flatnonzero(np.ravel(figures.failed)) if figures.failed is not None else ()
     if stopped is None and len(failed):
         values = case.sweep.values if case.sweep is not None else range(len(failed))
-        print(f"softarm: {len(failed)} of {trajectory.failed.size} cases failed (their values "
+        print(f"softarm: {len(failed)} of {figures.failed.size} cases failed (their values "
               f"are NaN in the outputs from their failed step on): sweep values "
               f"{', '.join(f'{values[b]:g}' for b in failed[:10])}"
               + (" ..." if len(failed) > 10 else ""), file=sys.stderr)
     if stopped is not None:
-        kept = f"; wrote the {done} of {total} steps done (to t = {trajectory.times[-1]:.6g} " \
+        kept = f"; wrote the {done} of {total} steps done (to t = {figures.end:.6g} " \
             f"s) to {', '.join(map(str, outputs + ([picture] if picture else [])))}" \
             if outputs or picture else f"; {done} of {total} steps were done (no output asked)"
         return _fail(stopped[1], f"softarm: {stopped[0]}{kept}")
-    print(_simulation_summary(case, trajectory, seconds))
+    print(_simulation_summary(case, figures, seconds))
     for out in [*outputs, *([picture] if picture else [])]:
         print(f"wrote {out}")
     return 0
 
 
-def _simulation_summary(case: Case, trajectory, seconds: float) -> str:
+class _RunFigures:
+    """What ``softarm simulate`` says of a run, gathered part by part (a streamed run keeps
+    no trajectory): steps, the last time, Newton's iterations and corrections, the tip's
+    path (an unbatched run) and the energy at the start and now."""
+
+    def __init__(self):
+        self.steps = -1  # the times seen, less one
+        self.stations, self.batch_shape, self.end = 0, (), 0.0
+        self.iterations, self.counted, self.most_iterations = 0.0, 0, 0
+        self.largest_correction = 0.0
+        self.tip_start = self.tip_end = None
+        self.farthest = 0.0
+        self.energy_start = self.energy_end = None
+        self.failed = None
+
+    def add(self, part) -> None:
+        first = self.steps < 0  # (a later part starts after the last time seen)
+        self.steps += part.times.size
+        self.stations, self.batch_shape = part.s.size, part.batch_shape
+        self.end = float(part.times[-1])
+        steps = part.iterations[..., 1:] if first else part.iterations  # (no step at t0)
+        self.iterations += float(np.sum(steps))
+        self.counted += steps.size
+        self.most_iterations = max(self.most_iterations, int(np.max(part.iterations)))
+        self.largest_correction = max(self.largest_correction, float(np.max(part.errors)))
+        total = part.energy.total
+        if first:
+            self.energy_start = total[..., 0]
+            self.tip_start = part.tip_position[..., 0, :]
+        self.energy_end = total[..., -1]
+        self.tip_end = part.tip_position[..., -1, :]
+        if not part.batch_shape:
+            self.farthest = max(self.farthest, float(np.max(np.linalg.norm(
+                part.tip_position - self.tip_start, axis=-1))))
+        if part.failed is not None:
+            self.failed = part.failed if self.failed is None else self.failed | part.failed
+
+
+def _simulation_summary(case: Case, figures: _RunFigures, seconds: float) -> str:
     from .plot import describe_loads
 
     options = case.simulation
-    steps = trajectory.times.size - 1
-    tip = trajectory.tip_position
-    energy = trajectory.energy
-    drift = np.max(np.abs(energy.total[..., -1] - energy.total[..., 0]))
+    drift = np.max(np.abs(figures.energy_end - figures.energy_start))
     lines = [f"case      {case.name}" + (f"  ({case.source})" if case.source else ""),
              f"loads     {describe_loads(case.loads, case.sweep)}",
-             f"simulated {steps} steps of {options.dt:g} s to t = {trajectory.times[-1]:.6g} s,"
-             f" {trajectory.s.size} stations"
-             + (f", {int(np.prod(trajectory.batch_shape))} cases" if trajectory.batch_shape
+             f"simulated {figures.steps} steps of {options.dt:g} s to t = {figures.end:.6g} s,"
+             f" {figures.stations} stations"
+             + (f", {int(np.prod(figures.batch_shape))} cases" if figures.batch_shape
                 else ""),
-             f"Newton    {np.mean(trajectory.iterations[..., 1:]):.3g} iterations a step on "
-             f"average, at most {int(np.max(trajectory.iterations))}; largest step correction "
-             f"{np.max(trajectory.errors):.2e} L"]
-    if not trajectory.batch_shape:
-        lines.append(f"tip       at t = {trajectory.times[-1]:.6g} s: {_vector(tip[-1])} m; "
-                     f"farthest from its start {np.max(np.linalg.norm(tip - tip[0], axis=-1)):.4g}"
-                     " m")
+             f"Newton    {figures.iterations / max(figures.counted, 1):.3g} iterations a step "
+             f"on average, at most {figures.most_iterations}; largest step correction "
+             f"{figures.largest_correction:.2e} L"]
+    if not figures.batch_shape:
+        lines.append(f"tip       at t = {figures.end:.6g} s: {_vector(figures.tip_end)} m; "
+                     f"farthest from its start {figures.farthest:.4g} m")
     lines += [f"energy    kinetic + elastic + gravity + dissipated changed by up to {drift:.3g} J"
               " (the work of the base and actuators, and the time steps' error)",
               f"time      {seconds:.3g} s"]

@@ -38,6 +38,7 @@ __all__ = [
     "TRAJECTORY_FORMATS",
     "SavedResult",
     "SavedTrajectory",
+    "TrajectoryStore",
     "load_result",
     "load_saved",
     "read_trajectory",
@@ -663,14 +664,15 @@ def _trajectory_arrays(trajectory) -> dict:
     return arrays
 
 
-def _trajectory_meta(trajectory, case: Case, complete: bool, reason: str) -> dict:
+def _trajectory_meta(case: Case, batch_shape: tuple, steps: int, failed, complete: bool,
+                     reason: str) -> dict:
+    """A trajectory file's metadata: ``failed`` the failed cases' mask (or None)."""
     sweep = case.sweep
     return {"softarm_version": __version__, "kind": "trajectory", "name": case.name,
-            "batch_shape": list(trajectory.batch_shape), "steps": int(trajectory.times.size - 1),
+            "batch_shape": list(batch_shape), "steps": int(steps),
             "steps_requested": int(case.simulation.steps) if case.simulation else None,
             "complete": bool(complete), "reason": reason,
-            "failed_cases": ([] if getattr(trajectory, "failed", None) is None else
-                             np.flatnonzero(np.ravel(trajectory.failed)).tolist()),
+            "failed_cases": [] if failed is None else np.flatnonzero(np.ravel(failed)).tolist(),
             "sweep_column": sweep.column if sweep is not None else None,
             "sweep_label": sweep.label if sweep is not None else None,
             "sweep_values": list(sweep.values) if sweep is not None else None,
@@ -699,7 +701,8 @@ def save_trajectory(trajectory, path: str | os.PathLike, case: Case, *, complete
         raise ValueError(f"{path}: unknown trajectory format {path.suffix!r}; use one of "
                          f"{', '.join(TRAJECTORY_FORMATS)}")
     arrays = _trajectory_arrays(trajectory)
-    meta = _trajectory_meta(trajectory, case, complete, reason)
+    meta = _trajectory_meta(case, trajectory.batch_shape, trajectory.times.size - 1,
+                            getattr(trajectory, "failed", None), complete, reason)
     if suffix == ".npz":
         with write_atomic(path, "wb") as stream:
             np.savez(stream, **arrays, meta=np.array(json.dumps(meta)))
@@ -763,6 +766,183 @@ def _save_zarr(arrays: dict, meta: dict, path: Path) -> None:
         raise
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
+
+
+class TrajectoryStore:
+    """A trajectory written to a Zarr store while it is computed: runs too long to hold in
+    memory (an hour of a control loop at 1 kHz is 3.6 million steps), in a memory that does
+    not grow with the run, what one chunk of each array holds (about ``chunk_bytes``).
+
+    Parameters
+    ----------
+    path : str or path-like
+        A ``.zarr`` folder (needs ``softarm[sweep]``), read back by :func:`read_trajectory`
+        with the layout :func:`save_trajectory` writes. A store already there is replaced
+        at the first write.
+    case : Case, optional
+        The run's case, kept in the metadata as :func:`save_trajectory` keeps it; or
+    arm, loads :
+        the arm and every load of the run (the actuators' included), kept as a case.
+    every : int
+        Keep every ``every``-th time step of the run (its first time included); default 1.
+    chunk_bytes : int
+        The size of a chunk of the largest array (the rotations), default 4 MiB: the parts
+        appended are held until a chunk is full, then written.
+
+    :meth:`append` takes the run's parts in order, each a :class:`softarm.Trajectory` that
+    continues the last (its first time, when it is the last time stored, is left out: the
+    parts of ``Simulator.run`` called again and again, and those of
+    :func:`softarm.case.simulation_parts`, both fit). :meth:`close` writes what is held and
+    marks the file complete (or not, with a reason). Until then the store holds every chunk
+    written so far, marked incomplete ("the run did not close the store"): a crash keeps
+    them. As a context manager, an exception closes it incomplete, with the exception.
+
+    Examples
+    --------
+    >>> import softarm
+    >>> from softarm.case import simulation_parts
+    >>> with TrajectoryStore("swing.zarr", case, every=10) as store:  # doctest: +SKIP
+    ...     for part in simulation_parts(case):
+    ...         store.append(part)
+    """
+
+    def __init__(self, path: str | os.PathLike, case: Case | None = None, *, arm=None,
+                 loads=(), every: int = 1, chunk_bytes: int = 1 << 22):
+        from ._validate import count
+
+        self.path = Path(path)
+        if self.path.suffix.lower() != ".zarr":
+            raise ValueError(f"path must name a .zarr folder, got {str(path)!r}")
+        if self.path.exists() and not self.path.is_dir():
+            raise CaseError(f"{self.path}: exists and is not a folder (a Zarr store is a "
+                            "folder)")
+        try:
+            import xarray  # noqa: F401
+            import zarr  # noqa: F401
+        except ImportError as error:
+            raise CaseError(f"{self.path}: a .zarr output needs xarray and zarr "
+                            f"({error.name} is missing): pip install 'softarm[sweep]'") from None
+        if (case is None) == (arm is None):
+            raise TypeError("give case (a softarm Case) or arm (and loads), one of them: the "
+                            "file keeps what was simulated")
+        if case is None:  # (the case of an arm and loads, as save_result keeps a result's)
+            case = _parse({"name": "trajectory", **arm_to_dict(arm),
+                           "load": loads_to_dict(loads), **contact_to_dict(loads)}, None)
+        elif not isinstance(case, Case):
+            raise TypeError(f"case must be a softarm Case (its metadata are kept), got "
+                            f"{type(case).__name__}")
+        self.case = case
+        self.every = count(every, "every", 1)
+        self.chunk_bytes = count(chunk_bytes, "chunk_bytes", 1)
+        self.steps = -1  # the times stored (written or held), less one
+        self._next = 0  # the run's index of the next time appended
+        self._last_time = None
+        self._held: list[dict] = []  # parts' kept arrays, not yet written
+        self._held_times = 0
+        self._chunk = None  # the time chunk (set by the first part)
+        self._started = False  # the store exists (its first chunk written)
+        self._first = None  # the first part (batch shape, stations, contact)
+        self._failed = None
+        self.closed = False
+
+    def append(self, trajectory) -> None:
+        """Add the next part of the run (a :class:`softarm.Trajectory`)."""
+        if self.closed:
+            raise ValueError(f"{self.path}: the store is closed")
+        times = np.asarray(trajectory.times)
+        start = 1 if self._last_time is not None and times.size and \
+            times[0] == self._last_time else 0
+        if self._first is None:
+            self._first = trajectory
+            batch, S = trajectory.batch_shape, np.asarray(trajectory.s).size
+            per_time = 8 * 9 * S * int(np.prod(batch, dtype=np.int64))
+            self._chunk = max(1, self.chunk_bytes // per_time)
+        elif trajectory.batch_shape != self._first.batch_shape or \
+                np.asarray(trajectory.s).shape != np.asarray(self._first.s).shape:
+            raise ValueError(f"{self.path}: a part of batch shape {trajectory.batch_shape} "
+                             f"and {np.asarray(trajectory.s).size} stations does not continue "
+                             f"the run's ({self._first.batch_shape}, "
+                             f"{np.asarray(self._first.s).size})")
+        if times.size > start:
+            self._last_time = float(times[-1])
+        index = self._next + np.arange(times.size - start)
+        keep = start + np.flatnonzero(index % self.every == 0)
+        self._next += times.size - start
+        if getattr(trajectory, "failed", None) is not None:
+            failed = np.asarray(trajectory.failed, dtype=bool)
+            self._failed = failed if self._failed is None else self._failed | failed
+        if keep.size:
+            axis = len(trajectory.batch_shape)
+            arrays = _trajectory_arrays(trajectory)
+            self._held.append({name: np.take(array, keep, axis=0 if name == "times" else axis)
+                               if name != "s" else array for name, array in arrays.items()})
+            self._held_times += keep.size
+            self.steps += keep.size
+        if self._held_times >= self._chunk:
+            self._write(complete=False, reason=_UNCLOSED)
+
+    def close(self, complete: bool = True, reason: str = "") -> Path | None:
+        """Write what is held and the final metadata; the store's path, or None if no part
+        was appended (nothing is written)."""
+        if self.closed:
+            return self.path if self._started else None
+        self.closed = True
+        if self._first is None:
+            return None
+        self._write(complete=complete, reason=reason)
+        return self.path
+
+    def __enter__(self) -> TrajectoryStore:
+        return self
+
+    def __exit__(self, kind, error, traceback) -> None:
+        if error is None:
+            self.close()
+        else:
+            self.close(complete=False, reason=f"{kind.__name__}: {_brief(error)}"
+                       if str(error) else kind.__name__)
+
+    def _meta(self, complete: bool, reason: str) -> dict:
+        meta = _trajectory_meta(self.case, self._first.batch_shape, self.steps, self._failed,
+                                complete, reason)
+        meta["every"] = self.every
+        return meta
+
+    def _write(self, complete: bool, reason: str) -> None:
+        """Append the parts held (if any) and set the metadata."""
+        import zarr
+
+        meta = self._meta(complete, reason)
+        if not self._held:
+            group = zarr.open_group(str(self.path), mode="r+", zarr_format=2)
+            group.attrs.update({"complete": int(complete), "meta": json.dumps(meta)})
+            zarr.consolidate_metadata(str(self.path), zarr_format=2)
+            return
+        axis = len(self._first.batch_shape)
+        arrays = {name: np.concatenate([part[name] for part in self._held],
+                                       axis=0 if name == "times" else axis)
+                  for name in self._held[0] if name != "s"}
+        arrays["s"] = self._held[0]["s"]
+        self._held, self._held_times = [], 0
+        data = _dataset(arrays, meta)
+        if not self._started:
+            encoding = {name: {"chunks": tuple(self._chunk if dim == "time" else size
+                                               for dim, size in zip(variable.dims,
+                                                                    variable.shape,
+                                                                    strict=True))}
+                        for name, variable in data.variables.items() if "time" in variable.dims}
+            data.to_zarr(self.path, mode="w", zarr_format=2, consolidated=True,
+                         encoding=encoding)
+            self._started = True
+        else:
+            fixed = [name for name, variable in data.variables.items()
+                     if "time" not in variable.dims]
+            data.drop_vars(fixed).to_zarr(self.path, append_dim="time", zarr_format=2,
+                                          consolidated=True)
+
+
+#: A store's reason until it is closed (a crash leaves it so).
+_UNCLOSED = "the run did not close the store (it stopped, or is still running)"
 
 
 def _write_trajectory_csv(stream, arrays: dict, meta: dict) -> None:
