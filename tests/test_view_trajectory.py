@@ -224,3 +224,28 @@ def test_trajectory_show_writes_the_motions_page(tmp_path):
     text = page.read_text(encoding="utf-8")
     assert page == tmp_path / "motion.html" and "softarm-view" in text
     assert f"{path.times[-1]:g}" in text  # the slider's last time
+
+
+def test_a_saved_trajectory_in_contact_shows_its_cases_obstacles(tmp_path):
+    """Issue 39: a trajectory file read back has no contact law of its own (a live
+    Trajectory's ``contact``), and its page drew no obstacle. It takes its case's now: the
+    same obstacle traces as the live trajectory's page (the obstacles are not saved
+    apart: the case in the file holds them)."""
+    from softarm.case import join_trajectories, simulation_parts
+
+    case = saved_case(tmp_path, CASE.replace("duration = 0.3", "duration = 0.02") + """
+[[obstacle]]
+kind = "plane"
+point = [0.0, 0.0, -0.03]
+normal = [0.0, 0.0, 1.0]
+""")
+    live = join_trajectories(list(simulation_parts(case)))
+    io.save_trajectory(live, tmp_path / "drop.npz", case)
+    page = view.view_trajectory_file(io.read_trajectory(tmp_path / "drop.npz"),
+                                     tmp_path / "drop.html")
+    fig = json.loads(view.to_json(view.trajectory_figure(live, arm=case.arm)))
+    obstacles = [t for t in fig["data"] if t["name"].startswith("obstacle")]
+    assert [t["name"] for t in obstacles] == ["obstacle 1: plane"]
+    html = page.read_text(encoding="utf-8")
+    assert html.count('"name":"obstacle 1: plane"') == 1
+    assert '"name":"obstacle' in view.to_html(view.trajectory_figure(live, arm=case.arm))

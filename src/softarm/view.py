@@ -903,7 +903,8 @@ def _pose_traces(poses, s, rings, length: float) -> list[dict]:
 
 
 def trajectory_figure(trajectory, *, arm=None, radii=None, name: str | None = None,
-                      frames: int = TRAJECTORY_FRAMES, height: int | None = 650) -> dict:
+                      frames: int = TRAJECTORY_FRAMES, height: int | None = 650,
+                      contact=None) -> dict:
     """The plotly figure of a motion: a dict with ``data``, ``layout``, ``frames`` (the
     moving traces at the shown times) and ``energy`` (the energy plot, a figure of its own),
     drawn by :func:`to_html`'s page with a time slider, play and pause and a choice of
@@ -927,6 +928,9 @@ def trajectory_figure(trajectory, *, arm=None, radii=None, name: str | None = No
         tip path and energy curves keep every k-th time, at most 4000.
     height : int or None
         As :func:`figure`'s.
+    contact : Contact, optional
+        Its obstacles are drawn; default the trajectory's own (``Trajectory.contact``; a
+        file read back keeps its case's instead: :func:`view_trajectory_file`).
     """
     times, s, poses, energies = _trajectory_arrays(trajectory)
     shown = frame_indices(times, frames)
@@ -950,7 +954,9 @@ def trajectory_figure(trajectory, *, arm=None, radii=None, name: str | None = No
                  "hovertemplate": "tip at t = %{customdata:.4g} s<br>(%{x:.4g}, %{y:.4g}, "
                                   "%{z:.4g}) m<extra></extra>"})
     data.append(_cube_anchor(centre, half))
-    contact = getattr(trajectory, "contact", None)  # (its obstacles stay: not in the frames)
+    if contact is None:
+        contact = getattr(trajectory, "contact", None)
+    # (the obstacles stay: not in the frames)
     data += _obstacle_traces([] if contact is None else [contact], centre, half)
     head = name or "softarm"
     duration = times[-1] - times[0]
@@ -1050,8 +1056,9 @@ def write_trajectory_html(trajectory, path: str | os.PathLike, **options) -> Pat
 def view_trajectory_file(saved, path: str | os.PathLike, *, case: int | None = None) -> Path:
     """:func:`write_trajectory_html` for a trajectory file read by
     :func:`softarm.io.read_trajectory` (``saved``, a :class:`softarm.io.SavedTrajectory`):
-    the tube of its case's arm, titled with the case's name; of a sweep of simulations, case
-    number ``case`` (counted from 1; default 1), with its parameter in the title."""
+    the tube of its case's arm and its case's obstacles, titled with the case's name; of a
+    sweep of simulations, case number ``case`` (counted from 1; default 1), with its
+    parameter in the title."""
     import dataclasses
 
     if isinstance(saved, (str, os.PathLike)):
@@ -1076,4 +1083,6 @@ def view_trajectory_file(saved, path: str | os.PathLike, *, case: int | None = N
     elif case not in (None, 1):
         raise ValueError(f"{saved.path}: case must be 1 (the file holds one simulation), got "
                          f"{case!r}")
-    return write_trajectory_html(saved, path, arm=saved.case.arm, name=name)
+    contacts = [load for load in saved.case.loads if load.kind == "contact"]
+    return write_trajectory_html(saved, path, arm=saved.case.arm, name=name,
+                                 contact=contacts[0] if contacts else None)
