@@ -417,3 +417,41 @@ def test_a_forward_solvers_equilibrium_in_contact_has_its_contact_wrench():
     with pytest.raises(ValueError, match=r"contact_wrench: its stations must run from the "
                                          r"base to the tip .* got 1 from"):
         _ = tip_only.equilibrium().contact_wrench
+
+
+@pytest.mark.slow  # (five solves of the finger in contact, 1-3 s each)
+def test_a_chained_solver_starts_at_the_stiffest_law_it_needed(monkeypatch):
+    """Issue 39 (the app's redraw): the finger of examples/gripper_finger.toml penetrates
+    its cylinder at the estimated penalty, and every slider move was solved twice, the
+    second time stiffer. A chained Solver keeps the stiffest law a case needed and starts
+    the next one there: one solve a move. Its answer is that of the same law given
+    explicitly (Contact(stiffness, distance), softarm.solve: the reference), and its law
+    only grows."""
+    from softarm.case import load_case
+    from softarm.statics import Solver
+    from softarm.statics import solver as solver_module
+
+    case = load_case(Path(__file__).parents[1] / "examples" / "gripper_finger.toml")
+    tendon, cylinder = case.loads
+    retries = []
+    penetration = solver_module._penetration
+    monkeypatch.setattr(solver_module, "_penetration",
+                        lambda *args: retries.append(penetration(*args)) or retries[-1])
+    solver = Solver(case.arm, s=21, tol=1e-6)
+    first = solver.solve([tendon.replace(tension=15.0), cylinder])
+    kept = first.loads[-1]
+    assert any(r is not None for r in retries)  # (the premise: raised once)
+    retries.clear()
+    moved = solver.solve([tendon.replace(tension=13.0), cylinder])
+    assert all(r is None for r in retries)  # one solve: no penetration at the kept law
+    law = moved.loads[-1]
+    assert law.stiffness == kept.stiffness and law.distance == kept.distance
+    given = sa.solve(case.arm, [tendon.replace(tension=13.0),
+                                cylinder.replace(stiffness=law.stiffness,
+                                                 distance=law.distance)], s=21, tol=1e-6)
+    np.testing.assert_allclose(moved.positions, given.positions, rtol=0, atol=1e-12)
+    # another Contact (the cylinder moved): its own estimate again
+    other = cylinder.replace(obstacles=(sa.Capsule((0.06, -0.05, -0.046),
+                                                   (0.06, 0.05, -0.046), 0.03),))
+    assert solver.solve([tendon.replace(tension=13.0), other]).loads[-1].stiffness != \
+        kept.stiffness

@@ -214,6 +214,13 @@ _NO_CONTACT = (np.zeros((0, 8)), np.zeros((1, 5)))
 _CONTACT_RETRIES = 4
 
 
+def _contact_key(load) -> tuple:
+    """What makes a Contact (as given, before the solver sets its law) the same one for
+    a kept penalty (Solver._kept_law): its obstacles and settings."""
+    return (tuple(tuple(obstacle.kernel_row()) for obstacle in load.obstacles),
+            load.distance, load.radius, load.friction, load.slip_velocity)
+
+
 def _penetration(solver, contact, gaps, forces, attempt: int,
                  given: bool) -> np.ndarray | None:
     """None if no station of the solved cases (their ``gaps`` (B, S) and contact ``forces``
@@ -1170,6 +1177,9 @@ class Solver:
                              f"{shooting!r}")
         self.shooting = shooting
         self._coarse_ratio = 4  # the path runs on N / 4 steps (benchmarks/run.py measures it)
+        # (the Contact as given, the stiffness it needed): the stiffest penalty a chained
+        # single case needed after a penetration, its next solves' start (_solve)
+        self._kept_law = None
         self.reset()
 
     def _stiff(self, loads, channels) -> np.ndarray:
@@ -1333,6 +1343,16 @@ class Solver:
         stiffness, attempt, widened = contact_retry or (None, 0, 0)
         contact = channels.resolve_contact(stiffness) \
             if channels.contact_load is not None else None
+        kept = self._kept_law
+        if contact is not None and stiffness is None and chained and count == 1 and \
+                kept is not None and kept[0] == _contact_key(channels._contact_given) and \
+                kept[1] > contact.stiffness:
+            # A chained case starts at the stiffest penalty the last ones needed: its
+            # estimate (from the loads' size) let the finger of examples/gripper_finger.toml
+            # into the cylinder at every slider move of the app, and each move was solved
+            # twice, the second time stiffer (2.5 s; 1.0 s from the kept law). The law only
+            # grows, as in the dynamics (contact.md); the Equilibrium's Contact says which.
+            contact = channels.resolve_contact(np.array([kept[1]]))
         given_loads = loads  # (a retry starts from them: their Contact as the user gave it)
         if contact is not None:
             if contact_retry is None:  # (a retry solves the same arm from the same start)
@@ -1446,6 +1466,11 @@ class Solver:
         if chained and count:
             self._last = (pieces[0], channels.piece[-1].copy(), channels.tip_loads[-1].copy(),
                           channels.signature())
+        if contact is not None and count == 1 and attempt > 0:
+            # (raised after a penetration: kept for the next chained case; a stiff route's
+            # retry runs unchained, from the unloaded arm)
+            self._kept_law = (_contact_key(channels._contact_given),
+                              float(np.max(contact.stiffness)))
         if not outputs:
             return None
         tip_compliance = compliance = None
