@@ -257,6 +257,13 @@ def test_a_zarr_output_alone_is_written_as_the_run_goes(small, capsys, monkeypat
     assert run(capsys, "simulate", path, "-o", kept)[0] == 0
     both = read_trajectory(kept)
     np.testing.assert_allclose(back.energy.total, both.energy.total, rtol=1e-6, atol=1e-12)
+    # --every 3: every third time, streamed or kept (the first included: t = 0 ... 0.018 s)
+    for name in ("third.zarr", "third.npz"):
+        assert run(capsys, "simulate", path, "-o", folder / name, "--every", "3")[0] == 0
+        third = read_trajectory(folder / name)
+        np.testing.assert_allclose(third.times, expected.times[::3], rtol=0, atol=1e-17)
+        np.testing.assert_allclose(third.positions, expected.positions[::3], rtol=0,
+                                   atol=1e-9)
     # Ctrl-C after the first part: the store holds it, marked incomplete
     monkeypatch.setattr(cli._Progress, "__call__", _interrupt)
     code, _stdout, stderr = run(capsys, "simulate", path, "-o", folder / "stopped.zarr")
@@ -390,6 +397,10 @@ def test_an_interrupt_before_any_step_writes_nothing(small, capsys, monkeypatch)
     (SIMULATE, ["-o", "{dir}/out.txt"], "unknown trajectory format '.txt'; use one of .npz, "
      ".zarr, .csv"),
     (SIMULATE, ["-o", "{dir}/missing/out.npz"], "does not exist"),
+    (SIMULATE, ["-o", "{dir}/out.npz", "--every", "0"], "argument --every: must be >= 1, "
+     "got 0"),
+    (SIMULATE, ["-o", "{dir}/out.zarr", "--every", "2.5"], "argument --every: must be an "
+     "integer, got '2.5'"),
     (SIMULATE.replace("dt = 0.001", "dt = -0.001"), ["-o", "{dir}/out.npz"],
      "simulate.dt: must be a positive number of s, got -0.001"),
     # issue 42: an arm that starts inside an obstacle, as `softarm solve` says it (it was

@@ -824,9 +824,10 @@ def _from(trajectory: Trajectory, start: int) -> Trajectory:
     return join_trajectories([trajectory], start)
 
 
-def join_trajectories(parts, start: int = 0) -> Trajectory:
+def join_trajectories(parts, start: int = 0, every: int = 1) -> Trajectory:
     """Consecutive trajectories (each starting where the last ended, without repeating its
-    time) as one, from time index ``start`` of the first on; the final state is the last's."""
+    time) as one, from time index ``start`` of the first on, every ``every``-th time; the
+    final state is the last's."""
     parts = list(parts)
     if not parts:
         raise ValueError("join_trajectories: no trajectory given")
@@ -834,7 +835,7 @@ def join_trajectories(parts, start: int = 0) -> Trajectory:
 
     def cat(arrays, axis=axis):
         array = np.concatenate([np.asarray(a) for a in arrays], axis=axis)
-        array = array[(slice(None),) * axis + (slice(start, None),)]
+        array = array[(slice(None),) * axis + (slice(start, None, every),)]
         array.setflags(write=False)
         return array
 

@@ -105,7 +105,7 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")
 
 
-def _stations(text: str) -> int:
+def _integer(text: str, least: int) -> int:
     try:
         value = int(text)
     except ValueError:
@@ -116,9 +116,17 @@ def _stations(text: str) -> int:
         if number is None or not number.is_integer():
             raise argparse.ArgumentTypeError(f"must be an integer, got {text!r}") from None
         value = int(number)
-    if value < 2:
-        raise argparse.ArgumentTypeError(f"must be >= 2, got {value}")
+    if value < least:
+        raise argparse.ArgumentTypeError(f"must be >= {least}, got {value}")
     return value
+
+
+def _stations(text: str) -> int:
+    return _integer(text, 2)
+
+
+def _every(text: str) -> int:
+    return _integer(text, 1)
 
 
 def _tolerance(text: str) -> float:
@@ -189,6 +197,9 @@ def _parser() -> argparse.ArgumentParser:
     simulate.add_argument("--plot", metavar="PICTURE",
                           help="draw snapshots, the tip's path and the energies (.png, .pdf, "
                           ".svg)")
+    simulate.add_argument("--every", type=_every, default=1, metavar="K",
+                          help="keep every K-th time step in the outputs (the first time "
+                          "included; default 1: every step)")
     simulate.set_defaults(run=_run_simulate)
 
     critical = commands.add_parser(
@@ -665,7 +676,8 @@ def _run_simulate(args) -> int:
     # the parts are kept and joined, and written at the end
     streamed = bool(outputs) and picture is None and \
         all(out.suffix.lower() == ".zarr" for out in outputs)
-    stores = [TrajectoryStore(out, case) for out in outputs] if streamed else []
+    stores = [TrajectoryStore(out, case, every=args.every) for out in outputs] \
+        if streamed else []
     progress = _Progress(label="simulating", unit="steps")
     parts, figures, done, stopped = [], _RunFigures(), 0, None
     start = time.perf_counter()
@@ -701,9 +713,12 @@ def _run_simulate(args) -> int:
     for store in stores:
         store.close(complete=stopped is None, reason=reason)
     if not streamed:
-        trajectory = join_trajectories(parts)
+        trajectory = join_trajectories(parts)  # (the picture: every step)
+        kept = trajectory if args.every == 1 else join_trajectories([trajectory],
+                                                                   every=args.every)
         for out in outputs:
-            save_trajectory(trajectory, out, case, complete=stopped is None, reason=reason)
+            save_trajectory(kept, out, case, complete=stopped is None, reason=reason,
+                            every=args.every)
         if picture is not None:
             from . import plot
 

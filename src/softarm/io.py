@@ -665,11 +665,12 @@ def _trajectory_arrays(trajectory) -> dict:
 
 
 def _trajectory_meta(case: Case, batch_shape: tuple, steps: int, failed, complete: bool,
-                     reason: str) -> dict:
-    """A trajectory file's metadata: ``failed`` the failed cases' mask (or None)."""
+                     reason: str, every: int = 1) -> dict:
+    """A trajectory file's metadata: ``failed`` the failed cases' mask (or None); ``steps``
+    the steps stored, every ``every``-th of the run's."""
     sweep = case.sweep
     return {"softarm_version": __version__, "kind": "trajectory", "name": case.name,
-            "batch_shape": list(batch_shape), "steps": int(steps),
+            "batch_shape": list(batch_shape), "steps": int(steps), "every": int(every),
             "steps_requested": int(case.simulation.steps) if case.simulation else None,
             "complete": bool(complete), "reason": reason,
             "failed_cases": [] if failed is None else np.flatnonzero(np.ravel(failed)).tolist(),
@@ -681,7 +682,7 @@ def _trajectory_meta(case: Case, batch_shape: tuple, steps: int, failed, complet
 
 
 def save_trajectory(trajectory, path: str | os.PathLike, case: Case, *, complete: bool = True,
-                    reason: str = "") -> Path:
+                    reason: str = "", every: int = 1) -> Path:
     """Write a :class:`softarm.Trajectory` of ``case`` to ``path``; the suffix chooses the
     format (``.npz``, ``.zarr`` (a folder; needs ``softarm[sweep]``) or ``.csv``).
 
@@ -693,7 +694,8 @@ def save_trajectory(trajectory, path: str | os.PathLike, case: Case, *, complete
     ``# case:`` JSON lines), a header and one row per (case, time, station)
     (:data:`TRAJECTORY_COLUMNS`). Every format is written to a temporary name beside
     ``path`` and renamed: no half-written output. ``complete=False`` (with a ``reason``)
-    marks a run that stopped early.
+    marks a run that stopped early; ``every``: the trajectory holds every ``every``-th
+    time step of the run (its metadata say so).
     """
     path = Path(path)
     suffix = path.suffix.lower()
@@ -702,7 +704,7 @@ def save_trajectory(trajectory, path: str | os.PathLike, case: Case, *, complete
                          f"{', '.join(TRAJECTORY_FORMATS)}")
     arrays = _trajectory_arrays(trajectory)
     meta = _trajectory_meta(case, trajectory.batch_shape, trajectory.times.size - 1,
-                            getattr(trajectory, "failed", None), complete, reason)
+                            getattr(trajectory, "failed", None), complete, reason, every)
     if suffix == ".npz":
         with write_atomic(path, "wb") as stream:
             np.savez(stream, **arrays, meta=np.array(json.dumps(meta)))
@@ -903,10 +905,8 @@ class TrajectoryStore:
                        if str(error) else kind.__name__)
 
     def _meta(self, complete: bool, reason: str) -> dict:
-        meta = _trajectory_meta(self.case, self._first.batch_shape, self.steps, self._failed,
-                                complete, reason)
-        meta["every"] = self.every
-        return meta
+        return _trajectory_meta(self.case, self._first.batch_shape, self.steps,
+                                self._failed, complete, reason, self.every)
 
     def _write(self, complete: bool, reason: str) -> None:
         """Append the parts held (if any) and set the metadata."""
