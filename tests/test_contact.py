@@ -450,6 +450,9 @@ def test_a_chained_solver_starts_at_the_stiffest_law_it_needed(monkeypatch):
                                 cylinder.replace(stiffness=law.stiffness,
                                                  distance=law.distance)], s=21, tol=1e-6)
     np.testing.assert_allclose(moved.positions, given.positions, rtol=0, atol=1e-12)
+    # a stiffness the user gives is theirs, never the kept one (softer, it penetrates)
+    with pytest.raises(sa.ConvergenceError, match=r"the given Contact\(stiffness=1e\+09\)"):
+        solver.solve([tendon.replace(tension=13.0), cylinder.replace(stiffness=1e9)])
     # another Contact (the cylinder moved): its own estimate again
     other = cylinder.replace(obstacles=(sa.Capsule((0.06, -0.05, -0.046),
                                                    (0.06, 0.05, -0.046), 0.03),))

@@ -843,7 +843,7 @@ class TrajectoryStore:
         self._held_times = 0
         self._chunk = None  # the time chunk (set by the first part)
         self._started = False  # the store exists (its first chunk written)
-        self._first = None  # the first part (batch shape, stations, contact)
+        self._shape = None  # the run's (batch shape, stations), from its first part
         self._failed = None
         self.closed = False
 
@@ -854,17 +854,15 @@ class TrajectoryStore:
         times = np.asarray(trajectory.times)
         start = 1 if self._last_time is not None and times.size and \
             times[0] == self._last_time else 0
-        if self._first is None:
-            self._first = trajectory
-            batch, S = trajectory.batch_shape, np.asarray(trajectory.s).size
-            per_time = 8 * 9 * S * int(np.prod(batch, dtype=np.int64))
+        shape = (tuple(trajectory.batch_shape), np.asarray(trajectory.s).size)
+        if self._shape is None:
+            self._shape = shape
+            per_time = 8 * 9 * shape[1] * int(np.prod(shape[0], dtype=np.int64))
             self._chunk = max(1, self.chunk_bytes // per_time)
-        elif trajectory.batch_shape != self._first.batch_shape or \
-                np.asarray(trajectory.s).shape != np.asarray(self._first.s).shape:
-            raise ValueError(f"{self.path}: a part of batch shape {trajectory.batch_shape} "
-                             f"and {np.asarray(trajectory.s).size} stations does not continue "
-                             f"the run's ({self._first.batch_shape}, "
-                             f"{np.asarray(self._first.s).size})")
+        elif shape != self._shape:
+            raise ValueError(f"{self.path}: a part of batch shape {shape[0]} and {shape[1]} "
+                             f"stations does not continue the run's ({self._shape[0]}, "
+                             f"{self._shape[1]})")
         if times.size > start:
             self._last_time = float(times[-1])
         index = self._next + np.arange(times.size - start)
@@ -889,7 +887,7 @@ class TrajectoryStore:
         if self.closed:
             return self.path if self._started else None
         self.closed = True
-        if self._first is None:
+        if self._shape is None:
             return None
         self._write(complete=complete, reason=reason)
         return self.path
@@ -905,8 +903,8 @@ class TrajectoryStore:
                        if str(error) else kind.__name__)
 
     def _meta(self, complete: bool, reason: str) -> dict:
-        return _trajectory_meta(self.case, self._first.batch_shape, self.steps,
-                                self._failed, complete, reason, self.every)
+        return _trajectory_meta(self.case, self._shape[0], self.steps, self._failed,
+                                complete, reason, self.every)
 
     def _write(self, complete: bool, reason: str) -> None:
         """Append the parts held (if any) and set the metadata."""
@@ -918,7 +916,7 @@ class TrajectoryStore:
             group.attrs.update({"complete": int(complete), "meta": json.dumps(meta)})
             zarr.consolidate_metadata(str(self.path), zarr_format=2)
             return
-        axis = len(self._first.batch_shape)
+        axis = len(self._shape[0])
         arrays = {name: np.concatenate([part[name] for part in self._held],
                                        axis=0 if name == "times" else axis)
                   for name in self._held[0] if name != "s"}

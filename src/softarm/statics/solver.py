@@ -216,9 +216,10 @@ _CONTACT_RETRIES = 4
 
 def _contact_key(load) -> tuple:
     """What makes a Contact (as given, before the solver sets its law) the same one for
-    a kept penalty (Solver._kept_law): its obstacles and settings."""
+    a kept penalty (Solver._kept_law): its obstacles and settings (a stiffness the user
+    gives among them: theirs is never replaced)."""
     return (tuple(tuple(obstacle.kernel_row()) for obstacle in load.obstacles),
-            load.distance, load.radius, load.friction, load.slip_velocity)
+            load.distance, load.radius, load.stiffness, load.friction, load.slip_velocity)
 
 
 def _penetration(solver, contact, gaps, forces, attempt: int,
