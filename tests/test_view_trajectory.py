@@ -227,25 +227,38 @@ def test_trajectory_show_writes_the_motions_page(tmp_path):
 
 
 def test_a_saved_trajectory_in_contact_shows_its_cases_obstacles(tmp_path):
-    """Issue 39: a trajectory file read back has no contact law of its own (a live
-    Trajectory's ``contact``), and its page drew no obstacle. It takes its case's now: the
-    same obstacle traces as the live trajectory's page (the obstacles are not saved
-    apart: the case in the file holds them)."""
+    """Issue 39: a trajectory file read back had no contact law (a live Trajectory's
+    ``contact``): its page drew no obstacle and its total energy dipped at each impact by
+    the penalty's stored energy, which it could not compute. The file keeps the law now:
+    the gaps, forces and stored energy read back are the live trajectory's, and the page
+    draws the obstacles and the same energy curves as the live trajectory's page."""
     from softarm.case import join_trajectories, simulation_parts
 
-    case = saved_case(tmp_path, CASE.replace("duration = 0.3", "duration = 0.02") + """
+    case = saved_case(tmp_path, CASE.replace("duration = 0.3", "duration = 0.1") + """
 [[obstacle]]
 kind = "plane"
-point = [0.0, 0.0, -0.03]
+point = [0.0, 0.0, -0.025]
 normal = [0.0, 0.0, 1.0]
 """)
     live = join_trajectories(list(simulation_parts(case)))
-    io.save_trajectory(live, tmp_path / "drop.npz", case)
-    page = view.view_trajectory_file(io.read_trajectory(tmp_path / "drop.npz"),
-                                     tmp_path / "drop.html")
+    assert live.contact_energy.max() > 0.0  # (the premise: it lands)
+    for name in ("drop.npz", "drop.zarr", "drop.csv"):
+        # the file keeps the law the steps used: the contact's gaps, forces and stored
+        # energy read back are the live trajectory's, to the bit
+        io.save_trajectory(live, tmp_path / name, case)
+        back = io.read_trajectory(tmp_path / name)
+        assert back.contact.stiffness == live.contact.stiffness
+        assert back.contact.distance == live.contact.distance
+        assert np.array_equal(back.contact_energy, live.contact_energy), name
+        assert np.array_equal(back.contact_wrench, live.contact_wrench), name
+    page = view.view_trajectory_file(back, tmp_path / "drop.html")
     fig = json.loads(view.to_json(view.trajectory_figure(live, arm=case.arm)))
     obstacles = [t for t in fig["data"] if t["name"].startswith("obstacle")]
     assert [t["name"] for t in obstacles] == ["obstacle 1: plane"]
     html = page.read_text(encoding="utf-8")
     assert html.count('"name":"obstacle 1: plane"') == 1
-    assert '"name":"obstacle' in view.to_html(view.trajectory_figure(live, arm=case.arm))
+    # and its energy plot holds the penalty's stored energy, as the live page's does
+    energy = [t["name"] for t in fig["energy"]["data"]]
+    assert any("contact" in name for name in energy)
+    for name in energy:
+        assert f'"name":"{name}"' in html, name

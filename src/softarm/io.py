@@ -132,9 +132,9 @@ def _contact_law(loads) -> dict | None:
     return None
 
 
-def _with_contact_law(loads: tuple, law, path) -> tuple:
+def _with_contact_law(loads: tuple, law, path, kind: str = "softarm result file") -> tuple:
     """``loads`` with the Contact's law set to ``law`` (:func:`_contact_law`'s, read from the
-    file ``path``: CaseError if it is not one)."""
+    file ``path``, a ``kind``: CaseError if it is not one)."""
     if law is None:
         return loads
     try:
@@ -143,8 +143,7 @@ def _with_contact_law(loads: tuple, law, path) -> tuple:
         return tuple(load.replace(**law) if isinstance(load, Contact) else load
                      for load in loads)
     except (TypeError, ValueError) as error:
-        raise CaseError(f"{path}: not a softarm result file ('contact' {_brief(error)})"
-                        ) from None
+        raise CaseError(f"{path}: not a {kind} ('contact' {_brief(error)})") from None
 
 
 def _saved_contact_wrench(value, batch, path) -> np.ndarray | None:
@@ -630,6 +629,13 @@ class SavedTrajectory(Trajectories):
     version : str
         softarm version that wrote the file.
     path : pathlib.Path
+    contact : Contact or None
+        The case's Contact with the law the steps used (its stiffness and distance, kept in
+        the file), for ``gaps``, ``contact_forces``, ``contact_wrench`` and
+        ``contact_energy`` as a Trajectory's; None without contact, or for a file written
+        before the law was kept.
+    contact_radii : ndarray, shape (S,), or None
+        The arm's surface radius at each station (m).
     """
 
     times: np.ndarray
@@ -652,6 +658,8 @@ class SavedTrajectory(Trajectories):
     sweep_label: str | None
     version: str
     path: Path
+    contact: object = None
+    contact_radii: np.ndarray | None = None
 
 
 def _trajectory_arrays(trajectory) -> dict:
@@ -665,11 +673,14 @@ def _trajectory_arrays(trajectory) -> dict:
 
 
 def _trajectory_meta(case: Case, batch_shape: tuple, steps: int, failed, complete: bool,
-                     reason: str, every: int = 1) -> dict:
+                     reason: str, every: int = 1, contact=None) -> dict:
     """A trajectory file's metadata: ``failed`` the failed cases' mask (or None); ``steps``
-    the steps stored, every ``every``-th of the run's."""
+    the steps stored, every ``every``-th of the run's; ``contact`` the law the steps used
+    (``Trajectory.contact``: its stiffness and distance are kept, for the contact's gaps,
+    forces and stored energy read back)."""
     sweep = case.sweep
     return {"softarm_version": __version__, "kind": "trajectory", "name": case.name,
+            "contact": None if contact is None else _contact_law([contact]),
             "batch_shape": list(batch_shape), "steps": int(steps), "every": int(every),
             "steps_requested": int(case.simulation.steps) if case.simulation else None,
             "complete": bool(complete), "reason": reason,
@@ -704,7 +715,8 @@ def save_trajectory(trajectory, path: str | os.PathLike, case: Case, *, complete
                          f"{', '.join(TRAJECTORY_FORMATS)}")
     arrays = _trajectory_arrays(trajectory)
     meta = _trajectory_meta(case, trajectory.batch_shape, trajectory.times.size - 1,
-                            getattr(trajectory, "failed", None), complete, reason, every)
+                            getattr(trajectory, "failed", None), complete, reason, every,
+                            getattr(trajectory, "contact", None))
     if suffix == ".npz":
         with write_atomic(path, "wb") as stream:
             np.savez(stream, **arrays, meta=np.array(json.dumps(meta)))
@@ -844,6 +856,7 @@ class TrajectoryStore:
         self._chunk = None  # the time chunk (set by the first part)
         self._started = False  # the store exists (its first chunk written)
         self._shape = None  # the run's (batch shape, stations), from its first part
+        self._contact = None  # the contact law of its steps (the first part's)
         self._failed = None
         self.closed = False
 
@@ -857,6 +870,7 @@ class TrajectoryStore:
         shape = (tuple(trajectory.batch_shape), np.asarray(trajectory.s).size)
         if self._shape is None:
             self._shape = shape
+            self._contact = getattr(trajectory, "contact", None)
             per_time = 8 * 9 * shape[1] * int(np.prod(shape[0], dtype=np.int64))
             self._chunk = max(1, self.chunk_bytes // per_time)
         elif shape != self._shape:
@@ -904,7 +918,7 @@ class TrajectoryStore:
 
     def _meta(self, complete: bool, reason: str) -> dict:
         return _trajectory_meta(self.case, self._shape[0], self.steps, self._failed,
-                                complete, reason, self.every)
+                                complete, reason, self.every, self._contact)
 
     def _write(self, complete: bool, reason: str) -> None:
         """Append the parts held (if any) and set the metadata."""
@@ -1031,6 +1045,14 @@ def read_trajectory(path: str | os.PathLike) -> SavedTrajectory:
                 raise CaseError(f"{path}: not a valid softarm trajectory: {name!r} has shape "
                                 f"{array.shape}, expected {shape}")
         case = _parse(meta["case"], path)
+        contact = radii = None
+        if meta.get("contact") is not None:
+            laws = [load for load in _with_contact_law(case.loads, meta["contact"], path,
+                                                       "softarm trajectory")
+                    if isinstance(load, Contact)]
+            if laws:
+                contact = laws[0]
+                radii = contact.station_radii(case.arm, arrays["s"])
     except CaseError:
         raise
     except KeyError as error:
@@ -1051,7 +1073,7 @@ def read_trajectory(path: str | os.PathLike) -> SavedTrajectory:
         reason=str(meta.get("reason", "")),
         sweep_values=None if sweep is None else np.asarray(sweep, dtype=float),
         sweep_label=meta.get("sweep_label"), version=str(meta.get("softarm_version", "")),
-        path=path)
+        path=path, contact=contact, contact_radii=radii)
 
 
 def _read_trajectory_csv(path: Path) -> tuple[dict, dict]:

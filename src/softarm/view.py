@@ -1074,15 +1074,21 @@ def view_trajectory_file(saved, path: str | os.PathLike, *, case: int | None = N
             raise ValueError(f"{saved.path}: case must be 1 ... {batch[0]} (the file holds "
                              f"{batch[0]} simulations), got {case!r}")
         energy = saved.energy
+        law = saved.contact
+        if law is not None and np.ndim(law.stiffness):  # (each case's own penalty)
+            law = law.replace(stiffness=float(np.ravel(law.stiffness)[k - 1]))
         saved = dataclasses.replace(
             saved, positions=saved.positions[k - 1], rotations=saved.rotations[k - 1],
-            energy=type(energy)(*(getattr(energy, n)[k - 1] for n, _ in _ENERGIES[:4])))
+            energy=type(energy)(*(getattr(energy, n)[k - 1] for n, _ in _ENERGIES[:4])),
+            contact=law)
         label = saved.sweep_label or "case"
         value = saved.sweep_values[k - 1] if saved.sweep_values is not None else k
         name = f"{name} ({label} = {value:.6g})"
     elif case not in (None, 1):
         raise ValueError(f"{saved.path}: case must be 1 (the file holds one simulation), got "
                          f"{case!r}")
+    # (a file written before its contact law was kept: its case's obstacles, no stored
+    # energy)
     contacts = [load for load in saved.case.loads if load.kind == "contact"]
     return write_trajectory_html(saved, path, arm=saved.case.arm, name=name,
-                                 contact=contacts[0] if contacts else None)
+                                 contact=saved.contact or (contacts[0] if contacts else None))

@@ -100,11 +100,51 @@ class State(AlongTheArm):
 
 
 class Trajectories(AlongTheArm):
-    """What a trajectory and a saved one share: the batch shape of (B..., T, S, 3)."""
+    """What a trajectory and a saved one share: the batch shape of (B..., T, S, 3), and the
+    contact's gaps, forces and stored energy (from ``contact``, the law the steps used, and
+    ``contact_radii``; None without contact)."""
+
+    s: np.ndarray
+    contact: object
+    contact_radii: np.ndarray | None
 
     @property
     def batch_shape(self) -> tuple[int, ...]:
         return self.positions.shape[:-3]
+
+    @property
+    def gaps(self) -> np.ndarray:
+        """(B..., T, S): the distance from the arm's surface to the nearest obstacle, m (inf
+        without a Contact)."""
+        return self._contact_state()[0]
+
+    @property
+    def contact_forces(self) -> np.ndarray:
+        """(B..., T, S, 3): the obstacles' normal force per length on the arm, N/m, spatial
+        (Coulomb friction, which acted in the steps, is not included; docs/contact.md)."""
+        return self._contact_state()[1]
+
+    @property
+    def contact_wrench(self) -> np.ndarray:
+        """(B..., T, 6): the total normal contact force (N) and its moment about the origin
+        (N m), integrated over the stations (:func:`softarm.contact.resultant`)."""
+        return resultant(self.s, self.positions, self.contact_forces)
+
+    @property
+    def contact_energy(self) -> np.ndarray:
+        """(B..., T): the energy the contact's penalty stores, ∫ Φ(g) ds over the stations
+        (J; zero without a Contact): what :class:`Energy`'s total leaves out while the arm
+        presses on an obstacle (docs/contact.md)."""
+        if self.contact is None:
+            return np.zeros(self.positions.shape[:-2])
+        k = np.asarray(self.contact.stiffness)
+        k = k.reshape(k.shape + (1,) * (self.positions.ndim - 1 - k.ndim)) if k.ndim else k
+        per_length = penalty_energy(self.gaps, self.contact.distance, k)
+        ds = np.diff(self.s)
+        return (0.5 * (per_length[..., 1:] + per_length[..., :-1]) * ds).sum(-1)
+
+    def _contact_state(self):
+        return along_the_arm(self.contact, self.contact_radii, self.positions, inner=1)
 
 
 @dataclass(frozen=True, eq=False)
@@ -159,40 +199,6 @@ class Trajectory(Trajectories):
     failed: np.ndarray | None = None
     contact: object = None
     contact_radii: np.ndarray | None = None
-
-    @property
-    def gaps(self) -> np.ndarray:
-        """(B..., T, S): the distance from the arm's surface to the nearest obstacle, m (inf
-        without a Contact)."""
-        return self._contact_state()[0]
-
-    @property
-    def contact_forces(self) -> np.ndarray:
-        """(B..., T, S, 3): the obstacles' normal force per length on the arm, N/m, spatial
-        (Coulomb friction, which acted in the steps, is not included; docs/contact.md)."""
-        return self._contact_state()[1]
-
-    @property
-    def contact_wrench(self) -> np.ndarray:
-        """(B..., T, 6): the total normal contact force (N) and its moment about the origin
-        (N m), integrated over the stations (:func:`softarm.contact.resultant`)."""
-        return resultant(self.s, self.positions, self.contact_forces)
-
-    @property
-    def contact_energy(self) -> np.ndarray:
-        """(B..., T): the energy the contact's penalty stores, ∫ Φ(g) ds over the stations
-        (J; zero without a Contact): what :class:`Energy`'s total leaves out while the arm
-        presses on an obstacle (docs/contact.md)."""
-        if self.contact is None:
-            return np.zeros(self.positions.shape[:-2])
-        k = np.asarray(self.contact.stiffness)
-        k = k.reshape(k.shape + (1,) * (self.positions.ndim - 1 - k.ndim)) if k.ndim else k
-        per_length = penalty_energy(self.gaps, self.contact.distance, k)
-        ds = np.diff(self.s)
-        return (0.5 * (per_length[..., 1:] + per_length[..., :-1]) * ds).sum(-1)
-
-    def _contact_state(self):
-        return along_the_arm(self.contact, self.contact_radii, self.positions, inner=1)
 
     def show(self, path=None, *, arm=None, browser: bool = True, **options):
         """Write the motion's page (:func:`softarm.view.trajectory_figure`: the arm moving
