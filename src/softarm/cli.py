@@ -679,7 +679,7 @@ def _run_simulate(args) -> int:
     stores = [TrajectoryStore(out, case, every=args.every) for out in outputs] \
         if streamed else []
     progress = _Progress(label="simulating", unit="steps")
-    parts, figures, done, stopped = [], _RunFigures(), 0, None
+    parts, figures, stopped = [], _RunFigures(), None
     start = time.perf_counter()
     try:
         try:
@@ -690,8 +690,7 @@ def _run_simulate(args) -> int:
                         store.append(part)
                 else:
                     parts.append(part)
-                done = figures.steps
-                progress(done, total)
+                progress(figures.steps, total)
         except (ValueError, TypeError) as error:  # the simulation rejected the case's data
             raise CaseError(_named(error, where)) from None
     except KeyboardInterrupt:
@@ -731,9 +730,10 @@ def _run_simulate(args) -> int:
               f"{', '.join(f'{values[b]:g}' for b in failed[:10])}"
               + (" ..." if len(failed) > 10 else ""), file=sys.stderr)
     if stopped is not None:
-        kept = f"; wrote the {done} of {total} steps done (to t = {figures.end:.6g} " \
+        kept = f"; wrote the {figures.steps} of {total} steps done (to t = {figures.end:.6g} " \
             f"s) to {', '.join(map(str, outputs + ([picture] if picture else [])))}" \
-            if outputs or picture else f"; {done} of {total} steps were done (no output asked)"
+            if outputs or picture else \
+            f"; {figures.steps} of {total} steps were done (no output asked)"
         return _fail(stopped[1], f"softarm: {stopped[0]}{kept}")
     print(_simulation_summary(case, figures, seconds))
     for out in [*outputs, *([picture] if picture else [])]:

@@ -750,12 +750,9 @@ def _dataset(arrays: dict, meta: dict):
                                  "meta": json.dumps(meta)})
 
 
-def _save_zarr(arrays: dict, meta: dict, path: Path) -> None:
-    """The Dataset written to a temporary folder beside ``path``, then renamed onto it (an
-    old store at ``path`` is removed only after the new one is whole)."""
-    import shutil
-    import tempfile
-
+def _check_zarr_target(path: Path) -> None:
+    """CaseError unless a Zarr store can be written at ``path``: xarray and zarr installed,
+    and ``path`` a folder or nothing yet."""
     try:
         import xarray  # noqa: F401
         import zarr  # noqa: F401
@@ -764,6 +761,15 @@ def _save_zarr(arrays: dict, meta: dict, path: Path) -> None:
                         "missing): pip install 'softarm[sweep]'") from None
     if path.exists() and not path.is_dir():
         raise CaseError(f"{path}: exists and is not a folder (a Zarr store is a folder)")
+
+
+def _save_zarr(arrays: dict, meta: dict, path: Path) -> None:
+    """The Dataset written to a temporary folder beside ``path``, then renamed onto it (an
+    old store at ``path`` is removed only after the new one is whole)."""
+    import shutil
+    import tempfile
+
+    _check_zarr_target(path)
     parent = path.parent if str(path.parent) else Path(".")
     tmp = Path(tempfile.mkdtemp(prefix=f".{path.name}.", suffix=".part", dir=parent))
     old = None
@@ -827,15 +833,7 @@ class TrajectoryStore:
         self.path = Path(path)
         if self.path.suffix.lower() != ".zarr":
             raise ValueError(f"path must name a .zarr folder, got {str(path)!r}")
-        if self.path.exists() and not self.path.is_dir():
-            raise CaseError(f"{self.path}: exists and is not a folder (a Zarr store is a "
-                            "folder)")
-        try:
-            import xarray  # noqa: F401
-            import zarr  # noqa: F401
-        except ImportError as error:
-            raise CaseError(f"{self.path}: a .zarr output needs xarray and zarr "
-                            f"({error.name} is missing): pip install 'softarm[sweep]'") from None
+        _check_zarr_target(self.path)
         if (case is None) == (arm is None):
             raise TypeError("give case (a softarm Case) or arm (and loads), one of them: the "
                             "file keeps what was simulated")

@@ -4892,9 +4892,7 @@ def _dyn_widened(Zw, last, pose, grid, props, coef, S, now, tip_now, hh, act, ac
     while code != DYN_OK and exponent < _WIDENINGS:
         exponent += 1.0
         _with_band(params, given, exponent)
-        for k in range(Zw.shape[0]):
-            for i in range(Zw.shape[1]):
-                Zw[k, i] = last[k, i]
+        _copy(last, Zw)
         _set_base(Zw, pose)
         fac[3][0] = 0
         code, res, more, nf2 = _dyn_newton(Zw, grid, props, coef, S, now, tip_now, hh, act,
@@ -4913,18 +4911,14 @@ def _dyn_widened(Zw, last, pose, grid, props, coef, S, now, tip_now, hh, act, ac
             its += more
             nf += nf2
             if code == DYN_OK:
-                for k in range(Zw.shape[0]):
-                    for i in range(Zw.shape[1]):
-                        good[k, i] = Zw[k, i]
+                _copy(Zw, good)
                 exponent = trial
                 step = min(2.0 * step, 1.0)
                 continue
             failures += 1
             if failures > _NARROWINGS:
                 break  # (code: the failure)
-            for k in range(Zw.shape[0]):
-                for i in range(Zw.shape[1]):
-                    Zw[k, i] = good[k, i]
+            _copy(good, Zw)
             step *= 0.5
     _with_band(params, given, 0.0)
     return code, res, its, nf
