@@ -458,3 +458,80 @@ def test_a_chained_solver_starts_at_the_stiffest_law_it_needed(monkeypatch):
                                                    (0.06, 0.05, -0.046), 0.03),))
     assert solver.solve([tendon.replace(tension=13.0), other]).loads[-1].stiffness != \
         kept.stiffness
+
+
+def _shootings_of_stiff_solves(monkeypatch) -> list:
+    """The shootings (integrations of the arm) of every case the multiple-shooting kernel
+    solves from now on, one list per call: a spy on ``solve_stiff_cases``."""
+    from softarm.statics import _kernels as kernels
+
+    calls, solve = [], kernels.solve_stiff_cases
+
+    def spy(*args):
+        solve(*args)
+        calls.append(args[6][3][:, 3].copy())  # (out's info: column 3 the shootings)
+
+    monkeypatch.setattr(kernels, "solve_stiff_cases", spy)
+    return calls
+
+
+@pytest.mark.slow  # (the finger in contact: a cold solve and its references, 1-2 s each)
+def test_a_chained_solver_in_contact_follows_its_path_from_its_last_solution(monkeypatch):
+    """Issue 39 (the app's redraw, the finger's tracking): on the multiple-shooting route,
+    which every solve in contact takes, a chained Solver kept nothing and started each
+    move from the unloaded arm (1-2 s a move of the finger). It now follows the path from
+    its last solution, on that solution's grid. Each move's answer is the cold solve's
+    with the same law (softarm.solve from the unloaded arm, the Contact's stiffness and
+    distance given: the reference) to the solves' tolerance, in a fifth of its shootings
+    or fewer; a chained batch is one path, case after case."""
+    from softarm.case import load_case
+    from softarm.statics import Solver
+
+    case = load_case(Path(__file__).parents[1] / "examples" / "gripper_finger.toml")
+    tendon, cylinder = case.loads
+    tol = 1e-6
+    solver = Solver(case.arm, s=21, tol=tol)
+    law = solver.solve([tendon.replace(tension=15.0), cylinder]).loads[-1]
+    given = cylinder.replace(stiffness=law.stiffness, distance=law.distance)
+    shootings = _shootings_of_stiff_solves(monkeypatch)
+    tensions = [14.5, 14.0]
+    moves = [solver.solve([tendon.replace(tension=q), cylinder]) for q in tensions]
+    batch = solver.solve([tendon.replace(tension=np.array([13.5, 13.0])), cylinder])
+    warm = np.concatenate(shootings)
+    shootings.clear()
+    reference = sa.solve(case.arm, [tendon.replace(tension=np.array([*tensions, 13.5, 13.0])),
+                                    given], s=21, tol=tol)
+    cold = shootings[0]
+    assert [m.loads[-1].stiffness for m in moves] == [law.stiffness] * 2  # (the same law)
+    chained = np.concatenate([*(m.positions[None] for m in moves), batch.positions])
+    np.testing.assert_allclose(chained, reference.positions, rtol=0,
+                               atol=2 * tol * case.arm.length)
+    assert warm.size == 4 and np.all(warm <= cold / 5), (warm, cold)
+
+
+@pytest.mark.slow  # (the finger tracked in contact with Jacobians: its own compiled variant)
+def test_the_forward_solver_in_contact_holds_the_arm_out_of_the_obstacle():
+    """Issue 39: a ForwardSolver (a prepared solve, the control loop's) kept the penalty it
+    estimated from the loads it was created with, and never checked the answer: the
+    finger tracked from 0.15 N to 15 N went 21 µm into its cylinder (175 tol·L), silently.
+    It now checks every answer on the solver's fine stations, as Solver.solve does, and
+    raises its law where the arm penetrates; its Equilibrium's Contact says which law.
+    Reference: softarm.solve from the unloaded arm with that law given, on 2001 stations:
+    no station deeper than tol·L, and the same tip to the solves' tolerance."""
+    arm = sa.Arm(0.12, sa.Circle(0.01),
+                 sa.Material(youngs_modulus=1e6, poisson_ratio=0.49, density=1070.0))
+    tendon = sa.Tendon(1.0, sa.routing.Straight(0.0, -0.007))
+    centre, radius = np.array([0.06, -0.045]), 0.03
+    cylinder = sa.Contact(sa.Capsule((centre[0], -0.05, centre[1]),
+                                     (centre[0], 0.05, centre[1]), radius))
+    tol = 1e-6
+    model = sa.ForwardSolver(arm, [tendon], [cylinder], tol=tol)
+    for q in np.linspace(0.15, 15.0, 6):
+        result = model.solve([q])
+    law = next(load for load in model.equilibrium().loads if load.kind == "contact")
+    assert law.stiffness > 1e8  # (raised: 2.1e7 was its estimate)
+    reference = sa.solve(arm, [tendon.replace(tension=15.0), law], s=2001, tol=tol)
+    p = reference.positions
+    gaps = np.hypot(p[:, 0] - centre[0], p[:, 2] - centre[1]) - radius - 0.01
+    assert gaps.min() > -tol * arm.length
+    np.testing.assert_allclose(result.tip[:3, 3], p[-1], rtol=0, atol=2 * tol * arm.length)

@@ -4081,10 +4081,12 @@ def _stiff_capability(args):
 
 
 @_entry(_stiff_capability, nogil=True)
-def solve_stiff_cases(base, arm, act, loads, options, s_out, out, verdicts, inputs):
+def solve_stiff_cases(base, arm, act, loads, options, s_out, out, verdicts, inputs, chain):
     """Solve every load case of a flattened batch by multiple shooting, each from the
     unloaded arm (λ = 0) along its own loading path (the stiff route of
-    :func:`solve_cases`: the same arguments where they exist, the same outputs).
+    :func:`solve_cases`: the same arguments where they exist, the same outputs), or, with
+    ``chain`` on, from the last solution the chain holds (a chained Solver's quasi-static
+    path: :func:`_ms_warm`).
 
     The stages follow solve_cases': the path (in levels of intervals, :func:`_ms_path`),
     the solution at 2N (chord iterations with the factors at N, else Newton), the
@@ -4100,7 +4102,13 @@ def solve_stiff_cases(base, arm, act, loads, options, s_out, out, verdicts, inpu
     backwards, where it would grow like e^{kL}). ``inputs``: None, or as solve_cases'
     (Jacobians): the compliances and actuation Jacobians by the implicit function theorem on
     the block system (:func:`_ms_sensitivities`), in solve_cases' outputs after its
-    :func:`_implicit_function`.
+    :func:`_implicit_function`. ``chain``: (x (6,), Z (cap, 18 + actuators), mult (cap,)
+    int64, meta (4,), piece (pieces, width), tip (TIP_LOADS,)); meta[0] is 0 (off: neither
+    read nor written), 1 (on, holding nothing) or 2 (holding a solution: meta[1] its M,
+    meta[2] its N, meta[3] its error estimate, x, Z[:M] and mult[:M] its nodes on N steps,
+    piece and tip its loads). A
+    chain on holds each case's solution for the next (the batch is one path) and nothing
+    after a case that failed.
     """
     piece_loads, tip_loads = loads
     nb = piece_loads.shape[0]
@@ -4124,118 +4132,163 @@ def solve_stiff_cases(base, arm, act, loads, options, s_out, out, verdicts, inpu
     tip_c = np.empty(3)
     tip_f = np.empty(3)
     y = scratch[0]
+    chain_x, chain_Z, chain_mult, chain_meta, chain_piece, chain_tip = chain
+    chained = chain_meta[0] > 0.0 and chain_Z.shape[1] == y.size and \
+        chain_piece.shape[0] == npieces and chain_piece.shape[1] == width
     for b in range(nb):
-        counter[0] = 0
-        for j in range(npieces):
-            for i in range(width):
-                rate[0, j, i] = piece_loads[b, j, i]
-        for i in range(TIP_LOADS):
-            tip_rate[0, i] = tip_loads[b, i]
-        w, turning = _load_size(arm, act, scale, start, piece_loads[b], tip_start, tip_loads[b])
-        threshold = 1e-12 * w + 1e-300
-        kl = _stiffness_size(arm, act, w, piece_loads[b])
-        # M = M_base 2^levels >= kL / _GROWTH (within 25 %): the path's levels halve it
-        needed = max(1, min(math.ceil(kl / _GROWTH), n_max // 4))
-        levels = 0
-        while (needed >> (_LEVEL * (levels + 1))) >= 4:
-            levels += 1
-        M = ((needed + (1 << (_LEVEL * levels)) - 1) >> (_LEVEL * levels)) << (_LEVEL * levels)
-        chunks, nc, first, csteps, work, colscale, rowscale = _ms_grid(arm, M, y.size)
-        n = 12 * M - 6
-        Z = np.zeros((M, y.size))
-        Z_f = np.zeros((M, y.size))
-        mult = np.ones(M, dtype=np.int64)
-        local = np.empty(M)
-        if n_fixed > 0:
-            N = n_fixed // 2
-        else:
-            N = max(_first_steps(arm, tol, turning), math.ceil(_STIFF_STEPS * kl))
-        N = min(N, n_max // 2)
-        status[b] = OK
-        estimate = np.inf
-        failures = 0
-        failed_at = -1.0
-        path = True
-        done = False
-        while not done:
-            if path:
-                _chunk_steps(chunks, nc, length, N, np.int64(1), mult, csteps)
-                if not _ms_path(x, Z, M, levels, kl, N, n_fixed, arm, act, base, case, scratch,
-                                w, threshold, max_iterations, max_load_step, budget,
-                                final_step, tip_c, counter, reached, chunks, first, csteps,
-                                work, colscale, rowscale):
-                    if counter[0] > budget:
-                        status[b] = BUDGET
+        # from the chain's last solution when it holds one; a cold start if that fails
+        warm = chained and chain_meta[0] == 2.0
+        again = True
+        while again:
+            again = False
+            counter[0] = 0
+            for j in range(npieces):
+                for i in range(width):
+                    start[j, i] = chain_piece[j, i] if warm else 0.0
+                    rate[0, j, i] = piece_loads[b, j, i] - start[j, i]
+            for i in range(TIP_LOADS):
+                tip_start[i] = chain_tip[i] if warm else 0.0
+                tip_rate[0, i] = tip_loads[b, i] - tip_start[i]
+            w, turning = _load_size(arm, act, scale, start, piece_loads[b], tip_start,
+                                    tip_loads[b])
+            threshold = 1e-12 * w + 1e-300
+            kl = _stiffness_size(arm, act, w, piece_loads[b])
+            # M = M_base 2^levels >= kL / _GROWTH (within 25 %): the path's levels halve it
+            needed = max(1, min(math.ceil(kl / _GROWTH), n_max // 4))
+            levels = 0
+            while (needed >> (_LEVEL * (levels + 1))) >= 4:
+                levels += 1
+            M = ((needed + (1 << (_LEVEL * levels)) - 1) >> (_LEVEL * levels)) \
+                << (_LEVEL * levels)
+            if warm and int(chain_meta[1]) < needed:
+                warm = False  # (the loads stiffen past the chain's grid: a cold start)
+                again = True
+                continue
+            if warm:  # the chain's grid, on which its nodes were solved
+                M = int(chain_meta[1])
+                levels = 0
+            chunks, nc, first, csteps, work, colscale, rowscale = _ms_grid(arm, M, y.size)
+            n = 12 * M - 6
+            Z = np.zeros((M, y.size))
+            Z_f = np.zeros((M, y.size))
+            mult = np.ones(M, dtype=np.int64)
+            local = np.empty(M)
+            if n_fixed > 0:
+                N = n_fixed // 2
+            else:
+                N = max(_first_steps(arm, tol, turning), math.ceil(_STIFF_STEPS * kl))
+            N = min(N, n_max // 2)
+            path = True
+            if warm:
+                if n_fixed == 0:
+                    # the chain's steps, half as many where its estimate allowed it (order
+                    # 4: 16 times the error): a zone that moves on needs fewer again
+                    held = int(chain_meta[2])
+                    if chain_meta[3] <= tol / 32.0:
+                        held = held // 2
+                    N = min(n_max // 2, max(N, held))
+                for i in range(M):
+                    mult[i] = chain_mult[i]
+            status[b] = OK
+            estimate = np.inf
+            failures = 0
+            failed_at = -1.0
+            done = False
+            while not done:
+                if path and warm:  # the path from the chain's solution, on N steps
+                    _chunk_steps(chunks, nc, length, N, np.int64(1), mult, csteps)
+                    _copy(chain_x, x)
+                    for i in range(M):
+                        for a in range(y.size):
+                            Z[i, a] = chain_Z[i, a]
+                    if not _ms_follow(x, Z, M, chunks, first, csteps, base, arm, act, case,
+                                      scratch, colscale, rowscale, work, w, length, threshold,
+                                      max_iterations, max_load_step, budget, final_step,
+                                      tip_c, counter, reached, 0.0, 1.0):
+                        status[b] = PATH_FAILED  # (then a cold start)
                         break
-                    if _retry_finer(n_fixed, N, n_max, failures, reached[0], failed_at):
-                        failures += 1
-                        failed_at = reached[0]
-                        N = 2 * N
-                        continue
-                    status[b] = PATH_FAILED
+                    path = False
+                if path:
+                    _chunk_steps(chunks, nc, length, N, np.int64(1), mult, csteps)
+                    if not _ms_path(x, Z, M, levels, kl, N, n_fixed, arm, act, base, case, scratch,
+                                    w, threshold, max_iterations, max_load_step, budget,
+                                    final_step, tip_c, counter, reached, chunks, first, csteps,
+                                    work, colscale, rowscale):
+                        if counter[0] > budget:
+                            status[b] = BUDGET
+                            break
+                        if _retry_finer(n_fixed, N, n_max, failures, reached[0], failed_at):
+                            failures += 1
+                            failed_at = reached[0]
+                            N = 2 * N
+                            continue
+                        status[b] = PATH_FAILED
+                        break
+                    path = False
+                if counter[0] > budget:
+                    status[b] = BUDGET
                     break
-                path = False
-            if counter[0] > budget:
-                status[b] = BUDGET
-                break
-            # the fine solution at 2N: chord iterations with the factors at N, else Newton
-            _copy(x, x_f)
-            _copy(Z, Z_f)
-            _chunk_steps(chunks, nc, length, N, np.int64(2), mult, csteps)
-            if not _ms_chord(x_f, Z_f, M, chunks, first, csteps, base, arm, act, case, scratch,
-                             colscale, rowscale, work, threshold, max_iterations, tip_f,
-                             counter):
+                # the fine solution at 2N: chord iterations with the factors at N, else Newton
                 _copy(x, x_f)
                 _copy(Z, Z_f)
+                _chunk_steps(chunks, nc, length, N, np.int64(2), mult, csteps)
+                if not _ms_chord(x_f, Z_f, M, chunks, first, csteps, base, arm, act, case, scratch,
+                                 colscale, rowscale, work, threshold, max_iterations, tip_f,
+                                 counter):
+                    _copy(x, x_f)
+                    _copy(Z, Z_f)
+                    ok, _, _ = _ms_corrector(
+                        x_f, Z_f, M, 1.0, M - M + _COLS, chunks, first, csteps, base, arm, act,
+                        case, scratch, colscale, rowscale, work, w, length, threshold,
+                        max_iterations, _REFINE_MAX, 1e-9, tip_f, counter)
+                    if not ok:
+                        if 4 * N > n_max or n_fixed > 0:
+                            status[b] = NEWTON_FAILED
+                            break
+                        N = 2 * N
+                        path = True
+                        continue
+                d2 = 0.0
+                for i in range(3):
+                    d2 += (tip_f[i] - tip_c[i]) ** 2
+                estimate = _STIFF_SAFETY * math.sqrt(d2) / 15.0
+                if estimate <= tol or n_fixed > 0:
+                    done = True
+                    break
+                total = 0
+                for c in range(nc):
+                    total += csteps[c]  # (at 2N)
+                if total >= n_max:
+                    status[b] = TOO_MANY_STEPS
+                    break
+                grow = (estimate / (0.3 * tol)) ** 0.25
+                if M > 1:
+                    # refine where the error is made: the intervals whose local error (N against
+                    # 2N from the same start) is within a factor 20 of the largest; a boundary
+                    # layer (the clamp's, width 1/k) then gets the steps, not the whole arm
+                    _ms_local_errors(x_f, Z_f, M, chunks, first, csteps, base, arm, act, case,
+                                     scratch, colscale, rowscale, work, length, nc, N, mult,
+                                     local)
+                    largest = 0.0
+                    for i in range(M):
+                        largest = max(largest, local[i])
+                    factor = max(2, math.ceil(grow))
+                    for i in range(M):
+                        if local[i] >= 0.05 * largest or not largest > 0.0:
+                            mult[i] *= factor
+                else:
+                    N = min(n_max // 2, max(N + 1, math.ceil(N * grow)))
+                _chunk_steps(chunks, nc, length, N, np.int64(1), mult, csteps)
+                _copy(x_f, x)
+                _copy(Z_f, Z)
                 ok, _, _ = _ms_corrector(
-                    x_f, Z_f, M, 1.0, M - M + _COLS, chunks, first, csteps, base, arm, act,
-                    case, scratch, colscale, rowscale, work, w, length, threshold,
-                    max_iterations, _REFINE_MAX, 1e-9, tip_f, counter)
-                if not ok:
-                    if 4 * N > n_max or n_fixed > 0:
-                        status[b] = NEWTON_FAILED
-                        break
-                    N = 2 * N
-                    path = True
-                    continue
-            d2 = 0.0
-            for i in range(3):
-                d2 += (tip_f[i] - tip_c[i]) ** 2
-            estimate = _STIFF_SAFETY * math.sqrt(d2) / 15.0
-            if estimate <= tol or n_fixed > 0:
-                done = True
-                break
-            total = 0
-            for c in range(nc):
-                total += csteps[c]  # (at 2N)
-            if total >= n_max:
-                status[b] = TOO_MANY_STEPS
-                break
-            grow = (estimate / (0.3 * tol)) ** 0.25
-            if M > 1:
-                # refine where the error is made: the intervals whose local error (N against
-                # 2N from the same start) is within a factor 20 of the largest; a boundary
-                # layer (the clamp's, width 1/k) then gets the steps, not the whole arm
-                _ms_local_errors(x_f, Z_f, M, chunks, first, csteps, base, arm, act, case,
-                                 scratch, colscale, rowscale, work, length, nc, N, mult,
-                                 local)
-                largest = 0.0
-                for i in range(M):
-                    largest = max(largest, local[i])
-                factor = max(2, math.ceil(grow))
-                for i in range(M):
-                    if local[i] >= 0.05 * largest or not largest > 0.0:
-                        mult[i] *= factor
-            else:
-                N = min(n_max // 2, max(N + 1, math.ceil(N * grow)))
-            _chunk_steps(chunks, nc, length, N, np.int64(1), mult, csteps)
-            _copy(x_f, x)
-            _copy(Z_f, Z)
-            ok, _, _ = _ms_corrector(
-                x, Z, M, 1.0, M - M + _COLS, chunks, first, csteps, base, arm, act, case,
-                scratch, colscale, rowscale, work, w, length, threshold, max_iterations,
-                _REFINE_MAX, final_step, tip_c, counter)
-            path = not ok
+                    x, Z, M, 1.0, M - M + _COLS, chunks, first, csteps, base, arm, act, case,
+                    scratch, colscale, rowscale, work, w, length, threshold, max_iterations,
+                    _REFINE_MAX, final_step, tip_c, counter)
+                path = not ok
+            if warm and status[b] != OK:  # a cold start, from the unloaded arm
+                warm = False
+                again = True
         info[b, 1] = estimate
         info[b, 2] = 1.0 if status[b] == OK else reached[0]
         info[b, 3] = counter[0]
@@ -4247,6 +4300,23 @@ def solve_stiff_cases(base, arm, act, loads, options, s_out, out, verdicts, inpu
             if not v <= residual:
                 residual = v
         info[b, 0] = residual
+        if chained:  # the chain holds this solution (its nodes on N steps) for the next case
+            chain_meta[0] = 1.0
+            if status[b] == OK and M <= chain_Z.shape[0]:
+                _copy(x, chain_x)
+                for i in range(M):
+                    chain_mult[i] = mult[i]
+                    for a in range(y.size):
+                        chain_Z[i, a] = Z[i, a]
+                for j in range(npieces):
+                    for i in range(width):
+                        chain_piece[j, i] = piece_loads[b, j, i]
+                for i in range(TIP_LOADS):
+                    chain_tip[i] = tip_loads[b, i]
+                chain_meta[1] = M
+                chain_meta[2] = N
+                chain_meta[3] = estimate
+                chain_meta[0] = 2.0
         if status[b] != OK:
             continue
         _chunk_steps(chunks, nc, length, N, np.int64(2), mult, csteps)

@@ -784,7 +784,15 @@ class PreparedSolve:
         self._arm = channels.arm_tuple()
         self._jacobians = bool(jacobians)
         self._options = {near: solver._options(near) for near in (False, True)}
-        S = solver._s_kernel.size
+        # In contact the kernel writes the Solver's fine stations (_contact_stations), on
+        # which every answer is checked for penetration (_raise_contact), and the buffers
+        # take the stations asked for from them
+        self._s_out, self._asked = solver._s_kernel, None
+        if channels.contact_load is not None:
+            self._s_out, self._asked = _contact_stations(
+                solver._s_kernel, solver.length, np.append(pieces[0], solver.length))
+            self._radii = channels.contact_load.station_radii(solver.arm, self._s_out)
+        S = self._s_out.size
         self._outs = (np.empty((1, S, 4, 4)), np.empty((1, S, 6)), np.empty((1, S, 6)),
                       np.zeros((1, 5)), np.zeros(1, dtype=np.int64),
                       np.zeros((1, 6 + A, 6 + n)) if jacobians else solver._unused((0, 6, 6)),
@@ -795,6 +803,12 @@ class PreparedSolve:
         self.info, self.base_wrench, self.lengths = info[0], base_wrench[0], lengths[0]
         self.jacobian = jac[0] if jacobians else None
         self.motion = motion[0] if jacobians else None
+        if self._asked is not None:  # the asked stations' own buffers
+            self.poses, self.strains, self.stresses = (
+                np.empty((self._asked.size, *a.shape[1:])) for a in
+                (self.poses, self.strains, self.stresses))
+            if jacobians:
+                self.motion = np.empty((self._asked.size, *self.motion.shape[1:]))
         # the verdict's arrays (writable and C-contiguous: one compiled version)
         self._tips = np.empty((1, 4, 4)) if solver.s[-1] == solver.length \
             else np.zeros((0, 4, 4))
@@ -845,7 +859,12 @@ class PreparedSolve:
         np.dot(self.inputs, self._unit_tip, out=tip[0])
         tip += self._tip0
         start_piece, start_tip = self._start
-        if near is not None:
+        stiff = self._stiff()
+        if stiff:
+            # multiple shooting, along the Solver's chain (_StiffChain: from its last
+            # solution on this route, else from the unloaded arm), with its verdict
+            memory = None
+        elif near is not None:
             memory = solver._memory = np.zeros(k.MEMORY)
             memory[0:6] = memory[6:12] = near[0]
             memory[12], memory[13] = max(1, int(near[1]) // 2), 1.0
@@ -874,17 +893,19 @@ class PreparedSolve:
                 np.negative(memory[k.MSTEP:k.MSTEP + 6], out=memory[k.MSTEP:k.MSTEP + 6])
                 memory[k.MPREDICTED] = 1.0
         status = self._outs[4]
-        stiff = self._stiff()
         if stiff:
-            # multiple shooting, from the unloaded arm (it keeps no chained memory: the next
-            # call starts from there too), with its verdict
-            k.solve_stiff_cases(solver._base_kernel, *self._arm, (piece, tip),
-                                self._options[False], solver._s_kernel, self._outs,
-                                (self._index, self._flags) if solver.stability else None,
-                                self._unit)
+            for attempt in range(_CONTACT_RETRIES + 1):
+                k.solve_stiff_cases(solver._base_kernel, *self._arm, (piece, tip),
+                                    self._options[False], self._s_out, self._outs,
+                                    (self._index, self._flags) if solver.stability else None,
+                                    self._unit, solver._stiff_chain(self._pieces,
+                                                                    self._channels))
+                if status[0] != k.OK or self._asked is None or \
+                        not self._raise_contact(attempt):
+                    break
         else:
             k.solve_cases(solver._base_kernel, *self._arm, (piece, tip), self._start,
-                          self._options[near is not None], solver._s_kernel, memory,
+                          self._options[near is not None], self._s_out, memory,
                           self._unit, self._outs)
         if status[0] != k.OK:
             solver.reset()
@@ -894,6 +915,11 @@ class PreparedSolve:
                 error = _tendon_limit(solver, self.loads_at(self.inputs), (), 0, None,
                                       error.residual) or error
             raise error
+        if self._asked is not None:
+            for fine, asked in ((self._outs[0][0], self.poses), (self._outs[1][0], self.strains),
+                                (self._outs[2][0], self.stresses)) + (
+                    ((self._outs[6][0], self.motion),) if self._jacobians else ()):
+                np.take(fine, self._asked, axis=0, out=asked)
         try:
             _admissible(solver, self.strains, self.stresses, solver._s_kernel, (),
                         self.info[0], True)
@@ -902,7 +928,7 @@ class PreparedSolve:
             raise
         self.solved = True
         if stiff:
-            solver.reset()
+            solver._forget_single()
             self._last = None
             if solver.stability:
                 self.index, self.conservative = int(self._index[0]), bool(self._flags[0])
@@ -920,6 +946,24 @@ class PreparedSolve:
                               self._Ns, self._tips, 1, self._index, self._theta0, self._flags,
                               None)
             self.index, self.conservative = int(self._index[0]), bool(self._flags[0])
+
+    def _raise_contact(self, attempt: int) -> bool:
+        """After a solve in contact (on the fine stations): False if no station penetrates
+        an obstacle by more than tol·L; else True, the penalty raised in this object's
+        channels for this call's retry and every later call (the law only grows, as in
+        Solver.solve and the dynamics; :func:`_penetration`, which raises the
+        ConvergenceError after its last attempt or for a stiffness the user gave)."""
+        channels, k = self._channels, self._k
+        law = channels.contact_load
+        gaps, forces = law.gaps(self._outs[0][:, :, :3, 3], self._radii)
+        stiffer = _penetration(self._solver, law, gaps, forces, attempt,
+                               channels.contact_given_stiffness)
+        if stiffer is None:
+            return False
+        for piece in (self._piece0, self._piece[0]):
+            piece[:, k.CT] = stiffer[0]
+        channels.contact_load = law.replace(stiffness=stiffer)
+        return True
 
     def reset(self) -> None:
         """Back to the unloaded arm: the Solver's quasi-static state, and this object's last
@@ -939,6 +983,9 @@ class PreparedSolve:
                 changes[name] = np.reshape(q[at:at + size], shape).copy() if shape \
                     else float(q[at])
                 at += size
+            if load.kind == "contact":  # the law this object solves with (raised as needed)
+                law = self._channels.contact_load
+                load = law.replace(stiffness=float(np.max(law.stiffness)))
             out.append(load._with_checked(**changes) if changes else load)
         return tuple(out)
 
@@ -1039,11 +1086,12 @@ def _shoot(k, x, lam, counts, base, arm, case, actuators) -> ShootResult:
 
 
 def _by_route(k, solver, arm, channels, options, s_kernel, first, memory, inputs, outs,
-              stiff, count, verdicts) -> None:
+              stiff, count, verdicts, chain) -> None:
     """Solve the easy cases by single shooting (solve_cases) and the stiff ones by multiple
     shooting (solve_stiff_cases, with their stability verdicts into ``verdicts`` (index,
-    conservative) when given), each route on its cases gathered, in threads, the outputs
-    scattered back (a case's answer does not depend on the others: batch = loop)."""
+    conservative) when given, along ``chain`` when it is on), each route on its cases
+    gathered, in threads, the outputs scattered back (unchained, a case's answer does not
+    depend on the others: batch = loop; chained, one thread follows the batch in order)."""
     for route, index in ((False, np.flatnonzero(~stiff)), (True, np.flatnonzero(stiff))):
         if index.size == 0:
             continue
@@ -1060,12 +1108,14 @@ def _by_route(k, solver, arm, channels, options, s_kernel, first, memory, inputs
                 k.solve_stiff_cases(solver._base_kernel, *arm, (pieces[a:b], tips[a:b]),
                                     options, s_kernel, cut,
                                     None if judged is None else (judged[0][a:b],
-                                                                 judged[1][a:b]), inputs)
+                                                                 judged[1][a:b]), inputs,
+                                    chain)
             else:
                 k.solve_cases(solver._base_kernel, *arm, (pieces[a:b], tips[a:b]), first,
                               options, s_kernel, memory, inputs, cut)
 
-        in_threads(run, index.size, solver._threads(index.size) if first is None else 1)
+        one_path = first is not None or chain[3][0] > 0.0
+        in_threads(run, index.size, 1 if one_path else solver._threads(index.size))
         if route and judged is not None:
             for v, w in zip(verdicts, judged, strict=True):
                 v[index] = w
@@ -1073,6 +1123,40 @@ def _by_route(k, solver, arm, channels, options, s_kernel, first, memory, inputs
             for x, y in zip(outs, part, strict=True):
                 if x.shape[0] == count:
                     x[index] = y
+
+
+class _StiffChain:
+    """A chained Solver's memory on the multiple-shooting route (solve_stiff_cases'
+    ``chain``): the last solution's base reaction, nodes and steps, and its loads, from
+    which the next chained solve follows its loading path instead of from the unloaded arm
+    (the path from the last loads to the new ones, on the last solution's grid; a cold start
+    where that fails or the new loads need more intervals). ``key``: the kernel problem it
+    was solved on (Solver._stiff_chain). Measured on examples/gripper_finger.toml (201
+    stations, tol 1e-6): a 0.5 N move of its tendon in contact, 1.0-1.4 s from the unloaded
+    arm and 0.09-0.16 s from the last solution (docs/solver.md, "Chained solves")."""
+
+    #: the most intervals a chain holds (a solution on more: the next solve starts cold)
+    MOST_INTERVALS = 8192
+
+    def __init__(self, key, pieces: int, width: int, intervals: int):
+        k = _kernels()
+        state = 18 + width - k.PIECE_LOADS  # the kernel's: p, R, n, m, tendon lengths
+        self.key = key
+        self.arrays = (np.zeros(6), np.zeros((intervals, state)),
+                       np.ones(intervals, dtype=np.int64), np.array([1.0, 0.0, 0.0, 0.0]),
+                       np.zeros((pieces, width)), np.zeros(k.TIP_LOADS))
+
+
+def _chain_off() -> tuple:
+    """solve_stiff_cases' ``chain`` off (every case from the unloaded arm)."""
+    global _CHAIN_OFF
+    if _CHAIN_OFF is None:
+        _CHAIN_OFF = (np.zeros(6), np.zeros((1, 1)), np.ones(1, dtype=np.int64), np.zeros(4),
+                      np.zeros((1, 1)), np.zeros(_kernels().TIP_LOADS))
+    return _CHAIN_OFF
+
+
+_CHAIN_OFF = None
 
 
 class Solver:
@@ -1200,8 +1284,28 @@ class Solver:
 
     def reset(self) -> None:
         """Return the quasi-static state to the unloaded arm."""
+        self._forget_single()
+        self._chain = None  # multiple shooting's: a _StiffChain, made on first use
+
+    def _forget_single(self) -> None:
+        """Forget single shooting's quasi-static memory (after a solve by multiple
+        shooting, which keeps its own)."""
         self._memory = None  # the kernel's chained-solve memory, made on first use
         self._last = None  # (cut starts, piece loads, tip loads) of the last solved case
+
+    def _stiff_chain(self, pieces, channels) -> tuple:
+        """solve_stiff_cases' ``chain`` for a chained solve of these channels: this
+        Solver's last solution on the multiple-shooting route if it was solved on the same
+        kernel problem (the same cuts, actuators, and Contact as given with its band), else
+        an empty chain (from the unloaded arm)."""
+        given = channels._contact_given
+        key = (pieces[0].tobytes(), channels.signature(),
+               None if given is None else (_contact_key(given), channels.contact_load.distance))
+        if self._chain is None or self._chain.key != key:
+            intervals = min(_StiffChain.MOST_INTERVALS,
+                            max(1, max(self.max_steps, self.steps or 0) // 4))
+            self._chain = _StiffChain(key, pieces[0].size, channels.piece.shape[2], intervals)
+        return self._chain.arrays
 
     # ---------------------------------------------------------------- preparation
 
@@ -1345,15 +1449,16 @@ class Solver:
         contact = channels.resolve_contact(stiffness) \
             if channels.contact_load is not None else None
         kept = self._kept_law
-        if contact is not None and stiffness is None and chained and count == 1 and \
+        if contact is not None and stiffness is None and chained and \
                 kept is not None and kept[0] == _contact_key(channels._contact_given) and \
-                kept[1] > contact.stiffness:
+                np.any(kept[1] > channels.contact_load.stiffness):
             # A chained case starts at the stiffest penalty the last ones needed: its
             # estimate (from the loads' size) let the finger of examples/gripper_finger.toml
             # into the cylinder at every slider move of the app, and each move was solved
             # twice, the second time stiffer (2.5 s; 1.0 s from the kept law). The law only
             # grows, as in the dynamics (contact.md); the Equilibrium's Contact says which.
-            contact = channels.resolve_contact(np.array([kept[1]]))
+            contact = channels.resolve_contact(
+                np.maximum(channels.contact_load.stiffness, kept[1]))
         given_loads = loads  # (a retry starts from them: their Contact as the user gave it)
         if contact is not None:
             if contact_retry is None:  # (a retry solves the same arm from the same start)
@@ -1397,13 +1502,19 @@ class Solver:
         outs = (poses, strains, stresses, info, status, jac, motion, base_wrench, lengths)
 
         stiff = self._stiff(loads, channels)
+        chain, along_chain = _chain_off(), False
         if stiff.any() and (chained or near):
-            # multiple shooting starts every case from the unloaded arm: a chained Solver
-            # restarts from there after it (docs/solver.md, "Multiple shooting")
+            # multiple shooting keeps its own quasi-static memory (_StiffChain): a chained
+            # batch follows its path from the last solution there, or from the unloaded arm
+            # (solve_near's start too); single shooting's memory is then out of date
             stiff[:] = True
+            if chained:
+                chain, along_chain = self._stiff_chain(pieces, channels), True
             first = memory = None
             chained = near = False
-            self.reset()
+            self._forget_single()
+        elif chained or near:
+            self._chain = None  # (single shooting moves the arm: the chain is out of date)
 
         def run(a, b):  # cases [a, b): per-case arrays cut, the rest (placeholders) whole
             k.solve_cases(self._base_kernel, *arm, (channels.piece[a:b],
@@ -1419,11 +1530,11 @@ class Solver:
             if self.stability and outputs:
                 verdicts = (np.zeros(count, dtype=np.int64), np.zeros(count, dtype=np.bool_))
             _by_route(k, self, arm, channels, options, s_kernel, first, memory, inputs, outs,
-                      stiff, count, verdicts)
+                      stiff, count, verdicts, chain)
         actuation = _actuation(channels, base_wrench, lengths, shape) if outputs else None
         failed = np.flatnonzero(status != k.OK) if status.any() else ()  # (OK is 0)
         if len(failed):
-            if chained:
+            if chained or along_chain:
                 self.reset()
             wider = _widened_contact(self, given_loads, contact, widened)
             if wider is not None:  # a path the band was too thin to follow: a wider band
@@ -1449,11 +1560,13 @@ class Solver:
             stiffer = _penetration(self, law, gaps, forces, attempt,
                                    channels.contact_given_stiffness)
             if stiffer is not None:  # raise the penalty until the pressure fits the band
-                if chained:
+                if chained or (along_chain and count > 1):
                     self.reset()
-                return self._solve(given_loads, chained=chained, jacobians=jacobians,
-                                   near=near, outputs=outputs, checked=True,
-                                   contact_retry=(stiffer, attempt + 1, widened))
+                # (a single case's retry along a chain starts from its penetrating answer,
+                # which the chain holds)
+                return self._solve(given_loads, chained=chained or along_chain,
+                                   jacobians=jacobians, near=near, outputs=outputs,
+                                   checked=True, contact_retry=(stiffer, attempt + 1, widened))
         _admissible(self, strains, stresses, s_kernel, shape, info[:, 0], chained)
         contact_resultant = None
         if asked is not None:  # the contact's total from the balance, then the asked stations
@@ -1467,9 +1580,8 @@ class Solver:
         if chained and count:
             self._last = (pieces[0], channels.piece[-1].copy(), channels.tip_loads[-1].copy(),
                           channels.signature())
-        if contact is not None and count == 1 and attempt > 0:
-            # (raised after a penetration: kept for the next chained case; a stiff route's
-            # retry runs unchained, from the unloaded arm)
+        if contact is not None and (count == 1 or along_chain) and attempt > 0:
+            # (raised after a penetration: kept for the next chained cases)
             self._kept_law = (_contact_key(channels._contact_given),
                               float(np.max(contact.stiffness)))
         if not outputs:
