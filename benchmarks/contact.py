@@ -7,6 +7,10 @@ alternatives.
 - the arm pressed onto a pin (a Capsule) by gravity and a tip force;
 - a tendon finger closing on a cylinder, tracked over 100 tension steps (a prepared
   ForwardSolver, as a control loop calls it);
+- the live app's redraw on examples/gripper_finger.toml: a chained Solver (the app's, its
+  stations and tol) moved by 0.5 N of tension in contact, against the same move solved from
+  the unloaded arm with the same law (what every move cost before the Solver kept its
+  multiple-shooting solution);
 - a dynamic drop onto the table at Δt = 1 ms: the cost of a step against the same step
   without the table.
 
@@ -19,6 +23,7 @@ warm-up call. Times are printed, never asserted. Run::
 from __future__ import annotations
 
 import argparse
+import itertools
 import sys
 import time
 import warnings
@@ -31,6 +36,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 from _table_reference import table_reference
 
 import softarm
+from softarm.case import load_case
+from softarm.statics import Solver
 
 L, RADIUS, DROP = 0.5, 0.01, 0.02
 
@@ -109,6 +116,26 @@ def finger(repeats):
              wall, cpu, "", "0.5 s")]
 
 
+def slider(repeats):
+    case = load_case(Path(__file__).resolve().parents[1] / "examples" / "gripper_finger.toml")
+    tendon, cylinder = case.loads
+    solver = Solver(case.arm, s=int(case.solve.stations), tol=float(case.solve.tol))
+    law = solver.solve([tendon.replace(tension=15.0), cylinder]).loads[-1]  # (raised, kept)
+    tensions = itertools.cycle([14.5, 15.0])
+
+    def move():
+        return solver.solve([tendon.replace(tension=next(tensions)), cylinder])
+
+    _, wall, cpu = _timed(move, repeats)
+    given = cylinder.replace(stiffness=law.stiffness, distance=law.distance)
+    _, cold_wall, cold_cpu = _timed(lambda: solver.solve_from_unloaded(
+        [tendon.replace(tension=14.5), given]), max(1, repeats // 2))
+    where = f"{case.solve.stations} stations, tol {case.solve.tol:g}"
+    return [(f"app redraw: a 0.5 N move of the gripper finger, chained ({where})", wall, cpu,
+             "", "0.1 s"),
+            ("the same move from the unloaded arm, the same law", cold_wall, cold_cpu, "", "")]
+
+
 def drop(repeats):
     arm = _soft_arm()
     table_ = softarm.Contact(softarm.Plane((0.0, 0.0, -0.05), (0.0, 0.0, 1.0)))
@@ -128,7 +155,8 @@ def measure(repeats: int) -> list[str]:
     """The markdown lines of docs/performance.md's "Contact" section (benchmarks/run.py)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # (stability and approximation notes)
-        rows = [*table(repeats), *pin(repeats), *finger(repeats), *drop(repeats)]
+        rows = [*table(repeats), *pin(repeats), *finger(repeats), *slider(repeats),
+                *drop(repeats)]
     lines = ["## Contact", "",
              f"`python benchmarks/contact.py --repeats {repeats}` "
              f"({time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}): best of {repeats} after "

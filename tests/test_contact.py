@@ -410,8 +410,12 @@ def test_a_forward_solvers_equilibrium_in_contact_has_its_contact_wrench():
     assert np.linalg.norm(reference.contact_wrench[:3]) > 0.1  # it presses
     np.testing.assert_allclose(eq.contact_wrench, reference.contact_wrench, rtol=0,
                                atol=1e-3 * np.abs(reference.contact_wrench).max())
+    # (why: summed on its 101 stations the pressure of a patch narrower than their spacing
+    # is far off, zero at the estimated law, twice the total at the law raised to hold the
+    # finger out of the cylinder)
     summed = sa.contact.resultant(eq.s, eq.positions, eq.contact_forces)
-    assert np.abs(summed).max() < 0.5 * np.abs(reference.contact_wrench).max()  # (why)
+    assert np.abs(summed - reference.contact_wrench).max() > \
+        0.5 * np.abs(reference.contact_wrench).max()
     tip_only = sa.ForwardSolver(case.arm, tendons, others)
     tip_only.solve(tension)
     with pytest.raises(ValueError, match=r"contact_wrench: its stations must run from the "
