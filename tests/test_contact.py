@@ -453,7 +453,10 @@ def test_a_chained_solver_starts_at_the_stiffest_law_it_needed(monkeypatch):
     given = sa.solve(case.arm, [tendon.replace(tension=13.0),
                                 cylinder.replace(stiffness=law.stiffness,
                                                  distance=law.distance)], s=21, tol=1e-6)
-    np.testing.assert_allclose(moved.positions, given.positions, rtol=0, atol=1e-12)
+    # (each within tol·L of the exact answer: the chained move starts from the last
+    # solution's grid, the reference from the unloaded arm)
+    np.testing.assert_allclose(moved.positions, given.positions, rtol=0,
+                               atol=2e-6 * case.arm.length)
     # a stiffness the user gives is theirs, never the kept one (softer, it penetrates)
     with pytest.raises(sa.ConvergenceError, match=r"the given Contact\(stiffness=1e\+09\)"):
         solver.solve([tendon.replace(tension=13.0), cylinder.replace(stiffness=1e9)])
@@ -539,3 +542,24 @@ def test_the_forward_solver_in_contact_holds_the_arm_out_of_the_obstacle():
     gaps = np.hypot(p[:, 0] - centre[0], p[:, 2] - centre[1]) - radius - 0.01
     assert gaps.min() > -tol * arm.length
     np.testing.assert_allclose(result.tip[:3, 3], p[-1], rtol=0, atol=2 * tol * arm.length)
+
+
+@pytest.mark.slow  # (the finger in contact with Jacobians: its own compiled variant)
+def test_inverse_statics_in_contact_recovers_the_tension_that_made_the_target():
+    """Issue 39 (`softarm inverse` on a contact case): the tip of the gripper finger
+    pressed on its cylinder by a 12 N tendon is the target; inverse statics, each forward
+    solve in contact, finds that tension again (the reference: the tension the target was
+    made with) to the tip tolerance's worth, the finger pressing on the cylinder."""
+    from softarm.case import load_case
+
+    case = load_case(Path(__file__).parents[1] / "examples" / "gripper_finger.toml")
+    tendon, cylinder = case.loads
+    made = sa.solve(case.arm, [tendon.replace(tension=12.0), cylinder])
+    assert np.linalg.norm(made.contact_wrench[:3]) > 0.5  # (the premise: it presses)
+    found = sa.inverse(case.arm, [tendon], made.tip_position, loads=[cylinder])
+    assert found.reached
+    # (pressed on the cylinder the tip moves little per newton: 1e-6 L of tip tolerance
+    # left 6e-6 N of tension, measured)
+    assert abs(found.inputs[0] - 12.0) < 1e-3, found.inputs
+    pressed = sa.solve(case.arm, [tendon.replace(tension=float(found.inputs[0])), cylinder])
+    assert np.linalg.norm(pressed.tip_position - made.tip_position) < 2e-6 * case.arm.length

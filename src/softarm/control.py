@@ -350,8 +350,10 @@ class InverseSolver:
         ``progress(start, iteration, error)`` after every forward solve of a target: the
         start (1 for the first guess, up to ``starts``), the Gauss–Newton iterations done
         from it, and the task error (relative to L) at the last accepted point. A slow
-        target (each forward solve of an arm in contact takes a second or more) can be
-        followed with it; ``softarm inverse`` shows it on stderr.
+        target can be followed with it (in contact, a forward solve from the unloaded arm
+        takes a second or more, one from the last solution a tenth; a target that pushes
+        the arm into an obstacle raises the contact's penalty on the way, and with it the
+        cost of every solve); ``softarm inverse`` shows it on stderr.
 
     After a target that is not reached, the next one starts from the last answer that
     reached its target (or the first guess), from the unloaded arm: the closest point to an

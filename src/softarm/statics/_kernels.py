@@ -3842,19 +3842,39 @@ def _ms_grid(arm, M, width):
 
 
 @_jit
+def _ms_fill_nodes(x, coarse, ratio, Z, M, chunks, first, csteps, base, arm, act, case,
+                   scratch, lam):
+    """The nodes Z (M) of a grid ``ratio`` times finer than a solution's (base reaction x,
+    nodes ``coarse``) at load factor lam, to be corrected there: the coarse nodes where they
+    fall (every ratio-th), the states between integrated from them on this grid (with ratio
+    0, every node integrated from the clamp)."""
+    y, T = scratch[0], scratch[1]
+    none = M - M
+    _set_loads(lam, case, scratch[4], scratch[5])
+    _start(y, T, none, base, x)
+    for i in range(M):
+        if i > 0:
+            if ratio > 0 and i % ratio == 0:
+                _copy(coarse[i // ratio], y)
+            _copy(y, Z[i])
+        _run_chunks(y, T, none, first[i], first[i + 1], chunks, csteps, arm, act, case[1],
+                    scratch)
+
+
+@_jit
 def _ms_path(x, Z, M, levels, kl, N, n_fixed, arm, act, base, case, scratch, w, threshold,
              max_iterations, max_load_step, budget, final_step, tip, counter, reached, chunks,
              first, csteps, work, colscale, rowscale):
     """The loading path from the unloaded arm to λ = 1 on the final grid (M intervals,
     ``csteps`` at N), in levels: k grows like √λ, so the path runs on M / 2^levels
     intervals and proportionally fewer steps while k√λ L <= _GROWTH times their number,
-    then on twice as many, each finer grid's nodes the coarser's plus the states halfway
-    (integrated on the finer grid from the coarser nodes, then corrected at that λ). The
+    then on four times as many, each finer grid's nodes the coarser's plus the states
+    between (integrated on the finer grid from the coarser nodes, :func:`_ms_fill_nodes`,
+    then corrected at that λ). The
     early load steps, most of the path's, cost a fraction of the last ones'. True on success,
     x and Z the solution at λ = 1 on the final grid (its band factors in ``work``)."""
     length = arm[6]
-    y, T = scratch[0], scratch[1]
-    none = M - M
+    y = scratch[0]
     lam = 0.0
     for k in range(6):
         x[k] = 0.0
@@ -3875,17 +3895,10 @@ def _ms_path(x, Z, M, levels, kl, N, n_fixed, arm, act, base, case, scratch, w, 
             Nl = N if n_fixed > 0 else max(nc, math.ceil(N * math.sqrt(end)))
             _chunk_steps(g_chunks, nc, length, Nl, np.int64(1), np.ones(Ml, dtype=np.int64),
                          g_csteps)
-        _set_loads(lam, case, scratch[4], scratch[5])
-        # the nodes: the coarser level's (every other one) and the states between them,
+        # the nodes: the coarser level's (every fourth one) and the states between them,
         # integrated from those; on the first level the unloaded arm's (x = 0, λ = 0)
-        _start(y, T, none, base, x)
-        for i in range(Ml):
-            if i > 0:
-                if prev_M > 0 and i % (1 << _LEVEL) == 0:
-                    _copy(prev_Z[i >> _LEVEL], y)
-                _copy(y, Zl[i])
-            _run_chunks(y, T, none, g_first[i], g_first[i + 1], g_chunks, g_csteps, arm, act,
-                        case[1], scratch)
+        _ms_fill_nodes(x, prev_Z, (1 << _LEVEL) if prev_M > 0 else 0, Zl, Ml, g_chunks,
+                       g_first, g_csteps, base, arm, act, case, scratch, lam)
         if not _ms_follow(x, Zl, Ml, g_chunks, g_first, g_csteps, base, arm, act, case, scratch,
                           g_colscale, g_rowscale, g_work, w, length, threshold, max_iterations,
                           max_load_step, budget, final_step if final else _loose(act, length),
@@ -4160,12 +4173,22 @@ def solve_stiff_cases(base, arm, act, loads, options, s_out, out, verdicts, inpu
                 levels += 1
             M = ((needed + (1 << (_LEVEL * levels)) - 1) >> (_LEVEL * levels)) \
                 << (_LEVEL * levels)
-            if warm and int(chain_meta[1]) < needed:
-                warm = False  # (the loads stiffen past the chain's grid: a cold start)
-                again = True
-                continue
-            if warm:  # the chain's grid, on which its nodes were solved
-                M = int(chain_meta[1])
+            ratio = 1  # a warm start's intervals per interval of the chain's grid
+            if warm:
+                # the chain's grid, on which its nodes were solved, or where the loads
+                # stiffen past it (a raised penalty), that grid refined the fewest times
+                # that hold them; a cold start where that is over twice the cold grid
+                # (measured: refined 4 times at once, an inverse solve's raised penalties
+                # took the finger's grid from 48 intervals to 3072) or the chain's grid is
+                # over 8 times it (loads that soften: each shooting costs as many more)
+                held = int(chain_meta[1])
+                ratio = max(1, (needed + held - 1) // held)
+                if held * ratio > 2 * M or held > 8 * M or held * ratio > n_max // 4 or \
+                        held * ratio > chain_Z.shape[0]:
+                    warm = False
+                    again = True
+                    continue
+                M = held * ratio
                 levels = 0
             chunks, nc, first, csteps, work, colscale, rowscale = _ms_grid(arm, M, y.size)
             n = 12 * M - 6
@@ -4188,7 +4211,7 @@ def solve_stiff_cases(base, arm, act, loads, options, s_out, out, verdicts, inpu
                         held = held // 2
                     N = min(n_max // 2, max(N, held))
                 for i in range(M):
-                    mult[i] = chain_mult[i]
+                    mult[i] = chain_mult[i // ratio]
             status[b] = OK
             estimate = np.inf
             failures = 0
@@ -4198,9 +4221,13 @@ def solve_stiff_cases(base, arm, act, loads, options, s_out, out, verdicts, inpu
                 if path and warm:  # the path from the chain's solution, on N steps
                     _chunk_steps(chunks, nc, length, N, np.int64(1), mult, csteps)
                     _copy(chain_x, x)
-                    for i in range(M):
-                        for a in range(y.size):
-                            Z[i, a] = chain_Z[i, a]
+                    if ratio == 1:
+                        for i in range(M):
+                            for a in range(y.size):
+                                Z[i, a] = chain_Z[i, a]
+                    else:
+                        _ms_fill_nodes(x, chain_Z, ratio, Z, M, chunks, first, csteps, base,
+                                       arm, act, case, scratch, 0.0)
                     if not _ms_follow(x, Z, M, chunks, first, csteps, base, arm, act, case,
                                       scratch, colscale, rowscale, work, w, length, threshold,
                                       max_iterations, max_load_step, budget, final_step,
