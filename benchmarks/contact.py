@@ -120,13 +120,14 @@ def slider(repeats):
     case = load_case(Path(__file__).resolve().parents[1] / "examples" / "gripper_finger.toml")
     tendon, cylinder = case.loads
     solver = Solver(case.arm, s=int(case.solve.stations), tol=float(case.solve.tol))
-    law = solver.solve([tendon.replace(tension=15.0), cylinder]).loads[-1]  # (raised, kept)
+    solver.solve([tendon.replace(tension=15.0), cylinder])  # (its law raised, then kept)
     tensions = itertools.cycle([14.5, 15.0])
 
     def move():
         return solver.solve([tendon.replace(tension=next(tensions)), cylinder])
 
-    _, wall, cpu = _timed(move, repeats)
+    moved, wall, cpu = _timed(move, repeats)
+    law = moved.loads[-1]  # (the law the moves ended with)
     given = cylinder.replace(stiffness=law.stiffness, distance=law.distance)
     _, cold_wall, cold_cpu = _timed(lambda: solver.solve_from_unloaded(
         [tendon.replace(tension=14.5), given]), max(1, repeats // 2))
