@@ -1129,8 +1129,9 @@ class _StiffChain:
     """A chained Solver's memory on the multiple-shooting route (solve_stiff_cases'
     ``chain``): the last solution's base reaction, nodes and steps, and its loads, from
     which the next chained solve follows its loading path instead of from the unloaded arm
-    (the path from the last loads to the new ones, on the last solution's grid; a cold start
-    where that fails or the new loads need more intervals). ``key``: the kernel problem it
+    (the path from the last loads to the new ones, on the last solution's grid or that grid
+    refined where the new loads need more intervals; a cold start where that fails or would
+    take over twice a cold start's intervals: solve_stiff_cases). ``key``: the kernel problem it
     was solved on (Solver._stiff_chain). Measured on examples/gripper_finger.toml (201
     stations, tol 1e-6): a 0.5 N move of its tendon in contact, 1.0-1.4 s from the unloaded
     arm and 0.09-0.16 s from the last solution (docs/solver.md, "Chained solves")."""
