@@ -4099,7 +4099,7 @@ def solve_stiff_cases(base, arm, act, loads, options, s_out, out, verdicts, inpu
     unloaded arm (λ = 0) along its own loading path (the stiff route of
     :func:`solve_cases`: the same arguments where they exist, the same outputs), or, with
     ``chain`` on, from the last solution the chain holds (a chained Solver's quasi-static
-    path: :func:`_ms_warm`).
+    path: solver.py's ``_StiffChain``, docs/solver.md "Chained solves").
 
     The stages follow solve_cases': the path (in levels of intervals, :func:`_ms_path`),
     the solution at 2N (chord iterations with the factors at N, else Newton), the
@@ -4119,9 +4119,8 @@ def solve_stiff_cases(base, arm, act, loads, options, s_out, out, verdicts, inpu
     int64, meta (4,), piece (pieces, width), tip (TIP_LOADS,)); meta[0] is 0 (off: neither
     read nor written), 1 (on, holding nothing) or 2 (holding a solution: meta[1] its M,
     meta[2] its N, meta[3] its error estimate, x, Z[:M] and mult[:M] its nodes on N steps,
-    piece and tip its loads). A
-    chain on holds each case's solution for the next (the batch is one path) and nothing
-    after a case that failed.
+    piece and tip its loads). A chain on holds each case's solution for the next (the
+    batch is one path) and nothing after a case that failed.
     """
     piece_loads, tip_loads = loads
     nb = piece_loads.shape[0]
@@ -4222,9 +4221,7 @@ def solve_stiff_cases(base, arm, act, loads, options, s_out, out, verdicts, inpu
                     _chunk_steps(chunks, nc, length, N, np.int64(1), mult, csteps)
                     _copy(chain_x, x)
                     if ratio == 1:
-                        for i in range(M):
-                            for a in range(y.size):
-                                Z[i, a] = chain_Z[i, a]
+                        Z[:, :] = chain_Z[:M]
                     else:
                         _ms_fill_nodes(x, chain_Z, ratio, Z, M, chunks, first, csteps, base,
                                        arm, act, case, scratch, 0.0)
@@ -4330,16 +4327,11 @@ def solve_stiff_cases(base, arm, act, loads, options, s_out, out, verdicts, inpu
         if chained:  # the chain holds this solution (its nodes on N steps) for the next case
             chain_meta[0] = 1.0
             if status[b] == OK and M <= chain_Z.shape[0]:
-                _copy(x, chain_x)
-                for i in range(M):
-                    chain_mult[i] = mult[i]
-                    for a in range(y.size):
-                        chain_Z[i, a] = Z[i, a]
-                for j in range(npieces):
-                    for i in range(width):
-                        chain_piece[j, i] = piece_loads[b, j, i]
-                for i in range(TIP_LOADS):
-                    chain_tip[i] = tip_loads[b, i]
+                chain_x[:] = x
+                chain_Z[:M] = Z
+                chain_mult[:M] = mult
+                chain_piece[:, :] = piece_loads[b]
+                chain_tip[:] = tip_loads[b]
                 chain_meta[1] = M
                 chain_meta[2] = N
                 chain_meta[3] = estimate
