@@ -514,6 +514,13 @@ def test_a_chained_solver_in_contact_follows_its_path_from_its_last_solution(mon
     np.testing.assert_allclose(chained, reference.positions, rtol=0,
                                atol=2 * tol * case.arm.length)
     assert warm.size == 4 and np.all(warm <= cold / 5), (warm, cold)
+    # and, by hand, every station outside the cylinder (its axis the line a-b) to tol·L
+    capsule = cylinder.obstacles[0]
+    axis = (capsule.b - capsule.a) / np.linalg.norm(capsule.b - capsule.a)
+    offset = chained - capsule.a
+    across = offset - (offset @ axis)[..., None] * axis
+    gaps = np.linalg.norm(across, axis=-1) - capsule.radius - case.arm.section.radius
+    assert gaps.min() > -tol * case.arm.length
 
 
 @pytest.mark.slow  # (the finger tracked in contact with Jacobians: its own compiled variant)
