@@ -390,3 +390,37 @@ def test_ctrl_c_at_any_moment_exit_130_one_line(tmp_path, delay):
     assert process.returncode == 130, err
     assert one_line(err) == "softarm: interrupted"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["long.toml"]
+
+
+@pytest.mark.parametrize("became", [ImportError("initialization failed"), ValueError("bad")])
+def test_a_ctrl_c_that_a_c_extension_turns_into_another_error_is_still_a_ctrl_c(
+        monkeypatch, capsys, became):
+    """Found by CI: a SIGINT landing in scipy's HiGHS wrapper while the parser imports
+    ``softarm reproduce`` (pybind11 turns the KeyboardInterrupt of its initialisation into
+    "ImportError: initialization failed") gave a traceback and exit 1. The same as a test:
+    the handler runs (as the signal would) and something turns its KeyboardInterrupt into
+    another error, either escaping the command or caught by its own error handling (a
+    ValueError is "bad input", exit 2): exit 130, one line."""
+    def parser_interrupted_in_an_import():
+        try:
+            cli._Interrupt.handler(signal.SIGINT, None)
+        except KeyboardInterrupt as interrupt:
+            raise became from interrupt
+        raise AssertionError("the handler did not raise")
+
+    if isinstance(became, ImportError):
+        monkeypatch.setattr(cli, "_parser", parser_interrupted_in_an_import)
+        argv = ["--version"]
+    else:
+        original = cli._parser
+
+        def parser():
+            built = original()
+            solve = built._subparsers._group_actions[0].choices["solve"]
+            solve.set_defaults(run=lambda args: parser_interrupted_in_an_import())
+            return built
+
+        monkeypatch.setattr(cli, "_parser", parser)
+        argv = ["solve", "nothing.toml"]
+    assert cli.main(argv) == 130
+    assert one_line(capsys.readouterr().err) == "softarm: interrupted"

@@ -413,6 +413,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         return code
     except KeyboardInterrupt:
         return interrupted()
+    except BaseException:
+        # A C extension may turn the KeyboardInterrupt raised in its initialisation into
+        # another error (scipy's HiGHS wrapper, imported by `softarm reproduce`'s parser:
+        # "ImportError: initialization failed"): what decides is the memory of the Ctrl-C.
+        if _Interrupt.seen and not _Interrupt.done:
+            return interrupted()
+        raise
     finally:
         _Interrupt.done = True
         sys.unraisablehook = hook
@@ -464,6 +471,8 @@ def _line(message: str, limit: int = 600) -> str:
 
 
 def _fail(code: int, message: str) -> int:
+    if code != 130:  # an error that a Ctrl-C became (in a C extension) is the Ctrl-C
+        _Interrupt.check()
     print(_line(message), file=sys.stderr)
     return code
 
