@@ -1,5 +1,6 @@
 """Every capability of softarm, each on a small problem (tests/test_compile_all.py runs this
-after ``softarm compile --all`` in the same fresh numba cache: nothing may compile here).
+after ``softarm compile --all`` in the same numba cache: every kernel version used here must
+be one that ``compile --all`` used, so that nothing compiles here in a user's fresh cache).
 
 ``python tests/_every_capability.py [NAME ...]``: prints ``NAME: ok SECONDS`` per capability, or
 the error, and exits 1 if any failed. Chosen by what a user calls, not by softarm's kernels:

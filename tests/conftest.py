@@ -59,14 +59,14 @@ def _slow_left_out(config) -> bool:
     return not (config.option.markexpr or config.getoption("--run-slow"))
 
 
-#: test files that start first under pytest-xdist, in this order (two workers take them in
-#: turn). First the longest single piece of work (the fresh cache's ``softarm compile --all``,
-#: about 7 minutes: ``pytest -m slow``), so that it runs beside everything else instead of after
-#: it. Then, for a first run (numba's cache empty, most of its time compiling), files whose
-#: first tests compile different capabilities, so that the two workers do not compile the same
-#: one at once (measured: 97 s of such duplicates in a 431-s run, the passive solver and the
-#: contact solver above all): the passive solver and multiple shooting; actuated arms;
-#: contact; dynamics.
+#: test files that start first under pytest-xdist, in this order (two workers take them in turn).
+#: First the longest single piece of work (``softarm compile --all`` and every capability after it:
+#: ``pytest -m slow``), so that it runs beside everything else instead of after it, and the slow
+#: tests after it load what it compiled. Then, for a first run (numba's cache empty, most of its
+#: time compiling), files whose first tests compile different capabilities, so that the two workers
+#: do not compile the same one at once (measured: 97 s of such duplicates in a 431-s run, the
+#: passive solver and the contact solver above all): the passive solver and multiple shooting;
+#: actuated arms; contact; dynamics.
 STARTS_FIRST = ("tests/test_compile_all.py", "tests/statics/test_invariants.py",
                 "tests/test_model_limits.py", "tests/test_contact.py", "tests/test_dynamics.py")
 
