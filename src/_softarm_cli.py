@@ -16,7 +16,11 @@ mask when it returns, so a Ctrl-C after the command's work (its outputs written)
 is dropped at exit: the exit status is the command's.
 """
 
-import signal
+# _signal and sys are built into the interpreter: importing them looks for no file, so the
+# handler is in place a few microseconds after this module starts. (``import signal`` first,
+# a Python module found on sys.path, left a window: CI's SIGINT at 0.05 s landed in its
+# file lookup, before the handler, and the command died with a traceback from this module.)
+import _signal
 import sys
 
 _INTERRUPTED = False
@@ -29,9 +33,11 @@ def _on_ctrl_c(signum, frame):
 
 
 try:
-    signal.signal(signal.SIGINT, _on_ctrl_c)
+    _signal.signal(_signal.SIGINT, _on_ctrl_c)
 except (ValueError, OSError):  # pragma: no cover - not the main thread
     pass
+
+import signal  # noqa: E402  (the handler above is in place)
 
 
 def _block_ctrl_c() -> None:
