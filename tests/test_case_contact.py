@@ -99,7 +99,6 @@ def test_the_case_solves_as_the_contact_built_by_hand(table_case, table_eq):
     assert 0.3 * weight < table_eq.contact_wrench[2] < weight
 
 
-@pytest.mark.slow  # (in contact, with the verdict: tests/test_contact.py's design note)
 def test_to_dict_round_trip_gives_the_same_contact_and_solve(table_case, table_eq):
     data = table_case.to_dict()
     assert data["obstacle"][0] == {"kind": "plane", "point": [0.0, 0.0, -0.05],
@@ -109,7 +108,6 @@ def test_to_dict_round_trip_gives_the_same_contact_and_solve(table_case, table_e
     np.testing.assert_array_equal(solve_case(again).poses, table_eq.poses)
 
 
-@pytest.mark.slow  # (in contact, with the verdict: tests/test_contact.py's design note)
 def test_the_solved_loads_written_back_reproduce_the_contact_law(table_eq):
     """contact_to_dict of eq.loads carries the stiffness the solver chose: read back, the
     same Contact, and solved with that stiffness fixed, the same shape."""
@@ -142,7 +140,6 @@ def test_contact_to_dict_without_contact_and_defaults():
 
 @pytest.mark.parametrize("suffix", [".csv", ".json", ".npz"])
 @pytest.mark.parametrize("with_case", [True, False])
-@pytest.mark.slow  # (in contact, with the verdict: tests/test_contact.py's design note)
 def test_result_files_keep_the_obstacles_and_the_contact_forces(tmp_path, table_case,
                                                                 table_eq, suffix, with_case):
     path = tmp_path / f"result{suffix}"

@@ -14,13 +14,6 @@
   the cantilever's π²/4;
 - the obstacles' distance functions against brute-force sampling of their surfaces;
 - bad input.
-
-Design note, for the default pytest's time: a solve in contact with the stability verdict
-compiles its own version of multiple shooting (73-116 s of a cold default run on a 2-core
-machine, the longest single compile), without it a version that takes a fifth of that. The
-verdict changes no number that these tests check, so the default tests solve without it
-(``stability=False``); the tests of the verdict in contact, and the case files and examples
-(which solve with it), are marked slow.
 """
 
 from __future__ import annotations
@@ -57,7 +50,7 @@ def lying(soft_arm):
     """The arm lying on the table, at fine stations (the contact zone is √(EI/GA) = 8.7 mm
     wide), and the hard-contact reference."""
     s = np.linspace(0.0, L, 2001)
-    eq = sa.solve(soft_arm, [sa.Gravity(), _table()], s=s, stability=False)
+    eq = sa.solve(soft_arm, [sa.Gravity(), _table()], s=s)
     R = soft_arm.rigidities
     ref = table_reference(L, R.EA, R.GAy, R.EIy, RADIUS, soft_arm.linear_density * 9.81, DROP)
     return eq, ref
@@ -84,8 +77,7 @@ def test_table_pressure_and_total_force_match_the_reference(lying, soft_arm):
     assert np.allclose(eq.contact_forces[:, :2], 0.0)
     # the total (from the solve's balance: measured 2.9e-5 and 1.0e-5 off, the band's
     # width; 2e-3 when it was summed on stations), whatever stations were asked for
-    coarse = sa.solve(soft_arm, [sa.Gravity(), _table()], s=np.linspace(0.0, L, 11),
-                      stability=False)
+    coarse = sa.solve(soft_arm, [sa.Gravity(), _table()], s=np.linspace(0.0, L, 11))
     for total in (eq.contact_wrench, coarse.contact_wrench):
         assert total[2] == pytest.approx(ref.contact_force[1], rel=1e-4)
         # moment about y: spatial M_y = z f_x - x f_z = -(planar x f_z - z f_x)
@@ -108,7 +100,7 @@ def test_the_contact_wrench_is_the_contact_forces_integrated(soft_arm):
     other loads); a second method, the contact forces per length integrated on stations
     that resolve the zone, agrees to 1e-7 of the weight at tol = 1e-12."""
     s = np.linspace(0.0, L, 8001)
-    eq = sa.solve(soft_arm, [sa.Gravity(), _table()], s=s, tol=1e-12, stability=False)
+    eq = sa.solve(soft_arm, [sa.Gravity(), _table()], s=s, tol=1e-12)
     weight = soft_arm.linear_density * 9.81 * L
     f = eq.contact_forces
     density = np.concatenate([f, np.cross(eq.positions, f)], axis=-1)
@@ -133,8 +125,7 @@ def test_a_tip_propped_on_a_plane_carries_the_propped_cantilevers_force(soft_arm
     expected = force - gap / c
     plane = sa.Plane((0.0, 0.0, -(RADIUS + gap)), (0.0, 0.0, 1.0))
     eq = sa.solve(soft_arm, [sa.TipLoad(force=(0.0, 0.0, -force)),
-                             sa.Contact(plane, distance=distance)], s=np.linspace(0.0, L, 101),
-                  stability=False)
+                             sa.Contact(plane, distance=distance)], s=np.linspace(0.0, L, 101))
     assert eq.contact_wrench[2] == pytest.approx(expected, rel=within)
     # its moment about the origin: the force at the tip, x_tip = L less O(w²/L)
     assert eq.contact_wrench[4] == pytest.approx(-L * expected, rel=within)
@@ -145,8 +136,7 @@ def test_contact_converges_to_the_hard_limit_as_the_distance_shrinks(soft_arm, l
     s = np.linspace(0.0, L, 401)
     errors = []
     for distance in (1e-3 * L, 1e-4 * L):
-        eq = sa.solve(soft_arm, [sa.Gravity(), _table(distance=distance)], s=s,
-                      stability=False)
+        eq = sa.solve(soft_arm, [sa.Gravity(), _table(distance=distance)], s=s)
         errors.append(np.abs(eq.positions - ref.positions(s)).max() / L)
     # the shape lies about one band width off the hard solution: first order in δ
     assert errors[0] == pytest.approx(1e-3, rel=0.5)
@@ -159,7 +149,7 @@ def test_far_obstacles_change_nothing(soft_arm):
                       sa.Sphere((0.0, 3.0, 0.0), 0.5)])
     loads = [sa.Gravity(), sa.TipLoad(force=(0.0, 0.02, 0.0))]
     free = sa.solve(soft_arm, loads, s=s, method="numeric", tol=1e-11)
-    near = sa.solve(soft_arm, [*loads, far], s=s, tol=1e-11, stability=False)
+    near = sa.solve(soft_arm, [*loads, far], s=s, tol=1e-11)
     assert np.abs(near.positions - free.positions).max() < 1e-9 * L
     assert np.all(near.contact_forces == 0.0)
     assert np.all(near.contact_wrench == 0.0)
@@ -170,11 +160,9 @@ def test_batch_equals_loop(soft_arm):
     s = np.linspace(0.0, L, 21)
     forces = np.array([[0.0, 0.0, -0.01], [0.0, 0.0, 0.0], [0.0, 0.01, -0.02]])
     contact = _table(distance=1e-4 * L)
-    batch = sa.solve(soft_arm, [sa.Gravity(), sa.TipLoad(force=forces), contact], s=s,
-                     stability=False)
+    batch = sa.solve(soft_arm, [sa.Gravity(), sa.TipLoad(force=forces), contact], s=s)
     for b, force in enumerate(forces):
-        one = sa.solve(soft_arm, [sa.Gravity(), sa.TipLoad(force=force), contact], s=s,
-                       stability=False)
+        one = sa.solve(soft_arm, [sa.Gravity(), sa.TipLoad(force=force), contact], s=s)
         assert np.array_equal(batch.positions[b], one.positions)
         assert np.array_equal(batch.contact_forces[b], one.contact_forces)
 
@@ -227,7 +215,6 @@ def test_column_held_between_pins_buckles_at_the_clamped_pinned_load(pinned_colu
     assert free.factor == pytest.approx(math.pi**2 / 4, rel=1e-4)
 
 
-@pytest.mark.slow  # (the verdict in contact: its own compiled version, see the docstring)
 def test_stability_verdict_includes_the_contact(pinned_column):
     arm, pins = pinned_column
     below = sa.solve(arm, [sa.TipLoad(force=(-19.5, 0.0, 0.0)), pins])
@@ -362,9 +349,8 @@ def test_one_contact_per_solve(soft_arm):
 def test_friction_in_statics_returns_the_frictionless_equilibrium(soft_arm):
     s = np.linspace(0.0, L, 21)
     options = {"distance": 1e-4 * L}
-    smooth = sa.solve(soft_arm, [sa.Gravity(), _table(**options)], s=s, stability=False)
-    rough = sa.solve(soft_arm, [sa.Gravity(), _table(friction=0.5, **options)], s=s,
-                     stability=False)
+    smooth = sa.solve(soft_arm, [sa.Gravity(), _table(**options)], s=s)
+    rough = sa.solve(soft_arm, [sa.Gravity(), _table(friction=0.5, **options)], s=s)
     assert np.array_equal(smooth.positions, rough.positions)
     assert "μ = 0.5" in rough.loads[1].describe()
 
@@ -373,7 +359,7 @@ def test_a_given_stiffness_that_lets_the_arm_penetrate_is_an_error(soft_arm):
     soft = _table(distance=1e-4 * L, stiffness=1e5)  # k δ/2 = 2.5 N/m < the weight, 3.1 N/m
     with pytest.raises(sa.ConvergenceError,
                        match=r"penetrates an obstacle by [1-9]\.\d+e-05 m .*stiffness=1e\+05"):
-        sa.solve(soft_arm, [sa.Gravity(), soft], stability=False)
+        sa.solve(soft_arm, [sa.Gravity(), soft])
 
 
 @pytest.mark.slow

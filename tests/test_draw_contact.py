@@ -17,10 +17,7 @@ OBSTACLES = [softarm.Plane((0, 0, -0.05), (0, 0, 1)), softarm.Sphere((0.3, 0.3, 
 
 @pytest.fixture(scope="module")
 def table():
-    # (without the verdict, which draws nothing: its compiled version in contact is the
-    # longest compile of a cold default pytest; tests/test_contact.py's design note)
-    return softarm.solve(ARM, [softarm.Gravity(), softarm.Contact(OBSTACLES)], s=51,
-                         stability=False)
+    return softarm.solve(ARM, [softarm.Gravity(), softarm.Contact(OBSTACLES)], s=51)
 
 
 @pytest.mark.parametrize("obstacle", OBSTACLES, ids=lambda o: o.kind)

@@ -81,12 +81,7 @@ def test_design_sweep_example():
                                    atol=1e-12)
 
 
-#: the examples in contact: solved with the verdict, marked slow (tests/test_contact.py's note)
-TOUCHING = {p.stem for p in EXAMPLES.glob("*.toml") if "[[obstacle]]" in p.read_text("utf-8")}
-
-
-@pytest.mark.parametrize("name", [pytest.param(name, marks=pytest.mark.slow)
-                                  if name in TOUCHING else name for name in CASES])
+@pytest.mark.parametrize("name", CASES)
 def test_example_solves(name):
     case, result = solve(name)
     steps = (len(case.sweep.values),) if case.sweep else ()
@@ -192,7 +187,6 @@ def test_quickstart(tmp_path, monkeypatch, capsys):
     assert (tmp_path / "fig2.csv").exists()
 
 
-@pytest.mark.slow  # (in contact, with the verdict: tests/test_contact.py's design note)
 @pytest.mark.parametrize("name", ["table", "catheter_bend"])
 def test_contact_examples_balance(name):
     """The whole arm is in balance: the internal force at the clamp (spatial: R(0) = I)
@@ -216,7 +210,6 @@ def test_contact_examples_balance(name):
     assert np.abs(result.contact_wrench[:3]).max() > 0.1 * scale  # the obstacles carry load
 
 
-@pytest.mark.slow  # (in contact, with the verdict: tests/test_contact.py's design note)
 def test_table_example_lies_on_the_table():
     """The tip rests on the table: z = -0.05 + r (within the contact distance 1e-5 L)."""
     _, result = solve("table")
@@ -224,7 +217,6 @@ def test_table_example_lies_on_the_table():
     assert np.all(result.gaps > -1e-8 * 0.5)
 
 
-@pytest.mark.slow  # (in contact, with the verdict: tests/test_contact.py's design note)
 def test_gripper_finger_example_touches_the_cylinder():
     """The finger presses on the cylinder (a contact force towards +z, up and away from its
     axis) and goes round it: its tip is below the cylinder's top (z = -0.015 m)."""
