@@ -6,14 +6,16 @@ exit status 130, as at any other moment, instead of a traceback from the middle 
 
 Design note: the Ctrl-C handler is installed by the first statements of this module, before
 anything heavy is imported; only the Python interpreter's own start-up (10-70 ms, before any
-line of softarm runs) is out of reach. During the import, a Ctrl-C raises KeyboardInterrupt and
-is also remembered: a C extension may turn the KeyboardInterrupt into an ImportError (numpy:
-"PyCapsule_Import could not import module ...") or an ``except`` in a library may swallow it,
-so what decides is the memory, not the exception's type. Once imported, SIGINT is *blocked*
-(held by the kernel, not lost) until :func:`softarm.cli.main` has installed its own handler
-and unblocks it: a Ctrl-C in between reaches that handler. ``softarm.cli.main`` restores the
-mask when it returns, so a Ctrl-C after the command's work (its outputs written) stays held and
-is dropped at exit: the exit status is the command's.
+line of softarm runs) is out of reach. Until :func:`main` is called, a Ctrl-C is only
+remembered (the entry script runs lines of its own in between), and main() looks first. During
+the import in main(), a Ctrl-C raises KeyboardInterrupt and is also remembered: a C extension
+may turn the KeyboardInterrupt into an ImportError (numpy: "PyCapsule_Import could not import
+module ...") or an ``except`` in a library may swallow it, so what decides is the memory, not
+the exception's type. Once imported, SIGINT is *blocked* (held by the kernel, not lost) until
+:func:`softarm.cli.main` has installed its own handler and unblocks it: a Ctrl-C in between
+reaches that handler. ``softarm.cli.main`` restores the mask when it returns, so a Ctrl-C after
+the command's work (its outputs written) stays held and is dropped at exit: the exit status is
+the command's.
 """
 
 # _signal and sys are built into the interpreter: importing them looks for no file, so the
@@ -24,12 +26,18 @@ import _signal
 import sys
 
 _INTERRUPTED = False
+#: Whether a Ctrl-C raises: only inside main(). Before it, in the entry script's own lines
+#: between its import of this module and its call of main() (pip's script runs a re.sub
+#: there; CI's SIGINT at 0.05 s landed in it), a Ctrl-C is only remembered, and main()
+#: starts by looking.
+_ARMED = False
 
 
 def _on_ctrl_c(signum, frame):
     global _INTERRUPTED
     _INTERRUPTED = True
-    raise KeyboardInterrupt
+    if _ARMED:
+        raise KeyboardInterrupt
 
 
 try:
@@ -62,7 +70,11 @@ def _interrupted() -> int:
 
 
 def main() -> int:
+    global _ARMED
     try:
+        _ARMED = True  # (inside the try: a Ctrl-C raising from here on is caught below)
+        if _INTERRUPTED:  # remembered before main() was called
+            return _interrupted()
         from softarm.cli import main as run
 
         if hasattr(signal, "pthread_sigmask"):

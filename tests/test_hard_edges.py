@@ -424,3 +424,17 @@ def test_a_ctrl_c_that_a_c_extension_turns_into_another_error_is_still_a_ctrl_c(
         argv = ["solve", "nothing.toml"]
     assert cli.main(argv) == 130
     assert one_line(capsys.readouterr().err) == "softarm: interrupted"
+
+
+def test_a_ctrl_c_between_the_entry_scripts_import_and_its_call_is_a_ctrl_c():
+    """Found by CI: pip's entry script runs lines of its own (a re.sub of argv[0]) between
+    ``from _softarm_cli import main`` and ``main()``; a SIGINT there (at 0.05 s) raised from
+    the handler outside any try: a traceback and death by SIGINT. The signal sent in exactly
+    that gap: exit 130, one line, and main() returns before importing softarm at all."""
+    launcher = ("import os, signal, sys, _softarm_cli\n"
+                "os.kill(os.getpid(), signal.SIGINT)\n"
+                "sys.exit(_softarm_cli.main() + 100 * ('softarm.cli' in sys.modules))")
+    run = subprocess.run([sys.executable, "-c", launcher, "--version"], capture_output=True,
+                         text=True, timeout=120)
+    assert run.returncode == 130, run.stderr
+    assert one_line(run.stderr) == "softarm: interrupted"
