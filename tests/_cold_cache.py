@@ -35,7 +35,11 @@ def softarm_with(*args: str, cache: Path, notice: bool = True):
                           text=True, timeout=900, env=cache_env(cache, notice))
 
 
-def cache_env(cache: Path, notice: bool, prefetch: bool = False) -> dict:
-    return dict(os.environ, NUMBA_CACHE_DIR=str(cache),
-                SOFTARM_COMPILE_NOTICE="1" if notice else "0",
-                SOFTARM_PREFETCH="1" if prefetch else "0")
+def cache_env(cache: Path | None, notice: bool, prefetch: bool = False) -> dict:
+    """This process's environment with numba's cache ``cache`` (None: the one the tests
+    use), the compile notice and the verdict's compile on another core on or off."""
+    env = dict(os.environ, SOFTARM_COMPILE_NOTICE="1" if notice else "0",
+               SOFTARM_PREFETCH="1" if prefetch else "0")
+    if cache is not None:
+        env["NUMBA_CACHE_DIR"] = str(cache)
+    return env

@@ -7,27 +7,28 @@ tests/_touched.py): every version a capability uses must be one that ``compile -
 compiled or loaded. The module fixture runs them all; the tests read its outcome.
 
 Design note, for the slow run's wall time: ``compile --all`` in a fresh cache of its own
-compiled every kernel once more than the rest of the run (566 s of a 892-s ``pytest -m
-slow``, with a core of its own). In the tests' cache it compiles only what no test compiled
-before it, and the tests after it load what it compiled. What a user's fresh cache would
-give, "after ``compile --all`` nothing compiles", is the same statement as "every version a
-capability uses is one that ``compile --all`` used", and only the second holds in a cache
-that other tests share (one compiled there first, or lost to two processes writing its
-index at once, says nothing about ``compile --all``). The fixture runs in the setup of the
+compiled every kernel once more than the rest of the run (566 s of a 892-s ``pytest -m slow``,
+with a core of its own). In the tests' cache it compiles only what no test compiled before it
+(after a cold default run: 8 kernels, 173 s on a quiet machine), and the tests after it load
+what it compiled. (Under the slow run's load the fixture was not shorter for it: 738-832 s in
+.ci/run, its compiles beside the other worker's of the same slow-only kernels.) What a user's
+fresh cache would give, "after ``compile --all`` nothing compiles", is the same statement as
+"every version a capability uses is one that ``compile --all`` used", and only the second holds
+in a cache that other tests share (one compiled there first, or lost to two processes writing
+its index at once, says nothing about ``compile --all``). The fixture runs in the setup of the
 first of three tests in this file; tests/conftest.py puts this file first.
 """
 
 from __future__ import annotations
 
 import json
-import os
 import subprocess
 import sys
 from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
-from _cold_cache import PASSIVE_SOLVE, python_with, softarm_with
+from _cold_cache import PASSIVE_SOLVE, cache_env, python_with, softarm_with
 
 HERE = Path(__file__).parent
 
@@ -51,7 +52,7 @@ def _used(out: Path, *command: str) -> tuple[subprocess.CompletedProcess, dict]:
     kernel versions it used)."""
     run = subprocess.run([sys.executable, str(HERE / "_touched.py"), str(out), *command],
                          capture_output=True, text=True, timeout=1800,
-                         env=dict(os.environ, SOFTARM_COMPILE_NOTICE="1", SOFTARM_PREFETCH="0"))
+                         env=cache_env(None, notice=True))
     return run, json.loads(out.read_text()) if out.exists() else {}
 
 
