@@ -319,8 +319,8 @@ class Contact(Load):
     --------
     >>> import softarm
     >>> table = softarm.Plane(point=(0, 0, -0.05), normal=(0, 0, 1))
-    >>> softarm.Contact(table).describe()
-    'contact with 1 obstacle (plane), frictionless, contact distance 1e-05 L'
+    >>> print(softarm.Contact(table).describe())
+    contact with 1 obstacle (plane), frictionless, hard at a free tip, else contact distance 1e-05 L
     """
 
     obstacles: tuple
@@ -379,10 +379,14 @@ class Contact(Load):
         kinds = ", ".join(o.kind for o in self.obstacles)
         count = len(self.obstacles)
         friction = f"μ = {self.friction:g}" if self.friction else "frictionless"
-        distance = (f"{self.distance:g} m" if self.distance is not None
-                    else f"{DISTANCE:g} L")
+        if self.distance is not None:
+            distance = f"contact distance {self.distance:g} m"
+        elif self.stiffness is None and all(o.kind == "plane" for o in self.obstacles):
+            distance = f"hard at a free tip, else contact distance {DISTANCE:g} L"
+        else:
+            distance = f"contact distance {DISTANCE:g} L"
         return (f"contact with {count} obstacle{'s' * (count != 1)} ({kinds}), {friction}, "
-                f"contact distance {distance}")
+                f"{distance}")
 
     def check(self, arm) -> None:
         self.surface_radii(arm)

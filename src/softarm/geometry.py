@@ -346,14 +346,21 @@ def obstacle_outline(obstacle, axes: tuple[int, int], centre, half: float,
 
 
 def contact_arrows(result) -> Arrow | None:
-    """The contact forces per length (N/m, spatial) of an unbatched equilibrium as arrows at
-    the stations where they are nonzero (``result.contact_forces``), or None without a
-    contact (or without a force: a contact law the solver did not set)."""
-    if not contacts(result.loads):
+    """The contact forces of an unbatched equilibrium as arrows, or None without a contact:
+    per length (N/m, spatial) at the stations where they are nonzero
+    (``result.contact_forces``), or, for a tip held on a plane without a penalty
+    (statics/tip_contact.py: no stiffness, a nonzero ``contact_wrench``), the plane's
+    reaction (N) at the tip."""
+    found = contacts(result.loads)
+    if not found:
         return None
+    positions = np.asarray(result.poses, dtype=float)[:, :3, 3]
+    resultant = getattr(result, "contact_resultant", None)
+    if not np.any(found[0].stiffness) and resultant is not None and np.any(resultant[:3]):
+        return Arrow("contact force at the tip", positions[-1:],
+                     np.asarray(resultant, dtype=float)[None, :3], "N", key=("contact", "force"))
     forces = np.asarray(result.contact_forces, dtype=float)
     on = np.linalg.norm(forces, axis=-1) > 0.0
-    positions = np.asarray(result.poses, dtype=float)[:, :3, 3]
     return Arrow("contact force per length", positions[on], forces[on], "N/m",
                  key=("contact", "force"))
 

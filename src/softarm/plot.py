@@ -269,9 +269,10 @@ def _draw_contact(ax3, side, loads, extent, arrows=None, scale: float = 0.0) -> 
                            color=_CONTACT_COLOR, angles="xy", scale_units="xy", scale=1.0,
                            width=0.004, zorder=4)
         artist.set_gid("contact forces")
+        ax.update_datalim(arrows.origins[:, [i, j]] + tips[:, [i, j]])  # (quiver does not)
     largest = float(np.max(np.linalg.norm(arrows.vectors, axis=-1)))
-    return (f"; contact force per length (magenta) up to {largest:.3g} N/m, drawn "
-            f"{largest * scale:.3g} m long")
+    return (f"; {arrows.label} (magenta) {'' if arrows.unit == 'N' else 'up to '}"
+            f"{largest:.3g} {arrows.unit}, drawn {largest * scale:.3g} m long")
 
 
 def plot_sweep(result, values=None, *, label: str | None = None, fig=None,

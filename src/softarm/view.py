@@ -153,8 +153,9 @@ def _arrow_traces(arrows, scales, length: float) -> list[dict]:
 
 
 def _contact_traces(arrow, scales, length: float) -> list[dict]:
-    """The contact forces per length (:func:`softarm.geometry.contact_arrows`) as magenta
-    shafts and cones, scaled by ``scales[CONTACT_KEY]`` (m per N/m; absent: this
+    """The contact forces (:func:`softarm.geometry.contact_arrows`: per length, or a held
+    tip's) as magenta shafts and cones, scaled by ``scales[CONTACT_KEY]`` (m per N/m, or
+    per N; absent: this
     equilibrium's own, :func:`softarm.geometry.contact_scale`). Two traces, empty where no
     force acts, so that a sweep's frames and the app's updates keep their number."""
     scale = scales.get(CONTACT_KEY) or contact_scale([arrow], length)
@@ -163,7 +164,8 @@ def _contact_traces(arrow, scales, length: float) -> list[dict]:
     xs = [np.stack([origins[:, k], ends[:, k], np.full(len(origins), np.nan)], -1).ravel()
           for k in range(3)]
     norms = np.linalg.norm(vectors, axis=-1)
-    text = [f"contact force per length<br>{_vec(v)} N/m (|f| = {n:.3g} N/m)"
+    unit = arrow.unit
+    text = [f"{arrow.label}<br>{_vec(v)} {unit} (|f| = {n:.3g} {unit})"
             for v, n in zip(vectors, norms, strict=True)]
     heads = vectors / np.where(norms > 0, norms, 1.0)[:, None] * 0.03 * length
     return [{"type": "scatter3d", "mode": "lines", "x": xs[0], "y": xs[1], "z": xs[2],

@@ -8,6 +8,7 @@ the numerical work, for the whole batch at once, is :func:`softarm.statics._kern
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import functools
 import math
@@ -49,6 +50,7 @@ from . import _prefetch
 from ._stiff import STIFF_KL, tension_kl
 from .displacement import solve_displaced
 from .stability import verdict
+from .tip_contact import solve_tip_contact
 
 __all__ = ["METHOD", "PreparedSolve", "ShootResult", "Shooter", "Snapshot", "Solver",
            "check_base", "check_tol", "solve_numeric"]
@@ -1268,6 +1270,18 @@ class Solver:
         self._kept_law = None
         self.reset()
 
+    def _with_stations(self, s: np.ndarray, *, stability: bool) -> Solver:
+        """A Solver like this one (arm, tol, base, options) at the stations ``s`` (checked:
+        increasing, on [0, L]), with or without verdicts, at the unloaded arm."""
+        other = copy.copy(self)
+        other._s_kernel = np.array(s, dtype=np.float64)
+        other.s = other._s_kernel.copy()
+        other.s.setflags(write=False)
+        other.stability = stability
+        other._kept_law = None
+        other.reset()
+        return other
+
     def _stiff(self, loads, channels) -> np.ndarray:
         """Which cases go to multiple shooting (B,) bool: ``shooting`` "multiple" all,
         "single" none, "auto" those whose estimated kL reaches STIFF_KL (_stiff.py)."""
@@ -1433,6 +1447,11 @@ class Solver:
             if math.prod(shape) > CASES_PER_PART:
                 return self._solve_in_parts(loads, shape, chained=chained,
                                             jacobians=jacobians, outputs=outputs)
+            if outputs and not chained and contact_retry is None and \
+                    any(load.kind == "contact" for load in loads):
+                held = self._held_at_tip(loads, shape, jacobians)
+                if held is not None:
+                    return held
         k = _kernels()
         last = self._last if chained else None
         loads, shape, count, pieces, channels = self._prepare(
@@ -1624,6 +1643,63 @@ class Solver:
             **actuation,
         )
 
+    def _held_at_tip(self, loads, shape, jacobians: bool) -> Equilibrium | None:
+        """The unchained solve of ``loads`` (checked, batch ``shape``, with a Contact) where
+        the free tip alone touches planes, held exactly (tip_contact.py); the cases it does
+        not hold with the penalty; None where it holds none."""
+        contact = next(load for load in loads if load.kind == "contact")
+        _check_outside(self, contact)
+        fine, asked = _contact_stations(self._s_kernel, self.length, np.array([self.length]))
+        try:
+            found = solve_tip_contact(self, loads, shape, jacobians, fine, asked)
+            if found is not None:
+                held = np.flatnonzero(found[1].reshape(-1))
+                found = ([(held, found[0], held)], found[1])
+        except ConvergenceError:  # (some case's free arm, or a held iterate, failed)
+            if not shape:
+                return None  # (the penalty follows the path, or says where it fails)
+            found = self._held_case_by_case(loads, shape, jacobians)
+        if found is None:
+            return None
+        parts, which = found
+        if which.all() and len(parts) == 1:
+            return parts[0][1]  # (every case held, in one solve)
+        # the other cases with the penalty, each case's answer into the batch's result
+        rest = np.flatnonzero(~which.reshape(-1))
+        if rest.size:
+            parts.append((rest, self._solve(
+                [_part_of(load, shape, np.unravel_index(rest, shape)) for load in loads],
+                chained=False, jacobians=jacobians, checked=True,
+                contact_retry=(None, 0, 0)), slice(None)))
+        whole = _Parts(parts[-1][1], math.prod(shape))
+        for cases, part, taken in parts:
+            whole.put(part, cases, taken)
+        law = parts[-1][1]._contact()
+        if rest.size:  # the penalty's law, with no stiffness on the cases held at the tip
+            stiffness = np.zeros(math.prod(shape))
+            stiffness[rest] = np.broadcast_to(law.stiffness, rest.shape)
+            law = law._with_checked_stiffness(stiffness.reshape(shape))
+        return whole.equilibrium(shape, tuple(law if load.kind == "contact" else load
+                                              for load in loads))
+
+    def _held_case_by_case(self, loads, shape, jacobians: bool):
+        """:func:`solve_tip_contact`'s answer, case by case: ([(flat cases, their
+        Equilibrium)], held (``shape`` bool)), or None where no case is held."""
+        parts, which = [], np.zeros(math.prod(shape), dtype=bool)
+        for case in range(which.size):
+            index = np.unravel_index(np.array([case]), shape)
+            one = [_part_of(load, shape, index) for load in loads]
+            fine, asked = _contact_stations(self._s_kernel, self.length,
+                                            np.array([self.length]))
+            try:
+                found = solve_tip_contact(self, one, (1,), jacobians, fine, asked)
+            except ConvergenceError:
+                continue
+            if found is not None and found[1][0]:
+                parts.append((np.array([case]), found[0], slice(None)))
+                which[case] = True
+        return (parts, which.reshape(shape)) if which.any() else None
+
     def _solve_in_parts(self, loads, shape, *, chained: bool, jacobians: bool,
                         outputs: bool) -> Equilibrium | None:
         """:meth:`_solve` of a batch larger than a part (:data:`CASES_PER_PART`), part after
@@ -1643,7 +1719,7 @@ class Solver:
             if outputs:
                 if whole is None:
                     whole = _Parts(result, count)
-                whole.put(result, first)
+                whole.put(result, slice(first, first + index[0].size))
         return whole.equilibrium(shape, loads) if outputs else None
 
     def _unused(self, shape: tuple) -> np.ndarray:
@@ -1917,12 +1993,14 @@ class _Parts:
             if isinstance(value, np.ndarray) and field.name != "s":
                 self.arrays[field.name] = np.empty((count, *value.shape[1:]), value.dtype)
 
-    def put(self, part: Equilibrium, first: int) -> None:
+    def put(self, part: Equilibrium, cases, taken=slice(None)) -> None:
+        """Copy the cases ``taken`` of ``part`` (flat indices, default all) to the cases
+        ``cases`` of the whole (a slice or flat indices)."""
         for name, array in self.arrays.items():
             value = getattr(part, name)
             if isinstance(value, Stability):
                 value = np.stack([value.index, value.conservative], axis=-1)
-            array[first:first + len(value)] = value
+            array[cases] = np.reshape(value, (-1, *array.shape[1:]))[taken]
 
     def equilibrium(self, shape, loads) -> Equilibrium:
         fields = {}

@@ -1,0 +1,138 @@
+"""A free tip held on planes, exactly (issue 39; softarm/statics/tip_contact.py).
+
+- the held arm against an independent solve_bvp of the planar Reissner rod with the plane's
+  reaction as an unknown (tests/_tip_reference.py), flat and tilted planes, with gravity;
+- the propped cantilever with shear compliance (the force on the plane, no δ);
+- the contact wrench against the solve's global balance;
+- the held arm's Jacobians (compliance and actuation) against finite differences of solves;
+- the cases the route does not hold (an arm lying on a table, a column held past its free
+  buckling load) are the penalty's, and a batch of both equals its cases one by one.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from _tip_reference import tip_on_plane
+
+import softarm as sa
+from softarm.contact import balance
+from softarm.routing import Straight
+
+L = 0.5
+RADIUS = 0.01
+
+
+def _arm(E):
+    return sa.Arm(L, sa.Circle(RADIUS), sa.Material(youngs_modulus=E, poisson_ratio=0.5,
+                                                     density=1000.0))
+
+
+def _plane(point, normal):  # (x, z) pairs: the planes of the x-z bending plane
+    return sa.Plane((point[0], 0.0, point[1]), (normal[0], 0.0, normal[1]))
+
+
+@pytest.mark.parametrize(("E", "gravity", "force", "point", "normal"), [
+    (1e6, False, (0.0, -0.05), (0.0, -0.1), (0.0, 1.0)),   # the tip lands at 60° or so
+    (2e7, True, (0.0, -0.2), (0.0, -0.04), (0.3, 1.0)),    # a heavy arm on a tilted plane
+])
+def test_a_held_tip_matches_the_reissner_rod_with_the_planes_reaction(E, gravity, force,
+                                                                      point, normal):
+    arm = _arm(E)
+    rig = arm.rigidities
+    weight = arm.linear_density * 9.81 if gravity else 0.0
+    ref = tip_on_plane(L, rig.EA, rig.GAy, rig.EIy, RADIUS, weight, force, point, normal)
+    loads = [sa.TipLoad(force=(force[0], 0.0, force[1]))] + ([sa.Gravity()] if gravity else [])
+    eq = sa.solve(arm, [*loads, sa.Contact(_plane(point, normal))], s=101)
+    assert eq.method == "numeric.tip_contact"
+    assert np.abs(eq.positions - ref.positions(eq.s)).max() < 1e-7 * L  # (measured 1e-8 L)
+    unit = np.array([normal[0], 0.0, normal[1]]) / np.hypot(*normal)
+    assert eq.contact_wrench[:3] == pytest.approx(ref.reaction * unit, rel=1e-7, abs=1e-12)
+    # the contact wrench is the global balance: the base wrench less the other loads
+    s = np.linspace(0.0, L, 2001)
+    fine = sa.solve(arm, [*loads, sa.Contact(_plane(point, normal))], s=s)
+    assert fine.contact_wrench == pytest.approx(
+        balance(arm, loads, s, fine.poses, fine.base_wrench), abs=1e-9)
+    # the tip's surface on the plane, and no station inside it
+    assert fine.gaps[-1] == pytest.approx(0.0, abs=1e-2 * 1e-8 * L)
+    assert fine.gaps.min() >= -1e-8 * L
+    assert eq.stability.stable
+
+
+def test_the_propped_cantilevers_force_needs_no_contact_distance():
+    """The free tip 0.5 mm above a plane, pressed on it by 0.05 N: the propped cantilever
+    with shear compliance (small deflection: the tip moves w = P c, c = L³/(3 EI) + L/GA,
+    under the net P) puts F - w/c = 0.049906 N on the plane; its own error is O((w/L)²)
+    = 1e-6. The penalty's answer was first order in δ (3.4e-4 off at δ = 1e-6 m)."""
+    arm = _arm(1e6)
+    rig = arm.rigidities
+    force, gap = 0.05, 5e-4
+    c = L**3 / (3.0 * rig.EIy) + L / rig.GAy
+    plane = sa.Plane((0.0, 0.0, -(RADIUS + gap)), (0.0, 0.0, 1.0))
+    eq = sa.solve(arm, [sa.TipLoad(force=(0.0, 0.0, -force)), sa.Contact(plane)])
+    assert eq.method == "numeric.tip_contact"
+    assert eq.contact_wrench[2] == pytest.approx(force - gap / c, rel=2e-6)
+    assert eq.contact_wrench[4] == pytest.approx(-L * (force - gap / c), rel=2e-6)
+    assert np.all(eq.contact_forces == 0.0)  # (a point force: no force per length)
+
+
+def _central(solve, h):
+    return (solve(h) - solve(-h)) / (2.0 * h)
+
+
+def test_a_held_tips_jacobians_match_finite_differences():
+    arm = _arm(2e7)
+    plane = sa.Contact(_plane((0.0, -0.05), (0.2, 1.0)))
+    chamber = sa.Chamber(5e4, 2e-5, Straight(0.0, -0.006))
+    loads = [sa.Gravity(), sa.TipLoad(force=(0.0, 0.0, -0.05)), chamber]
+    eq = sa.solve(arm, [*loads, plane], jacobians=True)
+    assert eq.method == "numeric.tip_contact"
+    assert eq.contact_wrench[2] > 0.01  # (pressed)
+
+    def tip(extra=(0.0,) * 6, pressure=5e4):
+        extra = np.asarray(extra)
+        held = sa.solve(arm, [*loads[:2], chamber.replace(pressure=pressure),
+                              sa.TipLoad(force=extra[:3], moment=extra[3:]), plane], tol=1e-12,
+                        stability=False)  # (a dead couple has no verdict: not conservative)
+        assert held.method == "numeric.tip_contact"
+        R = held.tip[:3, :3]
+        turned = R @ eq.tip[:3, :3].T  # the rotation vector of the small turn
+        angle = 0.5 * np.array([turned[2, 1] - turned[1, 2], turned[0, 2] - turned[2, 0],
+                                turned[1, 0] - turned[0, 1]])
+        return np.concatenate([held.tip_position, angle])
+
+    for j, h in enumerate((1e-4,) * 3 + (1e-5,) * 3):
+        column = _central(lambda e, j=j: tip(np.eye(6)[j] * e), h)
+        assert eq.tip_compliance[:, j] == pytest.approx(column, rel=1e-4, abs=1e-9)
+    pressure = _central(lambda e: tip(pressure=5e4 + e), 10.0)
+    assert eq.actuation_jacobian[:, 0] == pytest.approx(pressure, rel=1e-4, abs=1e-12)
+    # held: the tip does not move along the plane's normal, whatever the wrench
+    normal = np.array([0.2, 0.0, 1.0]) / np.hypot(0.2, 1.0)
+    assert np.abs(normal @ eq.tip_compliance[:3]).max() < 1e-9 * np.abs(eq.tip_compliance).max()
+    # every station's compliance ends in the tip's
+    assert eq.compliance[-1] == pytest.approx(eq.tip_compliance, abs=1e-14)
+
+
+def test_cases_the_tip_cannot_hold_are_the_penaltys_and_a_batch_equals_its_cases():
+    """A batch of a held tip, a free arm that does not reach the plane, and an arm that lies
+    on it (contact zones: the penalty's): each case equals its own solve to the bit."""
+    arm = _arm(1e6)
+    plane = sa.Contact(sa.Plane((0.0, 0.0, -0.1 - RADIUS), (0.0, 0.0, 1.0)))
+    forces = np.array([[0.0, 0.0, -0.05], [0.0, 0.01, -0.01], [0.0, 0.0, 0.0]])
+    weights = np.array([[0.0, 0.0, -0.5], [0.0, 0.0, 0.0], [0.0, 0.0, -2.0]])  # (N/m)
+    s = np.linspace(0.0, L, 21)
+    batch = sa.solve(arm, [sa.TipLoad(force=forces), sa.DistributedForce(force=weights),
+                           plane], s=s)
+    methods = []
+    for b, (force, weight) in enumerate(zip(forces, weights, strict=True)):
+        one = sa.solve(arm, [sa.TipLoad(force=force), sa.DistributedForce(force=weight),
+                             plane], s=s)
+        methods.append(one.method)
+        assert np.array_equal(batch.positions[b], one.positions)
+        assert np.array_equal(batch.contact_wrench[b], one.contact_wrench)
+        assert np.array_equal(batch.contact_forces[b], one.contact_forces)
+    assert methods == ["numeric.tip_contact", "numeric.tip_contact", "numeric.shooting"]
+    assert batch.contact_wrench[1] == pytest.approx(np.zeros(6), abs=0.0)
+    # the lying arm: pressure along a zone (the penalty's), and on the held tip none
+    assert np.count_nonzero(np.abs(batch.contact_forces[2]).max(-1)) >= 3
+    assert not np.any(batch.contact_forces[:2])
