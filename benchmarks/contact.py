@@ -4,6 +4,9 @@ alternatives.
 - the heavy soft arm lying on a table (tol 1e-6 L), against the hard-contact free-boundary
   ``solve_bvp`` reference of tests/_table_reference.py (the alternative: a free-boundary
   solve written for this one geometry) and against the same arm without the table;
+- the free tip pressed onto a plane: held exactly (statics/tip_contact.py), against the
+  penalty at the default δ, the free arm, and the Reissner-rod ``solve_bvp`` reference of
+  tests/_tip_reference.py;
 - the arm pressed onto a pin (a Capsule) by gravity and a tip force;
 - a tendon finger closing on a cylinder, tracked over 100 tension steps (a prepared
   ForwardSolver, as a control loop calls it);
@@ -34,6 +37,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
 from _table_reference import table_reference
+from _tip_reference import tip_on_plane
 
 import softarm
 from softarm.case import load_case
@@ -82,6 +86,37 @@ def table(repeats):
     _, wall, cpu = _timed(lambda: softarm.solve(arm, loads[:1], tol=1e-6, s=201,
                                                 method="numeric"), repeats)
     rows.append(("the same arm without the table", wall, cpu, "", ""))
+    return rows
+
+
+def tip(repeats):
+    """The free tip pressed by 0.05 N onto a plane 0.1 m below the clamp (it lands at about
+    60°): held exactly (the default), with the penalty at the default δ given explicitly, the
+    free arm, and the Reissner-rod ``solve_bvp`` reference (tests/_tip_reference.py)."""
+    arm = _soft_arm()
+    plane = softarm.Plane((0.0, 0.0, -0.1 - RADIUS), (0.0, 0.0, 1.0))
+    force = softarm.TipLoad(force=(0.0, 0.0, -0.05))
+    k = arm.rigidities
+    ref, rwall, rcpu = _timed(lambda: tip_on_plane(
+        L, k.EA, k.GAy, k.EIy, RADIUS, 0.0, (0.0, -0.05), (0.0, -0.1 - RADIUS), (0.0, 1.0)), 1)
+    rows = []
+    for name, contact, tol in (("tip on a plane, held (tol 1e-6 L)", softarm.Contact(plane),
+                                1e-6),
+                               ("tip on a plane, held (tol 1e-8 L)", softarm.Contact(plane),
+                                1e-8),
+                               ("tip on a plane, penalty at δ = 1e-5 L (tol 1e-6 L)",
+                                softarm.Contact(plane, distance=1e-5 * L), 1e-6)):
+        eq, wall, cpu = _timed(lambda c=contact, tol=tol: softarm.solve(
+            arm, [force, c], tol=tol, s=201), repeats)
+        shape = np.abs(eq.positions - ref.positions(eq.s)).max() / L
+        error = abs(eq.contact_wrench[2] / ref.reaction - 1.0)
+        rows.append((f"{name} ({eq.method})", wall, cpu,
+                     f"{shape:.1e} L; force {error:.1e}", ""))
+    rows.append(("tip on a plane, solve_bvp reference (hard contact)", rwall, rcpu,
+                 "reference", ""))
+    _, wall, cpu = _timed(lambda: softarm.solve(arm, [force], tol=1e-6, s=201,
+                                                method="numeric"), repeats)
+    rows.append(("the same arm without the plane", wall, cpu, "", ""))
     return rows
 
 
@@ -156,8 +191,8 @@ def measure(repeats: int) -> list[str]:
     """The markdown lines of docs/performance.md's "Contact" section (benchmarks/run.py)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # (stability and approximation notes)
-        rows = [*table(repeats), *pin(repeats), *finger(repeats), *slider(repeats),
-                *drop(repeats)]
+        rows = [*table(repeats), *tip(repeats), *pin(repeats), *finger(repeats),
+                *slider(repeats), *drop(repeats)]
     lines = ["## Contact", "",
              f"`python benchmarks/contact.py --repeats {repeats}` "
              f"({time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}): best of {repeats} after "

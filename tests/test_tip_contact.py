@@ -136,3 +136,22 @@ def test_cases_the_tip_cannot_hold_are_the_penaltys_and_a_batch_equals_its_cases
     # the lying arm: pressure along a zone (the penalty's), and on the held tip none
     assert np.count_nonzero(np.abs(batch.contact_forces[2]).max(-1)) >= 3
     assert not np.any(batch.contact_forces[:2])
+
+
+def test_pictures_draw_a_held_tips_reaction_at_the_tip():
+    from softarm.geometry import contact_arrows
+
+    arm = _arm(1e6)
+    eq = sa.solve(arm, [sa.TipLoad(force=(0.0, 0.0, -0.05)),
+                        sa.Contact(_plane((0.0, -0.1), (0.0, 1.0)))], s=21)
+    arrow = contact_arrows(eq)
+    assert arrow.unit == "N" and arrow.label == "contact force at the tip"
+    assert arrow.origins == pytest.approx(eq.tip_position[None], abs=0.0)
+    assert arrow.vectors[0] == pytest.approx(eq.contact_wrench[:3], abs=0.0)
+    # a penalty's (the same contact with δ given): forces per length, at their stations
+    penalty = sa.solve(arm, [sa.TipLoad(force=(0.0, 0.0, -0.05)),
+                             sa.Contact(_plane((0.0, -0.1), (0.0, 1.0)), distance=1e-3)],
+                       s=np.linspace(0.0, L, 2001))
+    arrow = contact_arrows(penalty)
+    assert arrow.unit == "N/m" and len(arrow.origins) >= 1
+

@@ -1,9 +1,11 @@
 """Contact with rigid obstacles fixed in space: :class:`Plane`, :class:`Sphere`,
 :class:`Capsule`, and the load :class:`Contact` that lets the arm's surface touch them.
 
-The method (docs/contact.md): a penalty on the gap g between the arm's surface (a tube of
-radius r around the centreline) and each obstacle, a force per unit length along the
-obstacle's outward normal through the centreline,
+The method (docs/contact.md): a free tip that alone touches planes is held exactly, its
+reaction found by Newton's method over plain solves (statics/tip_contact.py); elsewhere a
+penalty on the gap g between the arm's surface (a tube of radius r around the centreline)
+and each obstacle, a force per unit length along the obstacle's outward normal through the
+centreline,
 
     f = φ(g) n,   φ(g) = 0 for g >= δ,   k δ (t³ - t⁴/2) with t = (δ - g)/δ for 0 < g < δ,
     φ(g) = k (δ/2 - g) for g <= 0,
@@ -301,8 +303,11 @@ class Contact(Load):
     friction : float
         Coulomb's μ >= 0 (dynamics; statics returns the frictionless equilibrium).
     distance : float or None
-        The contact distance δ (m): forces act only where the gap is below it. Default
-        1e-5 L. The shape is within about δ of the hard-contact solution.
+        The contact distance δ (m) of the penalty: forces act only where the gap is below
+        it. Default 1e-5 L. The shape is within about δ of the hard-contact solution.
+        Without ``distance`` and ``stiffness``, a free tip that alone touches planes is
+        held exactly, with no δ (``softarm.solve``; docs/contact.md, "A free tip on
+        planes"); giving either asks for the penalty everywhere.
     radius : float or None
         The arm's surface radius (m). Default: the section's (``Arm.radius``, per segment);
         required for an arm given by its stiffnesses.

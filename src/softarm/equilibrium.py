@@ -138,7 +138,8 @@ class Equilibrium:
     loads : tuple
         The loads as given.
     method : str
-        The solution used, e.g. ``"analytic.tip_moment"`` or ``"numeric.shooting"``.
+        The solution used, e.g. ``"analytic.tip_moment"``, ``"numeric.shooting"`` or
+        ``"numeric.tip_contact"`` (a free tip held exactly on planes, docs/contact.md).
     exact : bool
         True only if the result solves the full Cosserat model (eq. 20) for these loads (to
         the solver's tolerance for numerical results).

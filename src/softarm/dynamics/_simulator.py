@@ -520,9 +520,12 @@ class Simulator:
             return
         off = float(np.max(np.linalg.norm(start.positions[..., -1, :]
                                           - initial.positions[..., -1, :], axis=-1)))
+        # (a free tip held exactly on planes has no law: statics/tip_contact.py)
+        solved = "with its tip held exactly (no contact distance), unlike" \
+            if given.distance is None else \
+            f"with another contact law (distance {given.distance:.3g} m) than"
         warnings.warn(
-            f"initial: the Equilibrium was solved with another contact law (distance "
-            f"{given.distance:.3g} m) than the time steps use (distance "
+            f"initial: the Equilibrium was solved {solved} the time steps (distance "
             f"{float(np.max(law.distance)):.3g} m, the stiffness at most μ/Δt²: "
             f"docs/contact.md, \"Dynamics\"); the arm starts at rest under the steps' law, "
             f"its tip {off:.3g} m from the Equilibrium's", ApproximationWarning, stacklevel=4)
