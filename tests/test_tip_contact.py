@@ -74,6 +74,12 @@ def test_the_propped_cantilevers_force_needs_no_contact_distance():
     assert eq.contact_wrench[2] == pytest.approx(force - gap / c, rel=2e-6)
     assert eq.contact_wrench[4] == pytest.approx(-L * (force - gap / c), rel=2e-6)
     assert np.all(eq.contact_forces == 0.0)  # (a point force: no force per length)
+    # a chained Solver (a quasi-static sweep, the app) holds it too, the same answer
+    solver = sa.statics.Solver(arm)
+    solver.solve([sa.TipLoad(force=(0.0, 0.0, -0.02)), sa.Contact(plane)])
+    chained = solver.solve([sa.TipLoad(force=(0.0, 0.0, -force)), sa.Contact(plane)])
+    assert chained.method == "numeric.tip_contact"
+    assert np.array_equal(chained.positions, eq.positions)
 
 
 def _central(solve, h):

@@ -1447,10 +1447,14 @@ class Solver:
             if math.prod(shape) > CASES_PER_PART:
                 return self._solve_in_parts(loads, shape, chained=chained,
                                             jacobians=jacobians, outputs=outputs)
-            if outputs and not chained and contact_retry is None and \
+            if outputs and contact_retry is None and \
                     any(load.kind == "contact" for load in loads):
                 held = self._held_at_tip(loads, shape, jacobians)
                 if held is not None:
+                    # (every held solve is from the unloaded arm: a chained Solver goes on
+                    # from there, whose answer this is where the held arm is stable)
+                    if chained:
+                        self.reset()
                     return held
         k = _kernels()
         last = self._last if chained else None
@@ -1648,6 +1652,8 @@ class Solver:
         the free tip alone touches planes, held exactly (tip_contact.py); the cases it does
         not hold with the penalty; None where it holds none."""
         contact = next(load for load in loads if load.kind == "contact")
+        if contact.stiffness is not None or contact.distance is not None:
+            return None  # (a penalty asked for)
         _check_outside(self, contact)
         fine, asked = _contact_stations(self._s_kernel, self.length, np.array([self.length]))
         try:

@@ -52,6 +52,8 @@ import dataclasses
 
 import numpy as np
 
+from ..equilibrium import Stability
+from ..errors import ConvergenceError
 from ..loads import TipLoad
 
 __all__ = ["METHOD", "solve_tip_contact"]
@@ -64,29 +66,27 @@ ITERATIONS = 60
 PATH = (0.25, 0.5, 0.75)
 #: Uniform stations of the path's check and of the Newton iterations.
 COARSE = 201
+#: The load factors k/CURVED_PATH at which a path near a ball or a capsule is checked.
+CURVED_PATH = 16
+#: Turns of the reaction's direction n̂ (a curved obstacle's normal at the new tip) at most,
+#: and the change of n̂ below which it has stopped turning.
+TURNS = 20
+TURNED = 1e-12
+#: The step of the curvature's differences, as a fraction of the obstacle's radius.
+CURVATURE_STEP = 1e-5
 #: The route's name in ``Equilibrium.method``.
 METHOD = "numeric.tip_contact"
 
 
-def _planes(contact) -> np.ndarray | None:
-    """(K, 2, 3): each plane's point and outward unit normal, or None where the route does
-    not apply to this Contact (an obstacle other than a plane, or a penalty asked for)."""
-    if contact.stiffness is not None or contact.distance is not None:
-        return None
-    if any(obstacle.kind != "plane" for obstacle in contact.obstacles):
-        return None
-    return np.array([(obstacle.point, obstacle.normal) for obstacle in contact.obstacles])
-
-
-def _gaps(planes, positions, radii) -> np.ndarray:
-    """(K, ..., S): the gap to each plane at centreline positions (..., S, 3) with surface
-    radii (S,) (m)."""
-    return np.stack([(positions - point) @ normal - radii for point, normal in planes])
+def _gaps(obstacles, positions, radii) -> np.ndarray:
+    """(K, ..., S): the gap to each obstacle at centreline positions (..., S, 3) with
+    surface radii (S,) (m)."""
+    return np.stack([obstacle.distance(positions)[0] - radii for obstacle in obstacles])
 
 
 def _at_tip_only(gaps, depth: float) -> np.ndarray:
     """(...) bool, from gaps (K, ..., S): whether the stations deeper than ``depth`` inside
-    a plane are on one plane at most and form a run that ends at the last station."""
+    an obstacle are in one obstacle at most and form a run that ends at the last station."""
     inside = gaps < -depth
     runs = np.all(np.diff(inside.astype(np.int8), axis=-1) >= 0, axis=(0, -1))
     return runs & (inside.any(axis=-1).sum(axis=0) <= 1)
@@ -96,9 +96,39 @@ def _dot(a, b):
     return np.einsum("...j,...j->...", a, b)
 
 
+def _matvec(A, x):
+    return np.einsum("...ij,...j->...i", A, x)
+
+
+def _path(coarse, free, obstacles) -> tuple[list, np.ndarray]:
+    """The free arm's positions (..., S, 3) at the load factors of its path's check, and
+    the cases (bool) whose stations move less than half the smallest curved obstacle's
+    radius between two of them (none passes through a ball or a pin unseen): PATH with
+    planes only, else CURVED_PATH uniform factors, the same for every batch."""
+    radii = [obstacle.radius for obstacle in obstacles if obstacle.kind != "plane"]
+    factors = PATH if not radii else np.arange(1, CURVED_PATH) / CURVED_PATH
+    positions = [coarse._solve(tuple(load.scaled(factor) for load in free), chained=False,
+                               jacobians=False, checked=True).positions
+                 for factor in (0.0, *factors)]
+    if not radii:
+        return positions[1:], True
+    moves = np.linalg.norm(np.diff(np.stack(positions), axis=0), axis=-1)  # (F, ..., S)
+    return positions[1:], moves.max(axis=(0, -1)) <= 0.5 * min(radii)
+
+
+def _curvature(obstacle, p, h) -> np.ndarray:
+    """(..., 3, 3): ∇²d of the obstacle's signed distance at points p (..., 3), from
+    central differences of its normal with step h (m): zero for a plane, (I - n̂ n̂ᵀ)/ρ on
+    a ball (ρ the distance from its centre)."""
+    columns = [(obstacle.distance(p + h * e)[1] - obstacle.distance(p - h * e)[1]) / (2 * h)
+               for e in np.eye(3)]
+    hessian = np.stack(columns, axis=-1)
+    return 0.5 * (hessian + np.swapaxes(hessian, -1, -2))
+
+
 def solve_tip_contact(solver, loads, shape, jacobians: bool, fine, asked):
     """(the Equilibrium of ``loads`` (checked, batch ``shape``, one Contact) with the arm's
-    free tip held outside the Contact's planes (module docstring) at ``solver``'s
+    free tip held outside the Contact's obstacles (module docstring) at ``solver``'s
     stations, the cases it holds (``shape`` bool)), or None where the route applies to no
     case; the caller solves the others with the penalty. ``fine``, ``asked``: the solver's
     stations in contact and the index of each asked one among them
@@ -106,88 +136,163 @@ def solve_tip_contact(solver, loads, shape, jacobians: bool, fine, asked):
     solve (the free arm's path, a held iterate) is raised: the caller then tries the
     cases one by one."""
     contact = next(load for load in loads if load.kind == "contact")
-    planes = _planes(contact)
-    if planes is None or (jacobians and any(load.kind == "tendon" for load in loads)):
-        return None
+    obstacles = contact.obstacles
+    if contact.stiffness is not None or contact.distance is not None or (
+            jacobians and any(load.kind == "tendon" for load in loads)):
+        return None  # (a penalty asked for; tendons' length Jacobians)
     free = tuple(load for load in loads if load.kind != "contact")
     depth = solver.tol * solver.length
     coarse = solver._with_stations(np.linspace(0.0, solver.length, COARSE), stability=False)
     radii = contact.station_radii(solver.arm, coarse.s)
     held = np.ones(shape, dtype=bool)  # the cases this route answers
-    for factor in PATH:  # the free arm on its way to the full load
-        eq = coarse._solve(tuple(load.scaled(factor) for load in free), chained=False,
-                           jacobians=False, checked=True)
-        held &= _at_tip_only(_gaps(planes, eq.positions, radii), depth)
+    path, seen = _path(coarse, free, obstacles)
+    held &= seen
+    for positions in path:  # the free arm on its way to the full load
+        held &= _at_tip_only(_gaps(obstacles, positions, radii), depth)
     eq = coarse._solve(free, chained=False, jacobians=True, checked=True)
-    gaps = _gaps(planes, eq.positions, radii)
+    gaps = _gaps(obstacles, eq.positions, radii)
     held &= _at_tip_only(gaps, depth)
     if not held.any():
         return None
-    # Newton's method on λ, per case (0 where the free tip is outside every plane)
+    # Newton's method on λ, per case (0 where the free tip is outside every obstacle), the
+    # reaction's direction n̂ frozen; then n̂ at the new tip, until it stays (a plane's at once)
     touching = held & (gaps[..., -1].min(axis=0) < -depth)
-    under = planes[np.argmin(gaps[..., -1], axis=0)]  # (*shape, 2, 3): the tip's plane
-    point, normal = under[..., 0, :], under[..., 1, :]
-    level = _dot(point, normal) + radii[-1]  # the gap is p(L) · n̂ - level
-    lam, low, high = np.zeros(shape), np.zeros(shape), np.full(shape, np.inf)
-    for _ in range(ITERATIONS):
-        gap = _dot(eq.tip_position, normal) - level
-        slope = _dot(normal, np.einsum("...ij,...j->...i", eq.tip_compliance[..., :3, :3],
-                                       normal))
-        # a case stops where it converged (its λ does not depend on its batch's), or where
-        # the held tip's Newton step has no direction
-        touching &= np.abs(gap) > GAP * depth
-        held &= ~(touching & (slope <= 0.0))
-        touching &= held
-        if not touching.any():
+    which = np.argmin(gaps[..., -1], axis=0)  # (*shape): the obstacle under the tip
+
+    def nearest(tip):  # (gap (*shape), n̂ (*shape, 3)) to each case's obstacle
+        found = [obstacle.distance(tip) for obstacle in obstacles]
+        d = np.choose(which, [f[0] for f in found])
+        n = np.stack([f[1] for f in found])[(which, *np.indices(shape))]
+        return d - radii[-1], n
+
+    gap, normal = nearest(eq.tip_position)
+    lam = np.zeros(shape)
+    for _ in range(TURNS):
+        low, high = np.zeros(shape), np.full(shape, np.inf)
+        active = touching.copy()
+        for _ in range(ITERATIONS):
+            slope = _dot(normal, _matvec(eq.tip_compliance[..., :3, :3], normal))
+            # a case stops where it converged (its λ does not depend on its batch's), or
+            # where the held tip's Newton step has no direction
+            active &= np.abs(gap) > GAP * depth
+            held &= ~(active & (slope <= 0.0))
+            active &= held
+            if not active.any():
+                break
+            # g(λ) rises with λ (slope > 0): a bracket [low, high] of the root, and Newton's
+            # step inside it, else its middle (large deflections: the tip's height saturates
+            # at ±L and plain Newton overshoots without end)
+            low, high = np.where(gap < 0.0, lam, low), np.where(gap > 0.0, lam, high)
+            step = lam - gap / np.where(active, slope, 1.0)
+            inside = (step > low) & (step < high)
+            lam = np.where(active, np.where(inside, step, 0.5 * (low + high)), lam)
+            for _ in range(ITERATIONS):
+                try:
+                    eq = coarse._solve((*free, TipLoad(force=lam[..., None] * normal)),
+                                       chained=False, jacobians=True, checked=False)
+                    break
+                except ConvergenceError:
+                    # a reaction the plain solve cannot follow from the unloaded arm (one
+                    # far too large: it turns the arm over): back towards the bracket's
+                    # low end. A batch is tried case by case (Solver._held_at_tip).
+                    if shape:
+                        raise
+                    high = lam
+                    lam = 0.5 * (low + high)
+            gap = nearest(eq.tip_position)[0]
+        held &= ~active  # (not converged)
+        gap, turned = nearest(eq.tip_position)
+        moved = touching & held & (np.linalg.norm(turned - normal, axis=-1) > TURNED)
+        if not moved.any():
             break
-        # g(λ) rises with λ (slope > 0): a bracket [low, high] of the root, and Newton's
-        # step inside it, else its middle (large deflections: the tip's height saturates at
-        # ±L and plain Newton overshoots without end)
-        low, high = np.where(gap < 0.0, lam, low), np.where(gap > 0.0, lam, high)
-        step = lam - gap / np.where(touching, slope, 1.0)
-        inside = (step > low) & (step < high)
-        lam = np.where(touching, np.where(inside, step, 0.5 * (low + high)), lam)
+        normal = np.where(moved[..., None], turned, normal)
         eq = coarse._solve((*free, TipLoad(force=lam[..., None] * normal)), chained=False,
                            jacobians=True, checked=False)
-    held &= ~touching & (lam >= 0.0)
+        gap = nearest(eq.tip_position)[0]
+    else:
+        held &= ~moved
+    held &= lam >= 0.0
     lam = np.where(held, lam, 0.0)
     if not held.any():
         return None
+    curved = any(obstacle.kind != "plane" for obstacle in obstacles)
     final = solver._with_stations(fine, stability=solver.stability)._solve(
-        (*free, TipLoad(force=lam[..., None] * normal)), chained=False, jacobians=jacobians,
-        checked=False)
-    gaps = _gaps(planes, final.positions, contact.station_radii(solver.arm, fine))
+        (*free, TipLoad(force=lam[..., None] * normal)), chained=False,
+        jacobians=jacobians or (curved and solver.stability), checked=False)
+    gaps = _gaps(obstacles, final.positions, contact.station_radii(solver.arm, fine))
     held &= np.all(gaps >= -depth, axis=(0, -1))  # (else contact zones: the penalty's)
+    pressed = held & (lam > 0.0)
+    # the constraint's curvature: the reaction λ n̂(p) turns with the tip (∇²d, zero on a
+    # plane), a stiffness -λ ∇²d at the tip
+    tip = final.tip_position
+    bent = np.zeros((*shape, 3, 3))
+    for k, obstacle in enumerate(obstacles):
+        if obstacle.kind != "plane":
+            mine = pressed & (which == k)
+            bent[mine] = -lam[mine][..., None, None] * _curvature(
+                obstacle, tip[mine], CURVATURE_STEP * obstacle.radius)
+    changes = {}
     if solver.stability:  # (final's verdict: the free arm's with the dead force λ n̂)
         held &= np.asarray(final.stability.stable)
+        index = _held_index(final.tip_compliance, normal, bent) if curved else 0
+        changes["stability"] = Stability.of(np.where(pressed, index, 0), True, shape)
     if not held.any():
         return None
-    changes = {}
     if jacobians:
-        changes.update(_held_jacobians(final, asked, normal, lam > 0.0))
+        changes.update(_held_jacobians(final, asked, normal, bent, pressed))
+    else:  # (the compliance was the verdict's)
+        changes.update(dict.fromkeys(("tip_compliance", "compliance", "actuation_jacobian",
+                                      "station_actuation_jacobian",
+                                      "tendon_length_jacobian")))
     force = lam[..., None] * normal
-    wrench = np.concatenate([force, np.cross(final.tip_position, force)], axis=-1)
+    wrench = np.concatenate([force, np.cross(tip, force)], axis=-1)
     return dataclasses.replace(
         final, s=solver.s, poses=final.poses[..., asked, :, :],
         strains=final.strains[..., asked, :], stresses=final.stresses[..., asked, :],
         loads=loads, method=METHOD, contact_resultant=wrench, **changes), held
 
 
-def _held_jacobians(final, asked, normal, pressed) -> dict:
+def _held_index(compliance, normal, bent) -> np.ndarray:
+    """The Morse index of the held arm where the free arm with the dead reaction is stable
+    (module docstring, "Stability"): the positive eigenvalues of S_r⁻¹ + C_r less those of
+    S_r⁻¹, S = K n̂ n̂ᵀ + ``bent`` (K → ∞) on its range, C the tip's position compliance."""
+    C = compliance[..., :3, :3]
+    index = np.zeros(normal.shape[:-1], dtype=np.int64)
+    for case in np.ndindex(index.shape):
+        n, B = normal[case], bent[case]
+        values, vectors = np.linalg.eigh(B)
+        keep = np.abs(values) > 1e-9 * max(1.0, np.abs(values).max())
+        keep &= np.abs(vectors.T @ n) < 0.5  # (n̂ is in ∇²d's null space)
+        U = np.column_stack([n, vectors[:, keep]])
+        scale = np.abs(C[case]).max()
+        inverse = np.diag([1e-12 * scale, *(1.0 / values[keep])])
+        bordered = inverse + U.T @ C[case] @ U
+        positive = np.sum(np.linalg.eigvalsh(0.5 * (bordered + bordered.T)) > 0.0)
+        index[case] = positive - 1 - np.sum(values[keep] > 0.0)
+    return index
+
+
+def _held_jacobians(final, asked, normal, bent, pressed) -> dict:
     """The Jacobians of ``final`` (the free arm with the tip's reaction as a dead force)
-    with the pressed tips held on their planes (module docstring), at the asked stations."""
+    with the pressed tips held on their obstacles (module docstring), at the asked
+    stations. A column W (a tip wrench, an input) moves the free tip by C_W W and the
+    reaction by δf = δλ n̂ + bent·δp: (I - C bent) δp - C n̂ δλ = C_W W, n̂ · δp = 0."""
     tip, stations = final.tip_compliance, final.compliance[..., asked, :, :]
-    # each station's motion per unit tip force along n̂ (spatial), and the tip's
-    along = np.einsum("...ij,...j->...i", stations[..., :3], normal[..., None, :])
-    tip_along = np.einsum("...ij,...j->...i", tip[..., :3], normal)
-    slope = _dot(normal, tip_along[..., :3])
-    # the reaction's change per unit column (wrench, then inputs): -n̂ᵀ C_col / n̂ᵀ C n̂
-    scale = np.where(pressed, 1.0 / np.where(pressed, slope, 1.0), 0.0)[..., None]
+    C = tip[..., :3, :3]
+    shape = normal.shape[:-1]
+    system = np.zeros((*shape, 4, 4))
+    system[..., :3, :3] = np.eye(3) - C @ bent
+    system[..., :3, 3] = -_matvec(C, normal)
+    system[..., 3, :3] = normal
+    system[~pressed] = np.eye(4)  # (a free case: no reaction)
 
     def held(columns, station_columns):
-        reaction = -scale * np.einsum("...j,...jk->...k", normal, columns[..., :3, :])
-        return (columns + tip_along[..., :, None] * reaction[..., None, :],
-                station_columns + along[..., :, None] * reaction[..., None, None, :])
+        right = np.zeros((*shape, 4, columns.shape[-1]))
+        right[..., :3, :] = np.where(pressed[..., None, None], columns[..., :3, :], 0.0)
+        solved = np.linalg.solve(system, right)  # (δp; δλ) per column
+        reaction = normal[..., :, None] * solved[..., 3:, :] + bent @ solved[..., :3, :]
+        return (columns + tip[..., :, :3] @ reaction,
+                station_columns + stations[..., :, :3] @ reaction[..., None, :, :])
 
     out = dict(zip(("tip_compliance", "compliance"), held(tip, stations), strict=True))
     if final.actuation_jacobian is not None:
