@@ -4,9 +4,9 @@ alternatives.
 - the heavy soft arm lying on a table (tol 1e-6 L), against the hard-contact free-boundary
   ``solve_bvp`` reference of tests/_table_reference.py (the alternative: a free-boundary
   solve written for this one geometry) and against the same arm without the table;
-- the free tip pressed onto a plane: held exactly (statics/tip_contact.py), against the
-  penalty at the default δ, the free arm, and the Reissner-rod ``solve_bvp`` reference of
-  tests/_tip_reference.py;
+- the free tip pressed onto a plane and onto a pin: held exactly (statics/tip_contact.py),
+  against the penalty at the default δ, the free arm, and the Reissner-rod ``solve_bvp``
+  references of tests/_tip_reference.py;
 - the arm pressed onto a pin (a Capsule) by gravity and a tip force;
 - a tendon finger closing on a cylinder, tracked over 100 tension steps (a prepared
   ForwardSolver, as a control loop calls it);
@@ -37,7 +37,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
 from _table_reference import table_reference
-from _tip_reference import tip_on_plane
+from _tip_reference import tip_on_circle, tip_on_plane
 
 import softarm
 from softarm.case import load_case
@@ -109,11 +109,26 @@ def tip(repeats):
         eq, wall, cpu = _timed(lambda c=contact, tol=tol: softarm.solve(
             arm, [force, c], tol=tol, s=201), repeats)
         shape = np.abs(eq.positions - ref.positions(eq.s)).max() / L
-        error = abs(eq.contact_wrench[2] / ref.reaction - 1.0)
+        error = abs(eq.contact_wrench[2] / ref.reaction[1] - 1.0)
         rows.append((f"{name} ({eq.method})", wall, cpu,
                      f"{shape:.1e} L; force {error:.1e}", ""))
     rows.append(("tip on a plane, solve_bvp reference (hard contact)", rwall, rcpu,
                  "reference", ""))
+    # a pin (a capsule across the bending plane) under the tip: the reaction turns with the
+    # contact point, followed along the load path from the first touch
+    centre, radius = (0.5, -0.25), 0.1
+    pin = softarm.Capsule((centre[0], -0.1, centre[1]), (centre[0], 0.1, centre[1]), radius)
+    ref = tip_on_circle(L, k.EA, k.GAy, k.EIy, RADIUS, 0.0, (0.0, -0.05), centre, radius)
+    for name, contact in (("tip on a pin, held (tol 1e-6 L)", softarm.Contact(pin)),
+                          ("tip on a pin, penalty at δ = 1e-5 L (tol 1e-6 L)",
+                           softarm.Contact(pin, distance=1e-5 * L))):
+        eq, wall, cpu = _timed(lambda c=contact: softarm.solve(arm, [force, c], tol=1e-6,
+                                                               s=201), repeats)
+        shape = np.abs(eq.positions - ref.positions(eq.s)).max() / L
+        error = np.abs(eq.contact_wrench[[0, 2]] - ref.reaction).max() / np.hypot(
+            *ref.reaction)
+        rows.append((f"{name} ({eq.method})", wall, cpu, f"{shape:.1e} L; force {error:.1e}",
+                     ""))
     _, wall, cpu = _timed(lambda: softarm.solve(arm, [force], tol=1e-6, s=201,
                                                 method="numeric"), repeats)
     rows.append(("the same arm without the plane", wall, cpu, "", ""))

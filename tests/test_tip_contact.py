@@ -1,7 +1,10 @@
-"""A free tip held on planes, exactly (issue 39; softarm/statics/tip_contact.py).
+"""A free tip held on obstacles, exactly (issue 39; softarm/statics/tip_contact.py).
 
-- the held arm against an independent solve_bvp of the planar Reissner rod with the plane's
-  reaction as an unknown (tests/_tip_reference.py), flat and tilted planes, with gravity;
+- the held arm against an independent solve_bvp of the planar Reissner rod with the
+  obstacle's reaction as an unknown (tests/_tip_reference.py), flat and tilted planes, with
+  gravity, and a pin (a capsule across the bending plane);
+- the verdict on a ball: a tip pulled against a ball ahead of it slides off (unstable) where
+  the pull over the ball's radius exceeds the tip's lateral stiffness, a closed form;
 - the propped cantilever with shear compliance (the force on the plane, no δ);
 - the contact wrench against the solve's global balance;
 - the held arm's Jacobians (compliance and actuation) against finite differences of solves;
@@ -11,9 +14,11 @@
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
-from _tip_reference import tip_on_plane
+from _tip_reference import tip_on_circle, tip_on_plane
 
 import softarm as sa
 from softarm.contact import balance
@@ -46,8 +51,8 @@ def test_a_held_tip_matches_the_reissner_rod_with_the_planes_reaction(E, gravity
     eq = sa.solve(arm, [*loads, sa.Contact(_plane(point, normal))], s=101)
     assert eq.method == "numeric.tip_contact"
     assert np.abs(eq.positions - ref.positions(eq.s)).max() < 1e-7 * L  # (measured 1e-8 L)
-    unit = np.array([normal[0], 0.0, normal[1]]) / np.hypot(*normal)
-    assert eq.contact_wrench[:3] == pytest.approx(ref.reaction * unit, rel=1e-7, abs=1e-12)
+    assert eq.contact_wrench[[0, 2]] == pytest.approx(ref.reaction, rel=1e-7, abs=1e-12)
+    assert eq.contact_wrench[1] == 0.0
     # the contact wrench is the global balance: the base wrench less the other loads
     s = np.linspace(0.0, L, 2001)
     fine = sa.solve(arm, [*loads, sa.Contact(_plane(point, normal))], s=s)
@@ -57,6 +62,63 @@ def test_a_held_tip_matches_the_reissner_rod_with_the_planes_reaction(E, gravity
     assert fine.gaps[-1] == pytest.approx(0.0, abs=1e-2 * 1e-8 * L)
     assert fine.gaps.min() >= -1e-8 * L
     assert eq.stability.stable
+
+
+def test_a_tip_held_on_a_pin_matches_the_reissner_rod_with_its_reaction():
+    """A pin (a capsule across the bending plane) under the free tip's path: the reaction
+    turns with the contact point, found along the load path from the first touch."""
+    arm = _arm(1e6)
+    rig = arm.rigidities
+    centre, radius = (0.5, -0.25), 0.1
+    ref = tip_on_circle(L, rig.EA, rig.GAy, rig.EIy, RADIUS, 0.0, (0.0, -0.05), centre,
+                        radius)
+    pin = sa.Capsule((centre[0], -0.1, centre[1]), (centre[0], 0.1, centre[1]), radius)
+    eq = sa.solve(arm, [sa.TipLoad(force=(0.0, 0.0, -0.05)), sa.Contact(pin)], s=101)
+    assert eq.method == "numeric.tip_contact"
+    assert np.abs(eq.positions - ref.positions(eq.s)).max() < 1e-7 * L  # (measured 7e-9 L)
+    assert eq.contact_wrench[[0, 2]] == pytest.approx(ref.reaction, rel=1e-6)
+    assert eq.stability.stable
+
+
+@pytest.mark.parametrize(("ratio", "index"), [(0.98, 2), (1.02, 0)])
+def test_a_tip_pulled_against_a_ball_slides_off_where_the_closed_form_says(ratio, index):
+    """A tip force P pulls the straight arm's tip against a ball ahead of it, whose centre
+    lies ρ ahead of the tip's centreline: held, the arm carries no force (λ = P), and a
+    lateral move δ of the tip turns the reaction by δ/ρ, a force P δ/ρ that pushes it on,
+    against the tip's lateral stiffness 1/c, c = L³/(3 EI) + L/GA. It slides off (Morse
+    index 2: both lateral directions of a round arm) where P c > ρ; a flat plane (ρ → ∞)
+    would hold it."""
+    arm = _arm(1e6)
+    rig = arm.rigidities
+    force = 0.05
+    rho = ratio * force * (L**3 / (3.0 * rig.EIy) + L / rig.GAy)
+    ball = sa.Sphere((L + rho, 0.0, 0.0), rho - RADIUS)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", sa.StabilityWarning)
+        eq = sa.solve(arm, [sa.TipLoad(force=(force, 0.0, 0.0)), sa.Contact(ball)])
+    assert eq.method == "numeric.tip_contact"
+    assert eq.contact_wrench[:3] == pytest.approx((-force, 0.0, 0.0), abs=1e-12)
+    assert eq.stability.index == index
+
+
+def test_a_tip_held_on_a_pin_has_the_jacobians_of_finite_differences():
+    """The reaction turns with the tip on a pin: the held compliance has the term
+    λ ∇²d of the contact's curvature (against central differences of held solves)."""
+    arm = _arm(1e6)
+    pin = sa.Contact(sa.Capsule((0.5, -0.1, -0.25), (0.5, 0.1, -0.25), 0.1))
+    loads = [sa.TipLoad(force=(0.0, 0.0, -0.05))]
+    eq = sa.solve(arm, [*loads, pin], jacobians=True)
+    assert eq.method == "numeric.tip_contact"
+
+    def tip(extra):
+        held = sa.solve(arm, [*loads, sa.TipLoad(force=extra), pin], tol=1e-12,
+                        stability=False)
+        assert held.method == "numeric.tip_contact"
+        return held.tip_position
+
+    for j in range(3):
+        column = _central(lambda e, j=j: tip(np.eye(3)[j] * e), 1e-4)
+        assert eq.tip_compliance[:3, j] == pytest.approx(column, rel=1e-4, abs=1e-9)
 
 
 def test_the_propped_cantilevers_force_needs_no_contact_distance():

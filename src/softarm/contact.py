@@ -1,8 +1,8 @@
 """Contact with rigid obstacles fixed in space: :class:`Plane`, :class:`Sphere`,
 :class:`Capsule`, and the load :class:`Contact` that lets the arm's surface touch them.
 
-The method (docs/contact.md): a free tip that alone touches planes is held exactly, its
-reaction found by Newton's method over plain solves (statics/tip_contact.py); elsewhere a
+The method (docs/contact.md): a free tip that alone touches an obstacle is held exactly,
+its reaction found by Newton's method over plain solves (statics/tip_contact.py); elsewhere a
 penalty on the gap g between the arm's surface (a tube of radius r around the centreline)
 and each obstacle, a force per unit length along the obstacle's outward normal through the
 centreline,
@@ -305,9 +305,9 @@ class Contact(Load):
     distance : float or None
         The contact distance δ (m) of the penalty: forces act only where the gap is below
         it. Default 1e-5 L. The shape is within about δ of the hard-contact solution.
-        Without ``distance`` and ``stiffness``, a free tip that alone touches planes is
-        held exactly, with no δ (``softarm.solve``; docs/contact.md, "A free tip on
-        planes"); giving either asks for the penalty everywhere.
+        Without ``distance`` and ``stiffness``, a free tip that alone touches an obstacle
+        is held exactly, with no δ (``softarm.solve``, ``Solver.solve``; docs/contact.md,
+        "A free tip held exactly"); giving either asks for the penalty everywhere.
     radius : float or None
         The arm's surface radius (m). Default: the section's (``Arm.radius``, per segment);
         required for an arm given by its stiffnesses.
@@ -386,7 +386,7 @@ class Contact(Load):
         friction = f"μ = {self.friction:g}" if self.friction else "frictionless"
         if self.distance is not None:
             distance = f"contact distance {self.distance:g} m"
-        elif self.stiffness is None and all(o.kind == "plane" for o in self.obstacles):
+        elif self.stiffness is None:
             distance = f"hard at a free tip, else contact distance {DISTANCE:g} L"
         else:
             distance = f"contact distance {DISTANCE:g} L"

@@ -139,7 +139,7 @@ class Equilibrium:
         The loads as given.
     method : str
         The solution used, e.g. ``"analytic.tip_moment"``, ``"numeric.shooting"`` or
-        ``"numeric.tip_contact"`` (a free tip held exactly on planes, docs/contact.md).
+        ``"numeric.tip_contact"`` (a free tip held exactly on an obstacle, docs/contact.md).
     exact : bool
         True only if the result solves the full Cosserat model (eq. 20) for these loads (to
         the solver's tolerance for numerical results).

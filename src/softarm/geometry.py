@@ -348,8 +348,8 @@ def obstacle_outline(obstacle, axes: tuple[int, int], centre, half: float,
 def contact_arrows(result) -> Arrow | None:
     """The contact forces of an unbatched equilibrium as arrows, or None without a contact:
     per length (N/m, spatial) at the stations where they are nonzero
-    (``result.contact_forces``), or, for a tip held on a plane without a penalty
-    (statics/tip_contact.py: no stiffness, a nonzero ``contact_wrench``), the plane's
+    (``result.contact_forces``), or, for a tip held on an obstacle without a penalty
+    (statics/tip_contact.py: no stiffness, a nonzero ``contact_wrench``), the obstacle's
     reaction (N) at the tip."""
     found = contacts(result.loads)
     if not found:

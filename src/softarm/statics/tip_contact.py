@@ -1,49 +1,60 @@
 """Hard contact at the free tip: exact, with no contact distance δ (issue 39).
 
-Where a solve's Contact holds planes only and asks for no penalty of its own (neither
-``distance`` nor ``stiffness`` given), the arm touching them with its free tip alone is
-solved as a unilateral constraint, not through the penalty's stiff band:
+Where a solve's Contact asks for no penalty of its own (neither ``distance`` nor
+``stiffness`` given), an arm touching its obstacles with its free tip alone is solved as a
+unilateral constraint, not through the penalty's stiff band:
 
-    g(p(L)) = n̂ · (p(L) - a) - r >= 0,   λ >= 0,   λ g = 0,
+    g = d(p(L)) - r >= 0,   λ >= 0,   λ g = 0,
 
 g the gap between the tip's surface (the tube of radius r around the centreline, as for the
-penalty) and the plane through a with outward normal n̂, λ the reaction the plane puts on
-the tip, a force λ n̂ at the tip (frictionless; no moment about the centreline). With λ
-given, the arm is a plain solve with one more dead tip force, so λ is found by Newton's
-method on the one equation g = 0 with the solve's exact tip compliance C,
-dg/dλ = n̂ᵀ C n̂, kept inside a bracket of the root. Every iterate is a solve of the smooth,
-non-stiff problem: the answer does not depend on a δ, its gap is zero to 1 % of tol·L, and
-its cost does not grow with how hard the tip is pressed (the penalty's stiffness made the
-same case 100× slower).
+penalty) and the obstacle, d its signed distance, λ the reaction it puts on the tip: a
+force λ n̂ at the tip along its outward normal n̂ = ∇d (frictionless; no moment about the
+centreline). With λ and n̂ given, the arm is a plain solve with one more dead tip force, so
+λ is found by Newton's method on the one equation g = 0 with the solve's exact tip
+compliance C, dg/dλ = n̂ᵀ C n̂, kept inside a bracket of the root (at large deflections the
+tip's height saturates and plain Newton overshoots without end); then n̂ is taken at the
+new tip and λ corrected again, until n̂ stays (a plane's at once). On a ball or a capsule
+the reaction is followed along the load path from the first touch (n̂ at a free tip deep
+inside a pin points anywhere). Every iterate is a solve of the smooth, non-stiff problem:
+the answer does not depend on a δ, its gap is zero to 1 % of tol·L, and its cost does not
+grow with how hard the tip is pressed (the penalty's stiffness made the same cases 25-100×
+slower).
 
 The route answers a case only where it is the answer (the caller solves the others with the
 penalty, case by case, so that a batch's answers are its cases' alone):
 
-- the free arm (no contact) meets the obstacles, at 1/4, 1/2, 3/4 and all of the load, at
-  its tip alone: on each plane the stations inside form a run ending at the tip, and on one
-  plane only (an arm that lies on a table or dips into it mid-span needs contact zones);
+- the free arm (no contact) meets the obstacles, at 1/4, 1/2, 3/4 and all of the load
+  (k/16 with a ball or a capsule, where no station moves more than half the smallest
+  one's radius between two factors, so that none passes through it unseen), at its tip
+  alone: the stations inside form a run ending at the tip, in one obstacle (an arm that
+  lies on a table or wraps a pin needs contact zones);
 - the solution with the tip held keeps every station of the solver's fine ones (the asked
-  stations and CONTACT_STATIONS uniform ones, as the penalty's check) outside every plane to
-  tol·L, and λ >= 0;
+  stations and CONTACT_STATIONS uniform ones, as the penalty's check) outside every
+  obstacle to tol·L, and λ >= 0;
 - where the solver gives verdicts, the free arm with the dead force λ n̂ is stable
   (conservative, Morse index 0);
 - with ``jacobians``, no tendon (their length Jacobian would need the tendons' response to
   the tip's reaction, which the solve does not return).
 
-Stability. The held arm's second variation is the free arm's with the dead force λ n̂,
-restricted to the variations with n̂ · δp(L) >= 0 (= 0 where λ > 0); a plane has no
-curvature, so the constraint adds no term of its own. A restriction removes directions
-only: where the free arm with the dead force is stable, so is the held arm, and its verdict
-is "stable". Where it is not, the held arm may still be stable (holding the tip of a column
-raises its buckling load from π²/4 to 20.19 EI/L²), but the dead force's own loading path
-from the unloaded arm then crosses a critical point and need not lead to the held
-equilibrium: those cases are left to the penalty, whose path carries the contact from the
-start (docs/contact.md).
+Stability. The held arm's second variation is the free arm's with the dead force λ n̂ (its
+Hessian H, index 0 by the rule above), plus the reaction's own stiffness -λ ∇²d at the tip
+(the force λ n̂(p) turns with the contact point: zero on a plane, -λ (I - n̂ n̂ᵀ)/ρ on a
+ball whose centre is ρ from the tip), restricted to the variations with n̂ · δp(L) = 0.
+With B the map from a variation to δp(L), C = B H⁻¹ Bᵀ, and S = K n̂ n̂ᵀ - λ ∇²d (K → ∞ for
+the constraint) on its range, the inertia of [[H, Bᵀ], [B, -S⁻¹]] counted both ways gives
+the held index: index(H + Bᵀ S B) = 0 + pos(S⁻¹ + C) - pos(S⁻¹) (pos: positive
+eigenvalues). On a plane it is 0: holding a point removes directions. On a ball it is the
+number of tangent directions in which λ/ρ exceeds the tip's lateral stiffness: a tip
+pushed onto a small ball slides off (tests/test_tip_contact.py checks the closed form).
+Where the free arm with the dead force is not stable the held arm may still be (holding
+the tip of a column raises its buckling load from π²/4 to 20.19 EI/L²), but the dead
+force's own loading path from the unloaded arm then crosses a critical point and need not
+lead to the held equilibrium: those cases are left to the penalty, whose path carries the
+contact from the start (docs/contact.md).
 
-Jacobians. An extra dead tip wrench W moves the tip by C_W W and the reaction by δλ n̂;
-holding n̂ · δp(L) = 0 gives δλ = -n̂ᵀ C_W W / n̂ᵀ C n̂, and every station's compliance
-becomes compliance - compliance[:, :3] n̂ (n̂ᵀ C_W) / (n̂ᵀ C n̂); the actuation Jacobians
-likewise with the inputs' columns.
+Jacobians. A column W (a tip wrench, an actuation input) moves the free tip by C_W W and
+the reaction by δf = δλ n̂ + λ ∇²d δp(L); holding n̂ · δp(L) = 0 gives the 4 × 4 system of
+:func:`_held_jacobians`, and every station's column gains its response to δf.
 """
 
 from __future__ import annotations
@@ -100,20 +111,21 @@ def _matvec(A, x):
     return np.einsum("...ij,...j->...i", A, x)
 
 
-def _path(coarse, free, obstacles) -> tuple[list, np.ndarray]:
-    """The free arm's positions (..., S, 3) at the load factors of its path's check, and
+def _path(coarse, free, obstacles) -> tuple:
+    """(the load factors of the free arm's path's check, its positions (..., S, 3) there,
+    and
     the cases (bool) whose stations move less than half the smallest curved obstacle's
     radius between two of them (none passes through a ball or a pin unseen): PATH with
     planes only, else CURVED_PATH uniform factors, the same for every batch."""
     radii = [obstacle.radius for obstacle in obstacles if obstacle.kind != "plane"]
-    factors = PATH if not radii else np.arange(1, CURVED_PATH) / CURVED_PATH
+    factors = PATH if not radii else tuple(np.arange(1, CURVED_PATH) / CURVED_PATH)
     positions = [coarse._solve(tuple(load.scaled(factor) for load in free), chained=False,
                                jacobians=False, checked=True).positions
-                 for factor in (0.0, *factors)]
+                 for factor in ((0.0,) if radii else ()) + tuple(factors)]
     if not radii:
-        return positions[1:], True
+        return factors, positions, True
     moves = np.linalg.norm(np.diff(np.stack(positions), axis=0), axis=-1)  # (F, ..., S)
-    return positions[1:], moves.max(axis=(0, -1)) <= 0.5 * min(radii)
+    return factors, positions[1:], moves.max(axis=(0, -1)) <= 0.5 * min(radii)
 
 
 def _curvature(obstacle, p, h) -> np.ndarray:
@@ -145,7 +157,7 @@ def solve_tip_contact(solver, loads, shape, jacobians: bool, fine, asked):
     coarse = solver._with_stations(np.linspace(0.0, solver.length, COARSE), stability=False)
     radii = contact.station_radii(solver.arm, coarse.s)
     held = np.ones(shape, dtype=bool)  # the cases this route answers
-    path, seen = _path(coarse, free, obstacles)
+    factors, path, seen = _path(coarse, free, obstacles)
     held &= seen
     for positions in path:  # the free arm on its way to the full load
         held &= _at_tip_only(_gaps(obstacles, positions, radii), depth)
@@ -155,8 +167,9 @@ def solve_tip_contact(solver, loads, shape, jacobians: bool, fine, asked):
     if not held.any():
         return None
     # Newton's method on λ, per case (0 where the free tip is outside every obstacle), the
-    # reaction's direction n̂ frozen; then n̂ at the new tip, until it stays (a plane's at once)
-    touching = held & (gaps[..., -1].min(axis=0) < -depth)
+    # reaction's direction n̂ frozen; then n̂ at the new tip, until it stays (a plane's at
+    # once). On a curved obstacle the reaction is followed along the path's factors from
+    # where the tip first touches: n̂ at a free tip deep inside a pin points anywhere
     which = np.argmin(gaps[..., -1], axis=0)  # (*shape): the obstacle under the tip
 
     def nearest(tip):  # (gap (*shape), n̂ (*shape, 3)) to each case's obstacle
@@ -165,57 +178,68 @@ def solve_tip_contact(solver, loads, shape, jacobians: bool, fine, asked):
         n = np.stack([f[1] for f in found])[(which, *np.indices(shape))]
         return d - radii[-1], n
 
-    gap, normal = nearest(eq.tip_position)
-    lam = np.zeros(shape)
-    for _ in range(TURNS):
-        low, high = np.zeros(shape), np.full(shape, np.inf)
-        active = touching.copy()
+    def solve(loads, lam, normal, low):
+        """(the held iterate, its λ, the least λ that failed (inf if none)): λ is moved
+        towards ``low`` where the plain solve fails."""
+        failed = np.full(shape, np.inf)
         for _ in range(ITERATIONS):
-            slope = _dot(normal, _matvec(eq.tip_compliance[..., :3, :3], normal))
-            # a case stops where it converged (its λ does not depend on its batch's), or
-            # where the held tip's Newton step has no direction
-            active &= np.abs(gap) > GAP * depth
-            held &= ~(active & (slope <= 0.0))
-            active &= held
-            if not active.any():
-                break
-            # g(λ) rises with λ (slope > 0): a bracket [low, high] of the root, and Newton's
-            # step inside it, else its middle (large deflections: the tip's height saturates
-            # at ±L and plain Newton overshoots without end)
-            low, high = np.where(gap < 0.0, lam, low), np.where(gap > 0.0, lam, high)
-            step = lam - gap / np.where(active, slope, 1.0)
-            inside = (step > low) & (step < high)
-            lam = np.where(active, np.where(inside, step, 0.5 * (low + high)), lam)
-            for _ in range(ITERATIONS):
-                try:
-                    eq = coarse._solve((*free, TipLoad(force=lam[..., None] * normal)),
-                                       chained=False, jacobians=True, checked=False)
-                    break
-                except ConvergenceError:
-                    # a reaction the plain solve cannot follow from the unloaded arm (one
-                    # far too large: it turns the arm over): back towards the bracket's
-                    # low end. A batch is tried case by case (Solver._held_at_tip).
-                    if shape:
-                        raise
-                    high = lam
-                    lam = 0.5 * (low + high)
-            gap = nearest(eq.tip_position)[0]
-        held &= ~active  # (not converged)
+            try:
+                return coarse._solve((*loads, TipLoad(force=lam[..., None] * normal)),
+                                     chained=False, jacobians=True, checked=False), lam, failed
+            except ConvergenceError:
+                # a reaction the plain solve cannot follow from the unloaded arm (one far
+                # too large: it turns the arm over): back towards the bracket's low end. A
+                # batch is tried case by case (Solver._held_at_tip).
+                if shape:
+                    raise
+                failed, lam = lam, 0.5 * (low + lam)
+        raise ConvergenceError("no held iterate could be solved", float("nan"))
+
+    curved = any(obstacle.kind != "plane" for obstacle in obstacles)
+    lam, normal = np.zeros(shape), nearest(eq.tip_position)[1]
+    for factor in (*([f for f in factors if f < 1.0] if curved else ()), 1.0):
+        loads_at = free if factor == 1.0 else tuple(load.scaled(factor) for load in free)
+        if factor < 1.0 or curved:
+            eq, lam, _ = solve(loads_at, lam, normal, np.zeros(shape))
         gap, turned = nearest(eq.tip_position)
-        moved = touching & held & (np.linalg.norm(turned - normal, axis=-1) > TURNED)
-        if not moved.any():
-            break
-        normal = np.where(moved[..., None], turned, normal)
-        eq = coarse._solve((*free, TipLoad(force=lam[..., None] * normal)), chained=False,
-                           jacobians=True, checked=False)
-        gap = nearest(eq.tip_position)[0]
-    else:
-        held &= ~moved
+        touching = held & ((lam > 0.0) | (gap < -depth))
+        normal = np.where((touching & (lam == 0.0))[..., None], turned, normal)
+        for _ in range(TURNS):
+            low, high = np.zeros(shape), np.full(shape, np.inf)
+            active = touching.copy()
+            for _ in range(ITERATIONS):
+                slope = _dot(normal, _matvec(eq.tip_compliance[..., :3, :3], normal))
+                # a case stops where it converged (its λ does not depend on its batch's),
+                # or where the held tip's Newton step has no direction
+                active &= np.abs(gap) > GAP * depth
+                held &= ~(active & (slope <= 0.0))
+                active &= held
+                if not active.any():
+                    break
+                # g(λ) rises with λ (slope > 0): a bracket [low, high] of the root, and
+                # Newton's step inside it, else its middle (large deflections: the tip's
+                # height saturates at ±L and plain Newton overshoots without end)
+                low, high = np.where(gap < 0.0, lam, low), np.where(gap > 0.0, lam, high)
+                step = lam - gap / np.where(active, slope, 1.0)
+                inside = (step > low) & (step < high)
+                lam = np.where(active, np.where(inside, step, 0.5 * (low + high)), lam)
+                eq, lam, failed = solve(loads_at, lam, normal, low)
+                high = np.minimum(high, failed)
+                gap = nearest(eq.tip_position)[0]
+            held &= ~active  # (not converged)
+            gap, turned = nearest(eq.tip_position)
+            moved = touching & held & (np.linalg.norm(turned - normal, axis=-1) > TURNED)
+            if not moved.any():
+                break
+            normal = np.where(moved[..., None], turned, normal)
+            eq, lam, _ = solve(loads_at, lam, normal, np.zeros(shape))
+            gap = nearest(eq.tip_position)[0]
+        else:
+            held &= ~moved
     held &= lam >= 0.0
     lam = np.where(held, lam, 0.0)
     if not held.any():
         return None
-    curved = any(obstacle.kind != "plane" for obstacle in obstacles)
     final = solver._with_stations(fine, stability=solver.stability)._solve(
         (*free, TipLoad(force=lam[..., None] * normal)), chained=False,
         jacobians=jacobians or (curved and solver.stability), checked=False)
@@ -275,13 +299,14 @@ def _held_index(compliance, normal, bent) -> np.ndarray:
 def _held_jacobians(final, asked, normal, bent, pressed) -> dict:
     """The Jacobians of ``final`` (the free arm with the tip's reaction as a dead force)
     with the pressed tips held on their obstacles (module docstring), at the asked
-    stations. A column W (a tip wrench, an input) moves the free tip by C_W W and the
-    reaction by δf = δλ n̂ + bent·δp: (I - C bent) δp - C n̂ δλ = C_W W, n̂ · δp = 0."""
+    stations. ``bent`` is the reaction's stiffness -λ ∇²d at the tip: a column W (a tip
+    wrench, an input) moves the free tip by C_W W and the reaction by
+    δf = δλ n̂ - bent·δp, so (I + C bent) δp - C n̂ δλ = C_W W with n̂ · δp = 0."""
     tip, stations = final.tip_compliance, final.compliance[..., asked, :, :]
     C = tip[..., :3, :3]
     shape = normal.shape[:-1]
     system = np.zeros((*shape, 4, 4))
-    system[..., :3, :3] = np.eye(3) - C @ bent
+    system[..., :3, :3] = np.eye(3) + C @ bent
     system[..., :3, 3] = -_matvec(C, normal)
     system[..., 3, :3] = normal
     system[~pressed] = np.eye(4)  # (a free case: no reaction)
@@ -290,7 +315,7 @@ def _held_jacobians(final, asked, normal, bent, pressed) -> dict:
         right = np.zeros((*shape, 4, columns.shape[-1]))
         right[..., :3, :] = np.where(pressed[..., None, None], columns[..., :3, :], 0.0)
         solved = np.linalg.solve(system, right)  # (δp; δλ) per column
-        reaction = normal[..., :, None] * solved[..., 3:, :] + bent @ solved[..., :3, :]
+        reaction = normal[..., :, None] * solved[..., 3:, :] - bent @ solved[..., :3, :]
         return (columns + tip[..., :, :3] @ reaction,
                 station_columns + stations[..., :, :3] @ reaction[..., None, :, :])
 
