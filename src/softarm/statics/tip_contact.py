@@ -156,14 +156,17 @@ def solve_tip_contact(solver, loads, shape, jacobians: bool, fine, asked):
     depth = solver.tol * solver.length
     coarse = solver._with_stations(np.linspace(0.0, solver.length, COARSE), stability=False)
     radii = contact.station_radii(solver.arm, coarse.s)
-    held = np.ones(shape, dtype=bool)  # the cases this route answers
-    factors, path, seen = _path(coarse, free, obstacles)
-    held &= seen
-    for positions in path:  # the free arm on its way to the full load
-        held &= _at_tip_only(_gaps(obstacles, positions, radii), depth)
+    # the free arm at the full load (an arm that lies on an obstacle is left at once), then
+    # on its way there
     eq = coarse._solve(free, chained=False, jacobians=True, checked=True)
     gaps = _gaps(obstacles, eq.positions, radii)
-    held &= _at_tip_only(gaps, depth)
+    held = np.array(_at_tip_only(gaps, depth))  # the cases this route answers
+    if not held.any():
+        return None
+    factors, path, seen = _path(coarse, free, obstacles)
+    held &= seen
+    for positions in path:
+        held &= _at_tip_only(_gaps(obstacles, positions, radii), depth)
     if not held.any():
         return None
     # Newton's method on λ, per case (0 where the free tip is outside every obstacle), the
