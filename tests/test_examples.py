@@ -187,7 +187,7 @@ def test_quickstart(tmp_path, monkeypatch, capsys):
     assert (tmp_path / "fig2.csv").exists()
 
 
-@pytest.mark.parametrize("name", ["table", "catheter_bend"])
+@pytest.mark.parametrize("name", ["table", "catheter_bend", "probe_on_surface"])
 def test_contact_examples_balance(name):
     """The whole arm is in balance: the internal force at the clamp (spatial: R(0) = I)
     carries the tip force, the weight and the obstacles' forces (contact_wrench, the
@@ -207,7 +207,8 @@ def test_contact_examples_balance(name):
     applied = tip + weight + result.contact_wrench[:3]
     scale = np.abs(tip).max() + np.abs(weight).max() + np.abs(result.contact_wrench[:3]).max()
     np.testing.assert_allclose(result.stresses[0, :3], applied, rtol=0, atol=2e-4 * scale)
-    assert np.abs(result.contact_wrench[:3]).max() > 0.1 * scale  # the obstacles carry load
+    # the obstacles carry load: far more than the balance's tolerance
+    assert np.abs(result.contact_wrench[:3]).max() > 100 * 2e-4 * scale
 
 
 def test_table_example_lies_on_the_table():

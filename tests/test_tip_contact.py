@@ -223,3 +223,22 @@ def test_pictures_draw_a_held_tips_reaction_at_the_tip():
     arrow = contact_arrows(penalty)
     assert arrow.unit == "N/m" and len(arrow.origins) >= 1
 
+
+
+def test_the_cli_says_the_held_tips_reaction(capsys):
+    """``softarm solve`` on examples/probe_on_surface.toml: the summary's contact line is the
+    tip's reaction, the solve's contact wrench (its digits)."""
+    from pathlib import Path
+
+    from softarm import cli
+    from softarm.case import load_case
+
+    path = Path(__file__).resolve().parents[1] / "examples" / "probe_on_surface.toml"
+    assert cli.main(["solve", str(path)]) == 0
+    line = next(line for line in capsys.readouterr().out.splitlines()
+                if line.startswith("contact"))
+    case = load_case(path)
+    eq = sa.solve(case.arm, case.loads, s=int(case.solve.stations))
+    printed = [float(v) for v in line.split("(")[1].split(")")[0].split(",")]
+    assert line.startswith("contact   the tip held exactly: reaction (")
+    assert printed == pytest.approx(eq.contact_wrench[:3], rel=1e-4, abs=1e-9)

@@ -1243,10 +1243,25 @@ def _summary(case: Case, result, seconds: float) -> str:
             lines.append(f"base      {what} force "
                          f"{_vector(result.base_wrench[:3])} N, moment "
                          f"{_vector(result.base_wrench[3:])} N m")
+        if any(load.kind == "contact" for load in result.loads):
+            lines.append(f"contact   {_contact_line(result)}")
         if result.stability is not None:
             lines.append(f"stability {result.stability.describe()}")
     lines.append(f"time      {seconds:.3g} s")
     return "\n".join(lines)
+
+
+def _contact_line(result) -> str:
+    """What the obstacles do to a single equilibrium: the tip's reaction where it is held
+    exactly (statics/tip_contact.py), else the total contact force and its moment about the
+    origin (Equilibrium.contact_wrench), or the nearest gap where nothing touches."""
+    wrench = np.asarray(result.contact_wrench)
+    if not wrench.any():
+        return f"no obstacle touched (nearest gap {float(np.min(result.gaps)):.4g} m)"
+    if result.method == "numeric.tip_contact":
+        return f"the tip held exactly: reaction {_vector(wrench[:3])} N at the tip"
+    return (f"total force {_vector(wrench[:3])} N, moment {_vector(wrench[3:])} N m about the "
+            "origin")
 
 
 def _tendon_lines(result) -> list[str]:

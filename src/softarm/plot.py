@@ -104,7 +104,7 @@ def _wrapped(text: str, width: int = 130, lines: int = 3) -> str:
 
 def _layout(fig):
     grid = fig.add_gridspec(2, 2, width_ratios=(1.25, 1.0), left=0.02, right=0.97,
-                            bottom=0.09, top=0.88, wspace=0.18, hspace=0.38)
+                            bottom=0.13, top=0.88, wspace=0.18, hspace=0.38)
     ax3 = fig.add_subplot(grid[:, 0], projection="3d")
     side = [fig.add_subplot(grid[0, 1]), fig.add_subplot(grid[1, 1])]
     return ax3, side
