@@ -242,3 +242,28 @@ def test_the_cli_says_the_held_tips_reaction(capsys):
     printed = [float(v) for v in line.split("(")[1].split(")")[0].split(",")]
     assert line.startswith("contact   the tip held exactly: reaction (")
     assert printed == pytest.approx(eq.contact_wrench[:3], rel=1e-4, abs=1e-9)
+
+
+def test_a_free_path_through_a_thin_pin_is_not_held():
+    """The free arm sweeps down through a thin pin under its middle (it ends below it, the
+    pin untouched) and lands its tip on a floor: held at the tip alone, the arm would have
+    passed through the pin. The path's check sees it (the arm's surface is given 0.5 mm
+    thin, the pin 0.5 mm: the sampled states straddle it) and leaves the case to the
+    penalty; without the pin the tip is held."""
+    from softarm.statics import Solver
+    from softarm.statics.solver import _contact_stations
+    from softarm.statics.tip_contact import solve_tip_contact
+
+    arm = _arm(1e6)
+    pin = sa.Capsule((0.2, -0.1, -0.0011), (0.2, 0.1, -0.0011), 0.0005)
+    floor = sa.Plane((0.0, 0.0, -0.15), (0.0, 0.0, 1.0))
+    solver = Solver(arm)
+    fine, asked = _contact_stations(solver._s_kernel, L, np.array([L]))
+    for obstacles, held in (([pin, floor], False), ([floor], True)):
+        loads, shape = solver.check_loads([sa.TipLoad(force=(0.0, 0.0, -0.05)),
+                                           sa.Contact(obstacles, radius=0.0005)])
+        found = solve_tip_contact(solver, loads, shape, False, fine, asked)
+        assert (found is not None) == held
+    # the free arm does pass through the pin's place and end below it, clear of it
+    free = sa.solve(arm, [sa.TipLoad(force=(0.0, 0.0, -0.05))], s=201, method="numeric")
+    assert sa.Contact(pin).gaps(free.positions, 0.0005)[0].min() > 0.01

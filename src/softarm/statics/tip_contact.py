@@ -24,10 +24,10 @@ The route answers a case only where it is the answer (the caller solves the othe
 penalty, case by case, so that a batch's answers are its cases' alone):
 
 - the free arm (no contact) meets the obstacles, at 1/4, 1/2, 3/4 and all of the load
-  (k/16 with a ball or a capsule, where no station moves more than half the smallest
-  one's radius between two factors, so that none passes through it unseen), at its tip
-  alone: the stations inside form a run ending at the tip, in one obstacle (an arm that
-  lies on a table or wraps a pin needs contact zones);
+  (k/16 with a ball or a capsule, where no station outside it at two factors comes closer
+  to it than half its move between them, so that none passes through it unseen), at its
+  tip alone: the stations inside form a run ending at the tip, in one obstacle (an arm
+  that lies on a table or wraps a pin needs contact zones);
 - the solution with the tip held keeps every station of the solver's fine ones (the asked
   stations and CONTACT_STATIONS uniform ones, as the penalty's check) outside every
   obstacle to tol·L, and λ >= 0;
@@ -79,6 +79,8 @@ PATH = (0.25, 0.5, 0.75)
 COARSE = 201
 #: The load factors k/CURVED_PATH at which a path near a ball or a capsule is checked.
 CURVED_PATH = 16
+#: Points along a station's way between two of those factors where it passes close to one.
+CHORD = 32
 #: Turns of the reaction's direction n̂ (a curved obstacle's normal at the new tip) at most,
 #: and the change of n̂ below which it has stopped turning.
 TURNS = 20
@@ -95,12 +97,14 @@ def _gaps(obstacles, positions, radii) -> np.ndarray:
     return np.stack([obstacle.distance(positions)[0] - radii for obstacle in obstacles])
 
 
-def _at_tip_only(gaps, depth: float) -> np.ndarray:
+def _at_tip_only(gaps, depth: float, which) -> np.ndarray:
     """(...) bool, from gaps (K, ..., S): whether the stations deeper than ``depth`` inside
-    an obstacle are in one obstacle at most and form a run that ends at the last station."""
+    an obstacle are all in the obstacle ``which`` (...) and form a run that ends at the
+    last station."""
     inside = gaps < -depth
     runs = np.all(np.diff(inside.astype(np.int8), axis=-1) >= 0, axis=(0, -1))
-    return runs & (inside.any(axis=-1).sum(axis=0) <= 1)
+    others = np.arange(len(gaps)).reshape((-1,) + (1,) * np.ndim(which)) != which
+    return runs & ~np.any(inside.any(axis=-1) & others, axis=0)
 
 
 def _dot(a, b):
@@ -111,21 +115,37 @@ def _matvec(A, x):
     return np.einsum("...ij,...j->...i", A, x)
 
 
-def _path(coarse, free, obstacles) -> tuple:
+def _path(coarse, free, obstacles, radii, full, depth) -> tuple:
     """(the load factors of the free arm's path's check, its positions (..., S, 3) there,
-    and
-    the cases (bool) whose stations move less than half the smallest curved obstacle's
-    radius between two of them (none passes through a ball or a pin unseen): PATH with
-    planes only, else CURVED_PATH uniform factors, the same for every batch."""
-    radii = [obstacle.radius for obstacle in obstacles if obstacle.kind != "plane"]
-    factors = PATH if not radii else tuple(np.arange(1, CURVED_PATH) / CURVED_PATH)
+    and the cases (bool) whose stations cannot have passed through a ball or a capsule
+    unseen between two of them): PATH with planes only, else CURVED_PATH uniform factors,
+    the same for every batch. ``full``: the positions at the full load. A station outside
+    a curved obstacle at two factors, with gaps g₁, g₂, that moved by Δ between them stays
+    outside on the straight way if min(g₁, g₂) >= Δ/2 (a distance changes by no more than
+    the point moves); where it does not, CHORD points of the way are looked at, and a case
+    where a station still comes closer than Δ/(2 CHORD) is not held. (The outside of a
+    plane is convex: a straight way between two points outside stays outside.)"""
+    curved = [obstacle for obstacle in obstacles if obstacle.kind != "plane"]
+    factors = PATH if not curved else tuple(np.arange(1, CURVED_PATH) / CURVED_PATH)
     positions = [coarse._solve(tuple(load.scaled(factor) for load in free), chained=False,
                                jacobians=False, checked=True).positions
-                 for factor in ((0.0,) if radii else ()) + tuple(factors)]
-    if not radii:
+                 for factor in ((0.0,) if curved else ()) + tuple(factors)]
+    if not curved:
         return factors, positions, True
-    moves = np.linalg.norm(np.diff(np.stack(positions), axis=0), axis=-1)  # (F, ..., S)
-    return factors, positions[1:], moves.max(axis=(0, -1)) <= 0.5 * min(radii)
+    way = np.stack([*positions, full])  # (F + 1, ..., S, 3), from the unloaded arm
+    moves = np.linalg.norm(np.diff(way, axis=0), axis=-1)
+    gaps = _gaps(curved, way, radii)  # (K, F + 1, ..., S)
+    outside = (gaps[:, :-1] >= -depth) & (gaps[:, 1:] >= -depth)
+    unseen = outside & (np.minimum(gaps[:, :-1], gaps[:, 1:]) < 0.5 * moves)
+    if unseen.any():  # those ways looked at closer: CHORD points, each Δ/CHORD apart
+        which, *where = np.nonzero(unseen)
+        start, end = way[:-1][tuple(where)], way[1:][tuple(where)]  # (n, 3)
+        t = np.linspace(0.0, 1.0, CHORD + 1)[:, None]
+        points = start[:, None] + t * (end - start)[:, None]  # (n, CHORD + 1, 3)
+        closest = np.stack([o.distance(points)[0] for o in curved])[
+            which, np.arange(which.size)].min(axis=-1) - radii[where[-1]]
+        unseen[(which, *where)] = closest < 0.5 * moves[tuple(where)] / CHORD
+    return factors, positions[1:], ~np.any(unseen, axis=(0, 1, -1))
 
 
 def _curvature(obstacle, p, h) -> np.ndarray:
@@ -160,20 +180,25 @@ def solve_tip_contact(solver, loads, shape, jacobians: bool, fine, asked):
     # on its way there
     eq = coarse._solve(free, chained=False, jacobians=True, checked=True)
     gaps = _gaps(obstacles, eq.positions, radii)
-    held = np.array(_at_tip_only(gaps, depth))  # the cases this route answers
+    which = np.argmin(gaps[..., -1], axis=0)  # (*shape): the obstacle under the tip
+    held = np.array(_at_tip_only(gaps, depth, which))  # the cases this route answers
     if not held.any():
         return None
-    factors, path, seen = _path(coarse, free, obstacles)
+    curved = any(obstacle.kind != "plane" for obstacle in obstacles)
+    touches = gaps[..., -1].min(axis=0) < -depth
+    factors, path, seen = _path(coarse, free, obstacles, radii, eq.positions, depth)
     held &= seen
     for positions in path:
-        held &= _at_tip_only(_gaps(obstacles, positions, radii), depth)
+        on_the_way = _gaps(obstacles, positions, radii)
+        held &= _at_tip_only(on_the_way, depth, which)
+        if not curved:  # (a plane met on the way and left again: no held answer follows it)
+            held &= touches | np.all(on_the_way >= -depth, axis=(0, -1))
     if not held.any():
         return None
     # Newton's method on λ, per case (0 where the free tip is outside every obstacle), the
     # reaction's direction n̂ frozen; then n̂ at the new tip, until it stays (a plane's at
     # once). On a curved obstacle the reaction is followed along the path's factors from
     # where the tip first touches: n̂ at a free tip deep inside a pin points anywhere
-    which = np.argmin(gaps[..., -1], axis=0)  # (*shape): the obstacle under the tip
 
     def nearest(tip):  # (gap (*shape), n̂ (*shape, 3)) to each case's obstacle
         found = [obstacle.distance(tip) for obstacle in obstacles]
@@ -198,7 +223,6 @@ def solve_tip_contact(solver, loads, shape, jacobians: bool, fine, asked):
                 failed, lam = lam, 0.5 * (low + lam)
         raise ConvergenceError("no held iterate could be solved", float("nan"))
 
-    curved = any(obstacle.kind != "plane" for obstacle in obstacles)
     lam, normal = np.zeros(shape), nearest(eq.tip_position)[1]
     for factor in (*([f for f in factors if f < 1.0] if curved else ()), 1.0):
         loads_at = free if factor == 1.0 else tuple(load.scaled(factor) for load in free)
