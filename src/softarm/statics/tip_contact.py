@@ -24,9 +24,9 @@ The route answers a case only where it is the answer (the caller solves the othe
 penalty, case by case, so that a batch's answers are its cases' alone):
 
 - the free arm (no contact) meets the obstacles, at 1/4, 1/2, 3/4 and all of the load
-  (k/16 with a ball or a capsule, where no station outside it at two factors comes closer
-  to it than half its move between them, so that none passes through it unseen), at its
-  tip alone: the stations inside form a run ending at the tip, in one obstacle (an arm
+  (k/16 with a ball or a capsule, and between two of those states the straight way of
+  every station that comes closer to it than half its move, on 33 points), at its tip
+  alone: the stations inside form a run ending at the tip, in one obstacle (an arm
   that lies on a table or wraps a pin needs contact zones);
 - the solution with the tip held keeps every station of the solver's fine ones (the asked
   stations and CONTACT_STATIONS uniform ones, as the penalty's check) outside every
@@ -122,9 +122,11 @@ def _path(coarse, free, obstacles, radii, full, depth) -> tuple:
     the same for every batch. ``full``: the positions at the full load. A station outside
     a curved obstacle at two factors, with gaps g₁, g₂, that moved by Δ between them stays
     outside on the straight way if min(g₁, g₂) >= Δ/2 (a distance changes by no more than
-    the point moves); where it does not, CHORD points of the way are looked at, and a case
-    where a station still comes closer than Δ/(2 CHORD) is not held. (The outside of a
-    plane is convex: a straight way between two points outside stays outside.)"""
+    the point moves); where it does not, CHORD + 1 points of the way are looked at, and a
+    case where a station is inside at one of them is not held (what could still pass
+    unseen is a clip of a ball of radius ρ (its own plus the arm's) between two of those
+    points, at most (Δ/CHORD)²/(8ρ) deep: 0.2 µm for Δ = 13 mm and ρ = 0.11 m). The outside
+    of a plane is convex: a straight way between two points outside stays outside."""
     curved = [obstacle for obstacle in obstacles if obstacle.kind != "plane"]
     factors = PATH if not curved else tuple(np.arange(1, CURVED_PATH) / CURVED_PATH)
     positions = [coarse._solve(tuple(load.scaled(factor) for load in free), chained=False,
@@ -144,7 +146,7 @@ def _path(coarse, free, obstacles, radii, full, depth) -> tuple:
         points = start[:, None] + t * (end - start)[:, None]  # (n, CHORD + 1, 3)
         closest = np.stack([o.distance(points)[0] for o in curved])[
             which, np.arange(which.size)].min(axis=-1) - radii[where[-1]]
-        unseen[(which, *where)] = closest < 0.5 * moves[tuple(where)] / CHORD
+        unseen[(which, *where)] = closest < -depth
     return factors, positions[1:], ~np.any(unseen, axis=(0, 1, -1))
 
 
