@@ -124,12 +124,15 @@ def _stiff():
 
 
 def _contact():
-    # a tip pressed lightly on a plane: the same compiled versions as any touching arm, and
-    # the shortest solve of those tried (about 1 s each here; a tip pushed 10 N into the
-    # plane took 6-7 s, one that grazes it 15 s)
+    # a tip pressed lightly on a plane, solved both ways: with the penalty (its contact
+    # distance given: the law of contact zones, an arm lying on a table; the same compiled
+    # versions as any touching arm, and the shortest solve of those tried, about 1 s each
+    # here, where a tip pushed 10 N into the plane took 6-7 s and one that grazes it 15 s),
+    # and held exactly at the tip (statics/tip_contact.py: plain solves and their verdict)
     arm = Arm.from_stiffness(1.0, EA=1e4, GAy=1e4, GAz=1e4, GJ=1.0, EIy=1.0, EIz=1.0)
-    _each_verdict_and_jacobians(arm, [TipLoad(force=[0.0, 0.0, -0.1]), Contact(
-        Plane((0.0, 0.0, -0.03), (0.0, 0.0, 1.0)), radius=0.01)])
+    plane = Plane((0.0, 0.0, -0.03), (0.0, 0.0, 1.0))
+    for contact in (Contact(plane, radius=0.01, distance=1e-5), Contact(plane, radius=0.01)):
+        _each_verdict_and_jacobians(arm, [TipLoad(force=[0.0, 0.0, -0.1]), contact])
 
 
 def _moving() -> Arm:
@@ -205,8 +208,8 @@ STEPS: tuple[Step, ...] = (
          "the verdict and Jacobians, and the verdict of a closed form in strong tension",
          ("stiff+verdict", "stiff", "stiff+jacobians+verdict", "stiff+jacobians",
           "verdict+given"), _stiff),
-    Step("contact", "contact with obstacles (softarm.Contact: multiple shooting), with and "
-         "without the verdict and Jacobians",
+    Step("contact", "contact with obstacles (softarm.Contact: multiple shooting, and a free "
+         "tip held exactly), with and without the verdict and Jacobians",
          ("stiff+actuated+verdict", "stiff+actuated", "stiff+actuated+jacobians+verdict",
           "stiff+actuated+jacobians"), _contact),
     Step("dynamics", "dynamics of passive arms (softarm.simulate, Simulator), from rest and "
