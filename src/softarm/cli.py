@@ -32,6 +32,7 @@ from . import __version__
 from .case import Case, CaseError, load_case
 from .errors import ConvergenceError, InadmissibleStateError, StabilityWarning
 from .io import FORMATS, load_saved, read_trajectory, save_result
+from .statics.tip_contact import METHOD as TIP_CONTACT
 from .sweep import solve_case
 
 __all__ = ["main"]
@@ -1258,7 +1259,7 @@ def _contact_line(result) -> str:
     wrench = np.asarray(result.contact_wrench)
     if not wrench.any():
         return f"no obstacle touched (nearest gap {float(np.min(result.gaps)):.4g} m)"
-    if result.method == "numeric.tip_contact":
+    if result.method == TIP_CONTACT:
         return f"the tip held exactly: reaction {_vector(wrench[:3])} N at the tip"
     return (f"total force {_vector(wrench[:3])} N, moment {_vector(wrench[3:])} N m about the "
             "origin")

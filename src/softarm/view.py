@@ -155,9 +155,9 @@ def _arrow_traces(arrows, scales, length: float) -> list[dict]:
 def _contact_traces(arrow, scales, length: float) -> list[dict]:
     """The contact forces (:func:`softarm.geometry.contact_arrows`: per length, or a held
     tip's) as magenta shafts and cones, scaled by ``scales[CONTACT_KEY]`` (m per N/m, or
-    per N; absent: this
-    equilibrium's own, :func:`softarm.geometry.contact_scale`). Two traces, empty where no
-    force acts, so that a sweep's frames and the app's updates keep their number."""
+    per N; absent: this equilibrium's own, :func:`softarm.geometry.contact_scale`). Two
+    traces, empty where no force acts, so that a sweep's frames and the app's updates keep
+    their number."""
     scale = scales.get(CONTACT_KEY) or contact_scale([arrow], length)
     origins, vectors = arrow.origins, arrow.vectors
     ends = origins + scale * vectors

@@ -520,7 +520,7 @@ class Simulator:
             return
         off = float(np.max(np.linalg.norm(start.positions[..., -1, :]
                                           - initial.positions[..., -1, :], axis=-1)))
-        # (a free tip held exactly on planes has no law: statics/tip_contact.py)
+        # (a free tip held exactly has no law: statics/tip_contact.py)
         solved = "with its tip held exactly (no contact distance), unlike" \
             if given.distance is None else \
             f"with another contact law (distance {given.distance:.3g} m) than"

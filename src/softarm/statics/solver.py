@@ -1648,9 +1648,9 @@ class Solver:
         )
 
     def _held_at_tip(self, loads, shape, jacobians: bool) -> Equilibrium | None:
-        """The unchained solve of ``loads`` (checked, batch ``shape``, with a Contact) where
-        the free tip alone touches planes, held exactly (tip_contact.py); the cases it does
-        not hold with the penalty; None where it holds none."""
+        """The solve of ``loads`` (checked, batch ``shape``, with a Contact) where the free
+        tip alone touches an obstacle, held exactly (tip_contact.py); the cases it does not
+        hold with the penalty; None where it holds none or a penalty is asked for."""
         contact = next(load for load in loads if load.kind == "contact")
         if contact.stiffness is not None or contact.distance is not None:
             return None  # (a penalty asked for)
@@ -1664,7 +1664,7 @@ class Solver:
         except ConvergenceError:  # (some case's free arm, or a held iterate, failed)
             if not shape:
                 return None  # (the penalty follows the path, or says where it fails)
-            found = self._held_case_by_case(loads, shape, jacobians)
+            found = self._held_case_by_case(loads, shape, jacobians, fine, asked)
         if found is None:
             return None
         parts, which = found
@@ -1688,15 +1688,14 @@ class Solver:
         return whole.equilibrium(shape, tuple(law if load.kind == "contact" else load
                                               for load in loads))
 
-    def _held_case_by_case(self, loads, shape, jacobians: bool):
+    def _held_case_by_case(self, loads, shape, jacobians: bool, fine, asked):
         """:func:`solve_tip_contact`'s answer, case by case: ([(flat cases, their
-        Equilibrium)], held (``shape`` bool)), or None where no case is held."""
+        Equilibrium, all of its cases)], held (``shape`` bool)), or None where no case is
+        held."""
         parts, which = [], np.zeros(math.prod(shape), dtype=bool)
         for case in range(which.size):
             index = np.unravel_index(np.array([case]), shape)
             one = [_part_of(load, shape, index) for load in loads]
-            fine, asked = _contact_stations(self._s_kernel, self.length,
-                                            np.array([self.length]))
             try:
                 found = solve_tip_contact(self, one, (1,), jacobians, fine, asked)
             except ConvergenceError:

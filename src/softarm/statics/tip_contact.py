@@ -161,7 +161,8 @@ def _curvature(obstacle, p, h) -> np.ndarray:
 
 
 def solve_tip_contact(solver, loads, shape, jacobians: bool, fine, asked):
-    """(the Equilibrium of ``loads`` (checked, batch ``shape``, one Contact) with the arm's
+    """(the Equilibrium of ``loads`` (checked, batch ``shape``, one Contact that asks for no
+    penalty: neither ``distance`` nor ``stiffness`` given, Solver._held_at_tip) with the arm's
     free tip held outside the Contact's obstacles (module docstring) at ``solver``'s
     stations, the cases it holds (``shape`` bool)), or None where the route applies to no
     case; the caller solves the others with the penalty. ``fine``, ``asked``: the solver's
@@ -171,9 +172,8 @@ def solve_tip_contact(solver, loads, shape, jacobians: bool, fine, asked):
     cases one by one."""
     contact = next(load for load in loads if load.kind == "contact")
     obstacles = contact.obstacles
-    if contact.stiffness is not None or contact.distance is not None or (
-            jacobians and any(load.kind == "tendon" for load in loads)):
-        return None  # (a penalty asked for; tendons' length Jacobians)
+    if jacobians and any(load.kind == "tendon" for load in loads):
+        return None  # (their length Jacobians would need their response to the reaction)
     free = tuple(load for load in loads if load.kind != "contact")
     depth = solver.tol * solver.length
     coarse = solver._with_stations(np.linspace(0.0, solver.length, COARSE), stability=False)
