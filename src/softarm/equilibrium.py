@@ -48,8 +48,9 @@ class Stability:
         multiplicity). 0: no unstable direction. -1: a conjugate point at the clamp itself
         (a critical equilibrium, neither stable nor unstable to first order).
     conservative : bool or ndarray of bool, shape (B...)
-        False for follower loads and dead couples (nonconservative in 3D, Ziegler): the
-        static test then cannot prove stability (an odd index still proves divergence).
+        False for follower loads and dead couples (nonconservative in 3D, Ziegler) and for
+        a tip held with friction (docs/contact.md, "Friction"): the static test then
+        cannot prove stability (an odd index still proves divergence).
     stable : bool or ndarray of bool, shape (B...)
         ``index == 0 and conservative``.
     """
@@ -86,8 +87,9 @@ class Stability:
         if index < 0:
             return "critical (a conjugate point at the clamp: neither stable nor unstable)"
         if not self.conservative:
-            return (f"not decided: follower loads or dead couples are not conservative (Morse "
-                    f"index {index}{', odd: unstable by divergence' if index % 2 else ''})")
+            odd = ", odd: unstable by divergence" if index % 2 else ""
+            return (f"not decided: follower loads, dead couples and friction are not "
+                    f"conservative (Morse index {index}{odd})")
         if index == 0:
             return "stable (Morse index 0)"
         return (f"UNSTABLE (Morse index {index}: a real arm would move away; solve with "

@@ -301,6 +301,20 @@ class Load(abc.ABC):
             object.__setattr__(new, name, array)
         return new
 
+    def part(self, shape, index) -> Load:
+        """The load of the cases ``index`` (a case's tuple of indices, or a tuple of index
+        arrays) of the whole batch ``shape``, into which this load's batch broadcasts: its
+        batched fields gathered (a broadcast field is not expanded to the whole batch
+        first)."""
+        if not self.batch_shape:
+            return self
+        changes = {}
+        for name, _, object_shape in self.arrays:
+            value = getattr(self, name)
+            if value is not None and np.ndim(value) > len(object_shape):
+                changes[name] = np.broadcast_to(value, (*shape, *object_shape))[index]
+        return self.replace(**changes)
+
     def take(self, index) -> Load:
         """The load of one case (or a sub-batch) of a batch: ``index`` into the batch axes."""
         shape = self.batch_shape

@@ -1657,6 +1657,9 @@ class Solver:
         _check_outside(self, contact)
         fine, asked = _contact_stations(self._s_kernel, self.length, np.array([self.length]))
         try:
+            if contact.friction > 0.0 and math.prod(shape) > 1:
+                # (friction: each case's own path, tip_friction.py)
+                raise ConvergenceError("friction: case by case", 0.0)
             found = solve_tip_contact(self, loads, shape, jacobians, fine, asked)
             if found is not None:
                 held = np.flatnonzero(found[1].reshape(-1))
@@ -1674,7 +1677,7 @@ class Solver:
         rest = np.flatnonzero(~which.reshape(-1))
         if rest.size:
             parts.append((rest, self._solve(
-                [_part_of(load, shape, np.unravel_index(rest, shape)) for load in loads],
+                [load.part(shape, np.unravel_index(rest, shape)) for load in loads],
                 chained=False, jacobians=jacobians, checked=True,
                 contact_retry=(None, 0, 0)), slice(None)))
         whole = _Parts(parts[-1][1], math.prod(shape))
@@ -1695,7 +1698,7 @@ class Solver:
         parts, which = [], np.zeros(math.prod(shape), dtype=bool)
         for case in range(which.size):
             index = np.unravel_index(np.array([case]), shape)
-            one = [_part_of(load, shape, index) for load in loads]
+            one = [load.part(shape, index) for load in loads]
             try:
                 found = solve_tip_contact(self, one, (1,), jacobians, fine, asked)
             except ConvergenceError:
@@ -1718,7 +1721,7 @@ class Solver:
         for first in range(0, count, size):
             index = np.unravel_index(np.arange(first, min(first + size, count)), shape)
             with batch_part(shape, first, index[0].size):  # (messages: the whole batch's)
-                result = self._solve([_part_of(load, shape, index) for load in loads],
+                result = self._solve([load.part(shape, index) for load in loads],
                                      chained=chained, jacobians=jacobians, outputs=outputs,
                                      checked=True)  # (the whole batch was)
             if outputs:
@@ -1757,7 +1760,7 @@ class Solver:
         connected to the unloaded arm. Leaves this Solver at that equilibrium."""
         return self._solve_near(loads, x, steps)
 
-    def _solve_near(self, loads, x, steps) -> Equilibrium:
+    def _solve_near(self, loads, x, steps, jacobians: bool = False) -> Equilibrium:
         k = _kernels()
         self.reset()
         memory = np.zeros(k.MEMORY)
@@ -1765,7 +1768,7 @@ class Solver:
         memory[12] = max(1, int(steps) // 2)
         memory[13] = 1.0
         self._memory = memory
-        return self._solve(loads, chained=True, jacobians=False, near=True)
+        return self._solve(loads, chained=True, jacobians=jacobians, near=True)
 
     def shoot(self, loads, x, load_factor=1.0, *, steps=None, inputs=False) -> ShootResult:
         """One integration from the base reaction ``x`` = (n(0); m(0)) (N, N m, spatial) at
@@ -1967,20 +1970,6 @@ def _input_channels(loads, pieces, data, width) -> tuple[np.ndarray, np.ndarray]
                 piece.append(channels.piece[0])
                 tip.append(channels.tip_loads[0])
     return np.ascontiguousarray(piece), np.ascontiguousarray(tip)
-
-
-def _part_of(load, shape, index):
-    """The load of the cases ``index`` (a tuple of index arrays into ``shape``, the whole
-    batch's) as a batch of shape (n,): its batched fields gathered (a broadcast field is not
-    expanded to the whole batch first)."""
-    if not load.batch_shape:
-        return load
-    changes = {}
-    for name, _, object_shape in load.arrays:
-        value = getattr(load, name)
-        if value is not None and np.ndim(value) > len(object_shape):
-            changes[name] = np.broadcast_to(value, (*shape, *object_shape))[index]
-    return load.replace(**changes)
 
 
 class _Parts:

@@ -60,12 +60,14 @@ the reaction by δf = δλ n̂ + λ ∇²d δp(L); holding n̂ · δp(L) = 0 giv
 from __future__ import annotations
 
 import dataclasses
+import warnings
 
 import numpy as np
 
 from ..equilibrium import Stability
 from ..errors import ConvergenceError
 from ..loads import TipLoad
+from .tip_friction import held_index, with_friction
 
 __all__ = ["METHOD", "solve_tip_contact"]
 
@@ -197,6 +199,122 @@ def solve_tip_contact(solver, loads, shape, jacobians: bool, fine, asked):
             held &= touches | np.all(on_the_way >= -depth, axis=(0, -1))
     if not held.any():
         return None
+    if contact.friction > 0.0:
+        return _with_friction(solver, coarse, loads, free, contact, which, held, depth,
+                              [*factors, 1.0], [*path, eq.positions], jacobians, fine, asked)
+    lam, normal, held = _normal_reaction(coarse, free, obstacles, radii, which, held, depth,
+                                         factors, curved, eq)
+    held &= lam >= 0.0
+    lam = np.where(held, lam, 0.0)
+    if not held.any():
+        return None
+    final = solver._with_stations(fine, stability=solver.stability)._solve(
+        (*free, TipLoad(force=lam[..., None] * normal)), chained=False,
+        jacobians=jacobians or (curved and solver.stability), checked=False)
+    gaps = _gaps(obstacles, final.positions, contact.station_radii(solver.arm, fine))
+    held &= np.all(gaps >= -depth, axis=(0, -1))  # (else contact zones: the penalty's)
+    pressed = held & (lam > 0.0)
+    # the constraint's curvature: the reaction λ n̂(p) turns with the tip (∇²d, zero on a
+    # plane), a stiffness -λ ∇²d at the tip
+    tip = final.tip_position
+    bent = np.zeros((*shape, 3, 3))
+    for k, obstacle in enumerate(obstacles):
+        if obstacle.kind != "plane":
+            mine = pressed & (which == k)
+            bent[mine] = -lam[mine][..., None, None] * _curvature(
+                obstacle, tip[mine], CURVATURE_STEP * obstacle.radius)
+    changes = {}
+    if solver.stability:  # (final's verdict: the free arm's with the dead force λ n̂)
+        held &= np.asarray(final.stability.stable)
+        index = _held_index(final.tip_compliance, normal, bent) if curved else 0
+        changes["stability"] = Stability.of(np.where(pressed, index, 0), True, shape)
+    if not held.any():
+        return None
+    if jacobians:
+        changes.update(_held_jacobians(final, asked, normal, bent, pressed))
+    else:  # (the compliance was the verdict's)
+        changes.update(dict.fromkeys(("tip_compliance", "compliance", "actuation_jacobian",
+                                      "station_actuation_jacobian",
+                                      "tendon_length_jacobian")))
+    force = lam[..., None] * normal
+    return _answer(final, solver, asked, loads, tip, force, changes), held
+
+
+def _answer(final, solver, asked, loads, point, force, changes):
+    """The held arm's Equilibrium from ``final`` (the arm with the reaction as a dead load
+    on the solver's fine stations) at the asked stations, the reaction ``force`` acting at
+    ``point`` (spatial, N and m) its contact wrench."""
+    wrench = np.concatenate([force, np.cross(point, force)], axis=-1)
+    return dataclasses.replace(
+        final, s=solver.s, poses=final.poses[..., asked, :, :],
+        strains=final.strains[..., asked, :], stresses=final.stresses[..., asked, :],
+        loads=loads, method=METHOD, contact_resultant=wrench, **changes)
+
+
+def _with_friction(solver, coarse, loads, free, contact, which, held, depth, factors, path,
+                   jacobians, fine, asked):
+    """solve_tip_contact's answer with Coulomb friction (tip_friction.py), for a single
+    case (batch shape () or (1,): a batch is held case by case, Solver._held_at_tip)."""
+    shape = held.shape
+    case = (0,) * len(shape)
+    obstacle = contact.obstacles[which[case]]
+    radius = contact.station_radii(solver.arm, np.array([solver.length]))[-1]
+    bracket = [(t, obstacle.distance(positions[case][-1])[0] - radius)
+               for t, positions in zip(factors, path, strict=True)]
+    one = tuple(load.part(shape, case) for load in free)
+    fine_solver = solver._with_stations(fine, stability=solver.stability)
+    try:
+        found = with_friction(coarse, fine_solver, one, obstacle, contact.friction, radius,
+                              depth, GAP * depth, bracket, jacobians)
+    except ConvergenceError as error:
+        warnings.warn(f"Contact.friction: the tip's path with friction did not solve "
+                      f"({error}); solved frictionless, with the penalty", stacklevel=5)
+        return None
+    if found is None:  # (the free tip never touches: the free arm, the penalty's answer)
+        return None
+    final = found.final
+    gaps = _gaps(contact.obstacles, final.positions, contact.station_radii(solver.arm, fine))
+    if np.any(gaps < -depth):  # (the held arm lies on an obstacle: contact zones)
+        return None
+    tip = final.poses[-1, :3, 3]
+    changes = dict.fromkeys(("tip_compliance", "compliance", "actuation_jacobian",
+                             "station_actuation_jacobian", "tendon_length_jacobian"))
+    if solver.stability:  # (friction is not conservative: the index with the friction force
+        # taken as dead; the verdict undecided where the obstacle pushes)
+        index = held_index(final.stability.index, final.tip_compliance, found.arm)
+        pushes = np.any(found.force != 0.0)
+        changes["stability"] = Stability.of(index, bool(final.stability.conservative)
+                                            and not pushes, ())
+    answer = _answer(final, solver, asked, loads if not shape else
+                     tuple(load.part(shape, case) for load in loads), tip + found.arm,
+                     found.force, changes)
+    return (_batched(answer, shape) if shape else answer), np.ones(shape, dtype=bool)
+
+
+def _batched(eq, shape):
+    """The unbatched Equilibrium ``eq`` as a batch of ``shape`` (one case)."""
+    changes = {}
+    for field in dataclasses.fields(eq):
+        value = getattr(eq, field.name)
+        if field.name in ("s", "loads", "method", "exact"):
+            continue
+        if isinstance(value, Stability):
+            changes[field.name] = Stability.of(np.reshape(value.index, shape),
+                                               np.reshape(value.conservative, shape), shape)
+        elif isinstance(value, np.ndarray):
+            changes[field.name] = value.reshape(*shape, *value.shape)
+        elif isinstance(value, (float, np.floating)):
+            changes[field.name] = np.full(shape, value)
+    return dataclasses.replace(eq, **changes)
+
+
+def _normal_reaction(coarse, free, obstacles, radii, which, held, depth, factors, curved,
+                     eq):
+    """(λ, n̂, the cases held) of the frictionless reaction λ n̂ at the tip (module
+    docstring): ``eq`` the free arm at the full load at ``coarse``'s stations, ``factors``
+    the path's check's load factors below 1."""
+    shape = held.shape
+    held = held.copy()
     # Newton's method on λ, per case (0 where the free tip is outside every obstacle), the
     # reaction's direction n̂ frozen; then n̂ at the new tip, until it stays (a plane's at
     # once). On a curved obstacle the reaction is followed along the path's factors from
@@ -265,44 +383,7 @@ def solve_tip_contact(solver, loads, shape, jacobians: bool, fine, asked):
             gap = nearest(eq.tip_position)[0]
         else:
             held &= ~moved
-    held &= lam >= 0.0
-    lam = np.where(held, lam, 0.0)
-    if not held.any():
-        return None
-    final = solver._with_stations(fine, stability=solver.stability)._solve(
-        (*free, TipLoad(force=lam[..., None] * normal)), chained=False,
-        jacobians=jacobians or (curved and solver.stability), checked=False)
-    gaps = _gaps(obstacles, final.positions, contact.station_radii(solver.arm, fine))
-    held &= np.all(gaps >= -depth, axis=(0, -1))  # (else contact zones: the penalty's)
-    pressed = held & (lam > 0.0)
-    # the constraint's curvature: the reaction λ n̂(p) turns with the tip (∇²d, zero on a
-    # plane), a stiffness -λ ∇²d at the tip
-    tip = final.tip_position
-    bent = np.zeros((*shape, 3, 3))
-    for k, obstacle in enumerate(obstacles):
-        if obstacle.kind != "plane":
-            mine = pressed & (which == k)
-            bent[mine] = -lam[mine][..., None, None] * _curvature(
-                obstacle, tip[mine], CURVATURE_STEP * obstacle.radius)
-    changes = {}
-    if solver.stability:  # (final's verdict: the free arm's with the dead force λ n̂)
-        held &= np.asarray(final.stability.stable)
-        index = _held_index(final.tip_compliance, normal, bent) if curved else 0
-        changes["stability"] = Stability.of(np.where(pressed, index, 0), True, shape)
-    if not held.any():
-        return None
-    if jacobians:
-        changes.update(_held_jacobians(final, asked, normal, bent, pressed))
-    else:  # (the compliance was the verdict's)
-        changes.update(dict.fromkeys(("tip_compliance", "compliance", "actuation_jacobian",
-                                      "station_actuation_jacobian",
-                                      "tendon_length_jacobian")))
-    force = lam[..., None] * normal
-    wrench = np.concatenate([force, np.cross(tip, force)], axis=-1)
-    return dataclasses.replace(
-        final, s=solver.s, poses=final.poses[..., asked, :, :],
-        strains=final.strains[..., asked, :], stresses=final.stresses[..., asked, :],
-        loads=loads, method=METHOD, contact_resultant=wrench, **changes), held
+    return lam, normal, held
 
 
 def _held_index(compliance, normal, bent) -> np.ndarray:
