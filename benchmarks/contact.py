@@ -7,6 +7,10 @@ alternatives.
 - the free tip pressed onto a plane and onto a pin: held exactly (statics/tip_contact.py),
   against the penalty at the default δ, the free arm, and the Reissner-rod ``solve_bvp``
   references of tests/_tip_reference.py;
+- a heavy arm's tip on a floor with Coulomb friction (statics/tip_friction.py): stuck and
+  sliding, against the Reissner-rod ``solve_bvp`` references rolling and sliding on the
+  floor (tests/_tip_reference.py) and the same tip held without friction; and a slide
+  turned by a pull across the bending plane;
 - the arm pressed onto a pin (a Capsule) by gravity and a tip force;
 - a tendon finger closing on a cylinder, tracked over 100 tension steps (a prepared
   ForwardSolver, as a control loop calls it);
@@ -37,7 +41,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
 from _table_reference import table_reference
-from _tip_reference import tip_on_circle, tip_on_plane
+from _tip_reference import tip_on_circle, tip_on_plane, tip_sliding_on_plane, tip_stuck_on_plane
 
 import softarm
 from softarm.case import load_case
@@ -135,6 +139,43 @@ def tip(repeats):
     return rows
 
 
+def friction(repeats):
+    """The heavy arm of tests/test_tip_friction.py (E = 20 MPa) under its weight, its tip on
+    a floor 40 mm below the clamp: with μ above the stuck force's lean on the whole path
+    (it sticks, the cap rolling), below it (it slides), without friction, and sliding with
+    a pull of 0.05 N across the bending plane (the slide's way turns on the path)."""
+    arm = softarm.Arm(L, softarm.Circle(RADIUS), softarm.Material(
+        youngs_modulus=2e7, poisson_ratio=0.5, density=1000.0))
+    k, w = arm.rigidities, arm.linear_density * 9.81
+    floor = softarm.Plane((0.0, 0.0, -0.04), (0.0, 0.0, 1.0))
+    stuck, rwall, rcpu = _timed(lambda: tip_stuck_on_plane(
+        L, k.EA, k.GAy, k.EIy, RADIUS, w, (0.0, 0.0), (0.0, -0.04), (0.0, 1.0)), 1)
+    mu_stick, mu_slide = stuck.ratios.max() / 0.9, stuck.ratios.min() / 1.1
+    sliding = tip_sliding_on_plane(L, k.EA, k.GAy, k.EIy, RADIUS, w, (0.0, 0.0),
+                                   (0.0, -0.04), (0.0, 1.0), mu_slide,
+                                   np.sign(stuck.reaction[0]))
+    rows = []
+    for name, mu, ref in ((f"floor, stuck (μ = {mu_stick:.2f})", mu_stick, stuck),
+                          (f"floor, sliding (μ = {mu_slide:.2f})", mu_slide, sliding),
+                          ("floor, frictionless (held)", 0.0, None)):
+        eq, wall, cpu = _timed(lambda mu=mu: softarm.solve(
+            arm, [softarm.Gravity(), softarm.Contact(floor, friction=mu)], s=201, tol=1e-6),
+            repeats)
+        error = "" if ref is None else (
+            f"{np.abs(eq.positions - ref.positions(eq.s)).max() / L:.1e} L; force "
+            f"{np.abs(eq.contact_wrench[[0, 2]] - ref.reaction).max() / np.hypot(*ref.reaction):.1e}"  # noqa: E501
+        )
+        rows.append((f"{name} ({eq.method})", wall, cpu, error, ""))
+    rows.append(("floor, stuck: solve_bvp reference (rolling, from the first touch)", rwall,
+                 rcpu, "reference", ""))
+    pull = [softarm.Gravity(), softarm.TipLoad(force=(0.0, 0.05, 0.0)),
+            softarm.Contact(floor, friction=0.3)]
+    eq, wall, cpu = _timed(lambda: softarm.solve(arm, pull, s=201, tol=1e-6), repeats)
+    rows.append((f"floor, sliding, pulled across the bending plane ({eq.method})", wall, cpu,
+                 "", ""))
+    return rows
+
+
 def pin(repeats):
     arm = _soft_arm()
     pin_radius = 0.005
@@ -206,7 +247,8 @@ def measure(repeats: int) -> list[str]:
     """The markdown lines of docs/performance.md's "Contact" section (benchmarks/run.py)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # (stability and approximation notes)
-        rows = [*table(repeats), *tip(repeats), *pin(repeats), *finger(repeats),
+        rows = [*table(repeats), *tip(repeats), *friction(repeats), *pin(repeats),
+                *finger(repeats),
                 *slider(repeats), *drop(repeats)]
     lines = ["## Contact", "",
              f"`python benchmarks/contact.py --repeats {repeats}` "

@@ -18,6 +18,7 @@ import pytest
 from _tip_reference import tip_sliding_on_plane, tip_stuck_on_plane
 
 import softarm as sa
+from softarm.cli import _contact_line
 from softarm.contact import balance
 from softarm.statics import tip_friction
 
@@ -64,6 +65,7 @@ def test_a_stuck_tip_matches_the_reissner_rod_rolling_on_the_floor(arm, stuck):
     assert not eq.stability.conservative
     assert eq.stability.index == 0
     assert "friction" in eq.stability.describe()
+    assert "(stuck: tangential 3.039 N, 0.9 × μ × the normal 0.751 N)" in _contact_line(eq)
 
 
 def test_a_sliding_tip_matches_the_reissner_rod_with_coulombs_force(arm, stuck):
@@ -78,6 +80,7 @@ def test_a_sliding_tip_matches_the_reissner_rod_with_coulombs_force(arm, stuck):
     assert np.abs(eq.positions - ref.positions(eq.s)).max() < 1e-7 * L  # (1.3e-9 L)
     assert eq.contact_wrench[[0, 2]] == pytest.approx(ref.reaction, rel=1e-6)
     assert _lean(eq.contact_wrench) == pytest.approx(mu, rel=1e-9)  # |f_t| = μ N
+    assert "(sliding: tangential 2.437 N, 1 × μ × the normal 0.6927 N)" in _contact_line(eq)
     # the contact wrench is the global balance: the base wrench less the weight
     s = np.linspace(0.0, L, 2001)
     fine = sa.solve(arm, [sa.Gravity(), sa.Contact(FLOOR, friction=mu)], s=s)

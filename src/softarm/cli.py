@@ -1260,7 +1260,17 @@ def _contact_line(result) -> str:
     if not wrench.any():
         return f"no obstacle touched (nearest gap {float(np.min(result.gaps)):.4g} m)"
     if result.method == TIP_CONTACT:
-        return f"the tip held exactly: reaction {_vector(wrench[:3])} N at the tip"
+        line = f"the tip held exactly: reaction {_vector(wrench[:3])} N at the tip"
+        contact = next(load for load in result.loads if load.kind == "contact")
+        if contact.friction:  # (stuck or sliding: its lean against Coulomb's μ)
+            tip = np.asarray(result.poses)[-1, :3, 3]
+            normal = min((o.distance(tip) for o in contact.obstacles), key=lambda f: f[0])[1]
+            pressing = float(wrench[:3] @ normal)
+            along = float(np.linalg.norm(wrench[:3] - pressing * normal))
+            lean = along / (contact.friction * pressing)
+            line += (f" ({'sliding' if lean > 1.0 - 1e-6 else 'stuck'}: tangential "
+                     f"{along:.4g} N, {lean:.4g} × μ × the normal {pressing:.4g} N)")
+        return line
     return (f"total force {_vector(wrench[:3])} N, moment {_vector(wrench[3:])} N m about the "
             "origin")
 

@@ -17,9 +17,11 @@ shape is then within δ of the hard-contact solution's, and no point penetrates 
 (the solver checks it at the stations and raises k where it must).
 
 Frictionless: the force passes through the centreline, so it has no moment about it.
-Friction (``friction`` = μ > 0) acts in the dynamics only (softarm.simulate): in statics the
-frictionless equilibrium is returned (a Coulomb equilibrium for any μ, with zero tangential
-force; not necessarily the one a quasi-static path with friction would reach: contact.md).
+Friction (``friction`` = μ > 0) acts in the dynamics (softarm.simulate) and, in statics, at a
+free tip held exactly (statics/tip_friction.py: the quasi-static path from the unloaded arm,
+the tip sticking or sliding); the penalty's contact zones in statics return the frictionless
+equilibrium (a Coulomb equilibrium for any μ, with zero tangential force; not necessarily
+the one a quasi-static path with friction would reach: docs/contact.md, "Friction").
 """
 
 from __future__ import annotations
@@ -301,7 +303,9 @@ class Contact(Load):
     obstacles : Obstacle or sequence of Obstacle
         :class:`Plane`, :class:`Sphere`, :class:`Capsule` (spatial frame, m).
     friction : float
-        Coulomb's μ >= 0 (dynamics; statics returns the frictionless equilibrium).
+        Coulomb's μ >= 0: in the dynamics, and in statics at a free tip held exactly (the
+        tip sticks or slides along the loads' path from the unloaded arm); a statics
+        contact zone (the penalty's) is frictionless (docs/contact.md, "Friction").
     distance : float or None
         The contact distance δ (m) of the penalty: forces act only where the gap is below
         it. Default 1e-5 L. The shape is within about δ of the hard-contact solution.
