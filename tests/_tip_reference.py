@@ -178,18 +178,36 @@ def first_touch(L, EA, GA, EI, r, w, force, point, normal, *, tol=1e-10):
 
 def tip_stuck_on_plane(L, EA, GA, EI, r, w, force, point, normal, *, steps=40, tol=1e-10):
     """The arm whose tip's cap touched the plane (``point``, ``normal``: (x, z)) first at
-    t₀ and rolled on it without sliding as the loads grew to their full value: the
-    reaction (x, z) is the parameters. Also the ratio |f_t|/f_n at every continuation step
-    (``.ratios``), to choose μ: the tip sticks on the whole path where μ exceeds them."""
+    t₀ and rolled on it without sliding as the loads grew to their full value (the weight
+    w and the tip force ``force`` scaled by t): the reaction (x, z) is the parameters. Also
+    the ratio |f_t|/f_n at every continuation step (``.ratios``), to choose μ: the tip
+    sticks on the whole path where μ exceeds them."""
+    t0 = first_touch(L, EA, GA, EI, r, w, force, point, normal, tol=tol)[0]
+    s = np.linspace(0.0, L, 201)
+    fun = _rates(L, EA, GA, EI, t0 * w, t0 * np.asarray(force, float), lambda p: (0.0, 0.0))
+    sol = solve_bvp(lambda s_, y_: fun(s_, y_, None),
+                    lambda ya, yb: np.array([ya[0], ya[1], ya[2], yb[3]]),
+                    s, np.vstack([s, 0 * s, 0 * s, 0 * s]), tol=tol, max_nodes=100_000)
+    touched = TipHeld(sol.x, sol.y[0], sol.y[1], sol.y[2], np.zeros(2))
+    touched.m = sol.y[3]
+    return tip_stuck_from(L, EA, GA, EI, r, w, force, point, normal, touched, t0, 1.0,
+                          steps=steps, tol=tol)
+
+
+def tip_stuck_from(L, EA, GA, EI, r, w, force, point, normal, held, start, end, *,
+                   steps=40, tol=1e-10):
+    """The arm whose tip's cap, held on the plane in ``held`` (a TipHeld with ``.m``, the
+    internal moment, at the load factor ``start``), rolls on it without sliding while the
+    loads go from ``start`` to ``end`` (scaled, as tip_stuck_on_plane's). ``.ratios``: the
+    lean |f_t|/f_n at every continuation step."""
     normal = np.asarray(normal, float) / np.linalg.norm(normal)
     tangent = np.array([normal[1], -normal[0]])  # ŷ × n̂ in (x, z)
     point, force = np.asarray(point, float), np.asarray(force, float)
-    t0, p0, th0 = first_touch(L, EA, GA, EI, r, w, force, point, normal, tol=tol)
-    s = np.linspace(0.0, L, 201)
-    sol0 = None
+    p0, th0 = np.array([held.x[-1], held.z[-1]]), held.theta[-1]
+    xs, y = held.s, np.vstack([held.x, held.z, held.theta, held.m])
+    p = np.asarray(held.reaction, float)
     ratios = []
-    y, p = None, np.zeros(2)
-    for mu in np.linspace(t0, 1.0, steps + 1)[1:]:
+    for mu in np.linspace(start, end, steps + 1)[1:]:
         fun = _rates(L, EA, GA, EI, mu * w, mu * force, lambda p: (p[0], p[1]))
 
         def bc(ya, yb, p):
@@ -197,22 +215,14 @@ def tip_stuck_on_plane(L, EA, GA, EI, r, w, force, point, normal, *, steps=40, t
                              (np.array([yb[0], yb[1]]) - point) @ normal - r,
                              (np.array([yb[0], yb[1]]) - p0) @ tangent - r * (yb[2] - th0)])
 
-        if y is None:
-            sol0 = solve_bvp(lambda s_, y_: _rates(L, EA, GA, EI, t0 * w, t0 * force,
-                                                   lambda p: (0.0, 0.0))(s_, y_, None),
-                             lambda ya, yb: np.array([ya[0], ya[1], ya[2], yb[3]]),
-                             s, np.vstack([s, 0 * s, 0 * s, 0 * s]), tol=tol,
-                             max_nodes=100_000)
-            y, xs = sol0.y, sol0.x
         sol = solve_bvp(fun, bc, xs, y, p, tol=tol, max_nodes=100_000)
         if not sol.success:
-            raise RuntimeError(f"tip_stuck_on_plane: solve_bvp failed at μ = {mu}")
+            raise RuntimeError(f"tip_stuck_from: solve_bvp failed at μ = {mu}")
         xs, y, p = sol.x, sol.y, sol.p
-        f = np.asarray(p)
-        ratios.append(abs(f @ tangent) / (f @ normal))
-    held = TipHeld(xs, y[0], y[1], y[2], np.asarray(p))
-    held.ratios = np.array(ratios)
-    return held
+        ratios.append(abs(p @ tangent) / (p @ normal))
+    out = TipHeld(xs, y[0], y[1], y[2], np.asarray(p))
+    out.m, out.ratios = y[3], np.array(ratios)
+    return out
 
 
 def tip_sliding_on_plane(L, EA, GA, EI, r, w, force, point, normal, mu, side, *, steps=40,
@@ -241,4 +251,6 @@ def tip_sliding_on_plane(L, EA, GA, EI, r, w, force, point, normal, mu, side, *,
         if not sol.success:
             raise RuntimeError(f"tip_sliding_on_plane: solve_bvp failed at c = {c}")
         s, y, p = sol.x, sol.y, sol.p
-    return TipHeld(s, y[0], y[1], y[2], p[0] * lean)
+    out = TipHeld(s, y[0], y[1], y[2], p[0] * lean)
+    out.m = y[3]
+    return out

@@ -8,6 +8,9 @@
 - the contact wrench against the solve's global balance; the answer converging as tol
   shrinks, with no δ; a load across the bending plane (a slide that turns) converging as
   the path's steps are refined;
+- a chained Solver follows the quasi-static path of its solves: loaded in steps it ends
+  where one solve does (a slide's end does not depend on the way), and unloaded after the
+  slide its tip sticks, rolling from where it slid to (the reference rolls from there);
 - a batch equals its cases one by one; Jacobians with friction are refused, saying why.
 """
 
@@ -15,12 +18,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from _tip_reference import tip_sliding_on_plane, tip_stuck_on_plane
+from _tip_reference import tip_sliding_on_plane, tip_stuck_from, tip_stuck_on_plane
 
 import softarm as sa
 from softarm.cli import _contact_line
 from softarm.contact import balance
-from softarm.statics import tip_friction
+from softarm.statics import Solver, tip_friction
 
 L = 0.5
 RADIUS = 0.01
@@ -114,6 +117,37 @@ def test_a_slide_across_the_bending_plane_converges_as_the_paths_steps_are_refin
     monkeypatch.setattr(tip_friction, "FRICTION_STEPS", (64, 128, 256))
     refined = sa.solve(arm, loads, s=101)
     assert np.abs(eq.positions - refined.positions).max() < 2e-8 * L
+
+
+def test_a_chained_solver_follows_the_path_of_its_solves(arm, stuck):
+    mu = stuck.ratios.min() / 1.1
+    rig, weight = arm.rigidities, arm.linear_density * 9.81
+    side = np.sign(stuck.reaction[0])
+    contact = sa.Contact(FLOOR, friction=mu)
+    solver = Solver(arm, s=np.linspace(0.0, L, 101))
+    for g in (0.6, 0.8, 1.0):  # loaded in steps: the slide ends where one solve's does
+        loaded = solver.solve([sa.Gravity().scaled(g), contact])
+    once = sa.solve(arm, [sa.Gravity(), contact], s=101)
+    assert np.abs(loaded.positions - once.positions).max() < 1e-8 * L  # (9.4e-10 L)
+    assert _lean(loaded.contact_wrench) == pytest.approx(mu, rel=1e-9)
+    # unloaded to 0.7 of the weight: the stuck force leans less than μ, and the cap rolls
+    # on the floor from where the slide left it (a path no single solve takes)
+    slid = tip_sliding_on_plane(L, rig.EA, rig.GAy, rig.EIy, RADIUS, weight, (0.0, 0.0),
+                                POINT, NORMAL, mu, side)
+    ref = tip_stuck_from(L, rig.EA, rig.GAy, rig.EIy, RADIUS, weight, (0.0, 0.0), POINT,
+                         NORMAL, slid, 1.0, 0.7)
+    assert ref.ratios.max() < mu  # (the reference sticks on the way: 0.906 μ at the end)
+    unloaded = solver.solve([sa.Gravity().scaled(0.7), contact])
+    assert np.abs(unloaded.positions - ref.positions(unloaded.s)).max() < 1e-7 * L  # 7.5e-10
+    assert unloaded.contact_wrench[[0, 2]] == pytest.approx(ref.reaction, rel=1e-6)
+    assert "stuck" in _contact_line(unloaded)
+    # a single solve at 0.7 slides there from its first touch: another equilibrium
+    fresh = sa.solve(arm, [sa.Gravity().scaled(0.7), contact], s=101)
+    assert abs(fresh.tip_position[0] - unloaded.tip_position[0]) > 1e-5  # (1.8e-5 m)
+    # a reset chain starts from the unloaded arm again
+    solver.reset()
+    again = solver.solve([sa.Gravity().scaled(0.7), contact])
+    assert np.abs(again.positions - fresh.positions).max() < 1e-8 * L
 
 
 def test_a_batch_with_friction_equals_its_cases_one_by_one(arm, stuck):

@@ -1301,6 +1301,9 @@ class Solver:
         """Return the quasi-static state to the unloaded arm."""
         self._forget_single()
         self._chain = None  # multiple shooting's: a _StiffChain, made on first use
+        # a tip held with friction: (the contact's key, its free loads, its FrictionalTip),
+        # from which a chained solve goes on (tip_friction.follow_on)
+        self._friction = self._friction_found = None
 
     def _forget_single(self) -> None:
         """Forget single shooting's quasi-static memory (after a solve by multiple
@@ -1449,12 +1452,15 @@ class Solver:
                                             jacobians=jacobians, outputs=outputs)
             if outputs and contact_retry is None and \
                     any(load.kind == "contact" for load in loads):
-                held = self._held_at_tip(loads, shape, jacobians)
+                held = self._held_at_tip(loads, shape, jacobians, chained)
                 if held is not None:
                     # (every held solve is from the unloaded arm: a chained Solver goes on
-                    # from there, whose answer this is where the held arm is stable)
+                    # from there, whose answer this is where the held arm is stable; with
+                    # friction it goes on from its last answer, tip_friction.py)
                     if chained:
+                        found = self._friction_found
                         self.reset()
+                        self._friction = found
                     return held
         k = _kernels()
         last = self._last if chained else None
@@ -1647,11 +1653,14 @@ class Solver:
             **actuation,
         )
 
-    def _held_at_tip(self, loads, shape, jacobians: bool) -> Equilibrium | None:
+    def _held_at_tip(self, loads, shape, jacobians: bool,
+                     chained: bool = False) -> Equilibrium | None:
         """The solve of ``loads`` (checked, batch ``shape``, with a Contact) where the free
         tip alone touches an obstacle, held exactly (tip_contact.py); the cases it does not
-        hold with the penalty; None where it holds none or a penalty is asked for."""
+        hold with the penalty; None where it holds none or a penalty is asked for.
+        ``chained``: a tip held with friction goes on from the last answer's."""
         contact = next(load for load in loads if load.kind == "contact")
+        self._friction_found = None
         if contact.stiffness is not None or contact.distance is not None:
             return None  # (a penalty asked for)
         _check_outside(self, contact)
@@ -1660,7 +1669,8 @@ class Solver:
             if contact.friction > 0.0 and math.prod(shape) > 1:
                 # (friction: each case's own path, tip_friction.py)
                 raise ConvergenceError("friction: case by case", 0.0)
-            found = solve_tip_contact(self, loads, shape, jacobians, fine, asked)
+            found = solve_tip_contact(self, loads, shape, jacobians, fine, asked,
+                                      self._friction if chained and not shape else None)
             if found is not None:
                 held = np.flatnonzero(found[1].reshape(-1))
                 found = ([(held, found[0], held)], found[1])

@@ -67,7 +67,7 @@ import numpy as np
 from ..equilibrium import Stability
 from ..errors import ConvergenceError
 from ..loads import TipLoad
-from .tip_friction import held_index, with_friction
+from .tip_friction import follow_on, held_index, with_friction
 
 __all__ = ["METHOD", "solve_tip_contact"]
 
@@ -162,7 +162,7 @@ def _curvature(obstacle, p, h) -> np.ndarray:
     return 0.5 * (hessian + np.swapaxes(hessian, -1, -2))
 
 
-def solve_tip_contact(solver, loads, shape, jacobians: bool, fine, asked):
+def solve_tip_contact(solver, loads, shape, jacobians: bool, fine, asked, last=None):
     """(the Equilibrium of ``loads`` (checked, batch ``shape``, one Contact that asks for no
     penalty: neither ``distance`` nor ``stiffness`` given, Solver._held_at_tip) with the arm's
     free tip held outside the Contact's obstacles (module docstring) at ``solver``'s
@@ -171,7 +171,8 @@ def solve_tip_contact(solver, loads, shape, jacobians: bool, fine, asked):
     stations in contact and the index of each asked one among them
     (:func:`softarm.statics.solver._contact_stations`). A ConvergenceError of any case's
     solve (the free arm's path, a held iterate) is raised: the caller then tries the
-    cases one by one."""
+    cases one by one. ``last``: a chained Solver's last answer held with friction
+    (Solver._friction), from which a single case with the same Contact goes on."""
     contact = next(load for load in loads if load.kind == "contact")
     obstacles = contact.obstacles
     if jacobians and any(load.kind == "tendon" for load in loads):
@@ -179,6 +180,9 @@ def solve_tip_contact(solver, loads, shape, jacobians: bool, fine, asked):
     free = tuple(load for load in loads if load.kind != "contact")
     depth = solver.tol * solver.length
     coarse = solver._with_stations(np.linspace(0.0, solver.length, COARSE), stability=False)
+    if contact.friction > 0.0 and last is not None and last[0] == _key(contact):
+        return _with_friction(solver, coarse, loads, free, contact, last[1], shape, depth,
+                              jacobians, fine, asked, last=last)
     radii = contact.station_radii(solver.arm, coarse.s)
     # the free arm at the full load (an arm that lies on an obstacle is left at once), then
     # on its way there
@@ -199,9 +203,14 @@ def solve_tip_contact(solver, loads, shape, jacobians: bool, fine, asked):
             held &= touches | np.all(on_the_way >= -depth, axis=(0, -1))
     if not held.any():
         return None
-    if contact.friction > 0.0:
-        return _with_friction(solver, coarse, loads, free, contact, which, held, depth,
-                              [*factors, 1.0], [*path, eq.positions], jacobians, fine, asked)
+    if contact.friction > 0.0:  # (a single case: Solver._held_at_tip)
+        case = (0,) * len(shape)
+        obstacle = obstacles[which[case]]
+        bracket = [(t, obstacle.distance(positions[case][-1])[0] - radii[-1])
+                   for t, positions in zip([*factors, 1.0], [*path, eq.positions],
+                                           strict=True)]
+        return _with_friction(solver, coarse, loads, free, contact, int(which[case]), shape,
+                              depth, jacobians, fine, asked, bracket=bracket)
     lam, normal, held = _normal_reaction(coarse, free, obstacles, radii, which, held, depth,
                                          factors, curved, eq)
     held &= lam >= 0.0
@@ -251,21 +260,30 @@ def _answer(final, solver, asked, loads, point, force, changes):
         loads=loads, method=METHOD, contact_resultant=wrench, **changes)
 
 
-def _with_friction(solver, coarse, loads, free, contact, which, held, depth, factors, path,
-                   jacobians, fine, asked):
-    """solve_tip_contact's answer with Coulomb friction (tip_friction.py), for a single
-    case (batch shape () or (1,): a batch is held case by case, Solver._held_at_tip)."""
-    shape = held.shape
+def _key(contact) -> str:
+    """What a chained solve with friction needs unchanged: the obstacles, μ, the radius."""
+    return repr(([o.to_case() for o in contact.obstacles], contact.friction, contact.radius))
+
+
+def _with_friction(solver, coarse, loads, free, contact, which, shape, depth, jacobians,
+                   fine, asked, *, bracket=None, last=None):
+    """solve_tip_contact's answer with Coulomb friction (tip_friction.py) for a single
+    case (batch shape () or (1,): a batch is held case by case, Solver._held_at_tip), its
+    tip on the obstacle ``which``: along the loads' path from the unloaded arm (the free
+    arm's tip's gaps ``bracket`` on it), or from a chained Solver's ``last`` answer. Sets
+    ``solver._friction_found``: the answer a chained solve goes on from."""
     case = (0,) * len(shape)
-    obstacle = contact.obstacles[which[case]]
+    obstacle = contact.obstacles[which]
     radius = contact.station_radii(solver.arm, np.array([solver.length]))[-1]
-    bracket = [(t, obstacle.distance(positions[case][-1])[0] - radius)
-               for t, positions in zip(factors, path, strict=True)]
     one = tuple(load.part(shape, case) for load in free)
     fine_solver = solver._with_stations(fine, stability=solver.stability)
     try:
-        found = with_friction(coarse, fine_solver, one, obstacle, contact.friction, radius,
-                              depth, GAP * depth, bracket, jacobians)
+        if last is None:
+            found = with_friction(coarse, fine_solver, one, obstacle, contact.friction,
+                                  radius, depth, GAP * depth, bracket, jacobians)
+        else:
+            found = follow_on(coarse, fine_solver, last[2:], one, obstacle, contact.friction,
+                              radius, depth, GAP * depth, jacobians)
     except ConvergenceError as error:
         warnings.warn(f"Contact.friction: the tip's path with friction did not solve "
                       f"({error}); solved frictionless, with the penalty", stacklevel=5)
@@ -288,6 +306,7 @@ def _with_friction(solver, coarse, loads, free, contact, which, held, depth, fac
     answer = _answer(final, solver, asked, loads if not shape else
                      tuple(load.part(shape, case) for load in loads), tip + found.arm,
                      found.force, changes)
+    solver._friction_found = (_key(contact), which, one, found)
     return (_batched(answer, shape) if shape else answer), np.ones(shape, dtype=bool)
 
 

@@ -57,7 +57,7 @@ import numpy as np
 from ..errors import ConvergenceError
 from ..loads import TipLoad
 
-__all__ = ["FRICTION_STEPS", "FrictionalTip", "held_index", "with_friction"]
+__all__ = ["FRICTION_STEPS", "FrictionalTip", "follow_on", "held_index", "with_friction"]
 
 #: The path's steps after the first touch: doubled from the first until two answers agree.
 FRICTION_STEPS = (2, 4, 8, 16, 32, 64, 128)
@@ -84,6 +84,7 @@ class FrictionalTip(NamedTuple):
     arm: np.ndarray  # (3,): where it acts, from the tip's centre, spatial, m
     sliding: bool  # whether the tip slid over the path's last step
     final: object  # the Equilibrium on the solver's stations (unbatched)
+    state: object  # the path's _State there (on the answer's grid): a chain goes on from it
 
 
 @dataclass(frozen=True)
@@ -120,10 +121,7 @@ def with_friction(coarse, fine, free, obstacle, mu, radius, depth, gap_tol, brac
     tip was checked and its gaps there, (t, gap) pairs in increasing t. ConvergenceError
     where a step or the answer does not solve or the steps do not converge."""
     if jacobians:
-        raise ValueError("solve(..., jacobians=True) is not available with "
-                         "Contact.friction > 0 where a free tip touches an obstacle (its "
-                         "Jacobians with friction are not built: docs/contact.md, "
-                         "\"Friction\"); give jacobians=False or friction=0")
+        raise ValueError(_NO_JACOBIANS)
     start = _first_touch(coarse, free, obstacle, radius, gap_tol, bracket)
     if start is None:
         return None
@@ -139,21 +137,52 @@ def with_friction(coarse, fine, free, obstacle, mu, radius, depth, gap_tol, brac
             raise ConvergenceError("the path with friction needs single shooting, and this "
                                    "arm is solved by multiple shooting", float("nan"))
         grids.append(last[1])
-    shots = _Shots(coarse.shooter(free), obstacle, radius, mu, gap_tol)
+    shooter = coarse.shooter(free)
+    shots = _Shots(lambda x, t, steps: shooter(x, load_factor=t, steps=steps), obstacle,
+                   radius, mu, gap_tol)
     x, steps = last
     if grids[0] > steps:
         x, steps = shots.solve(_Grid(grids[0]), start, None, "free", x, None).x, grids[0]
-    touched = shots.state(x, steps, start, np.zeros(3), touching=True)
+    return _on_grids(shots, fine, free, shots.state(x, steps, start, np.zeros(3), True),
+                     start, depth)
+
+
+def follow_on(coarse, fine, last, free, obstacle, mu, radius, depth, gap_tol,
+              jacobians) -> FrictionalTip:
+    """The one case ``free`` (unbatched loads less the Contact) reached from a chained
+    Solver's last answer ``last`` (its loads, the FrictionalTip) along the straight way
+    between their loads, the tip on ``obstacle`` with Coulomb's ``mu`` (the quasi-static
+    path of a chain of solves: the app's slider, a quasi-static sweep). The rest as
+    :func:`with_friction`."""
+    if jacobians:
+        raise ValueError(_NO_JACOBIANS)
+    before, found = last
+    shooters = {}
+
+    def shoot(x, t, steps):  # (the loads on the way: before's (1 - t) and free's t)
+        if t not in shooters:
+            shooters[t] = coarse.shooter((*(load.scaled(1.0 - t) for load in before),
+                                          *(load.scaled(t) for load in free)))
+        return shooters[t](x, steps=steps)
+
+    shots = _Shots(shoot, obstacle, radius, mu, gap_tol)
+    return _on_grids(shots, fine, free, found.state, 0.0, depth)
+
+
+def _on_grids(shots, fine, free, start_state, start, depth) -> FrictionalTip:
+    """The path from ``start_state`` at the load factor ``start`` to the full load, and its
+    answer on ``fine``'s stations; the path again on the answer's grid where that solve
+    needed a finer one than the path's (a path on a coarser grid is off by its RK4 error)."""
     counts = FRICTION_STEPS
     for _ in range(GRIDS):
-        state, count = _followed(shots, touched, start, depth, counts)
+        state, count = _followed(shots, start_state, start, depth, counts)
         found, grid = _finished(shots, fine, free, state)
-        if grid <= touched.steps:
+        if grid <= start_state.steps:
             return found
-        # the answer's solve needed a finer grid than the path's (a path on the first
-        # touch's grid is off by its RK4 error): the path again on that grid
-        x = shots.solve(_Grid(grid), start, None, "free", touched.x, None).x
-        touched = shots.state(x, grid, start, np.zeros(3), touching=True)
+        mode = "stick" if start_state.touching else "free"
+        x = shots.solve(replace(start_state, steps=grid), start, start_state, mode,
+                        start_state.x, start_state.force).x
+        start_state = replace(start_state, x=x, steps=grid)
         counts = tuple(c for c in FRICTION_STEPS if c >= count // 2)
     return found
 
@@ -188,15 +217,22 @@ def _finished(shots, fine, free, state) -> tuple:
         final = fine._solve_near((*free, tip), state.x, 2 * state.steps,
                                  jacobians=fine.stability)
         x, steps = fine.last_solution()
-        p = final.poses[-1, :3, 3]
+        p, R = final.poses[-1, :3, 3], final.poses[-1, :3, :3]
         if not state.touching or abs(shots.gap(p)) <= shots.gap_tol:
-            return FrictionalTip(state.force, arm, state.sliding, final), steps
+            state = replace(state, x=x, steps=steps, p=p, R=R,
+                            normal=shots.obstacle.distance(p)[1], rate=None)
+            return FrictionalTip(state.force, arm, state.sliding, final, state), steps
         state = replace(shots.solve(replace(state, x=x, steps=steps), 1.0, state,
                                     "slide" if state.sliding else "stick", x, state.force,
                                     onward=False), sliding=state.sliding)
         arm = -shots.radius * state.normal
     raise ConvergenceError("the held tip's gap on the solver's stations did not settle",
                            float(shots.gap(p)))
+
+
+_NO_JACOBIANS = ("solve(..., jacobians=True) is not available with Contact.friction > 0 "
+                 "where a free tip touches an obstacle (its Jacobians with friction are not "
+                 "built: docs/contact.md, \"Friction\"); give jacobians=False or friction=0")
 
 
 class _Grid(NamedTuple):
@@ -329,7 +365,8 @@ def _tangents(n):
 
 class _Shots:
     """Newton's method on the held arm's base reaction x and the contact's unknowns
-    (module docstring), through the free loads' shooter. The unknowns after x, per mode:
+    (module docstring), through ``shoot`` (x, the load factor t, the grid) -> the free
+    loads' shooting at t (Solver.shooter's). The unknowns after x, per mode:
 
     - "free": none (the free arm);
     - "stick": the force f (3), the contact conditions the gap and the slide Δw (m);
@@ -339,8 +376,8 @@ class _Shots:
       where ŝ = Δw/|Δw| is not.
     """
 
-    def __init__(self, shooter, obstacle, radius, mu, gap_tol):
-        self.shooter, self.obstacle = shooter, obstacle
+    def __init__(self, shoot, obstacle, radius, mu, gap_tol):
+        self.shoot, self.obstacle = shoot, obstacle
         self.radius, self.mu, self.gap_tol = radius, mu, gap_tol
         # (:meth:`solve`'s: the slide's rate's ``history``, the tangent plane's basis)
         self.history = self.basis = None
@@ -349,7 +386,7 @@ class _Shots:
         return float(self.obstacle.distance(p)[0]) - self.radius
 
     def state(self, x, steps, t, force, touching) -> _State:
-        pose = self.shooter(x, load_factor=t, steps=("solution", steps)).tip_pose
+        pose = self.shoot(x, t, ("solution", steps)).tip_pose
         p = pose[:3, 3]
         return _State(x, steps, p, pose[:3, :3], self.obstacle.distance(p)[1], force,
                       touching)
@@ -402,7 +439,7 @@ class _Shots:
 
     def _residual(self, base, t, before, mode, z):
         """(the residual, the shooting's result, the merit in m)."""
-        shot = self.shooter(z[:6], load_factor=t, steps=("solution", base.steps))
+        shot = self.shoot(z[:6], t, ("solution", base.steps))
         p, R = shot.tip_pose[:3, 3], shot.tip_pose[:3, :3]
         e = self._parts(before, mode, z[6:], p, R)
         e[:6] += shot.residual
