@@ -107,16 +107,16 @@ def test_the_stuck_tip_converges_as_tol_shrinks_with_no_contact_distance(arm, st
 def test_a_slide_across_the_bending_plane_converges_as_the_paths_steps_are_refined(
         arm, monkeypatch):
     """A tip force across the bending plane turns the slide's direction on the way: the
-    answer at the path's own step count against the path in 64 steps and more."""
+    answer at the path's own step count (32, BDF2's way) against the path in 128 steps."""
     loads = [sa.Gravity(), sa.TipLoad(force=(0.0, 0.05, 0.0)), sa.Contact(FLOOR,
                                                                            friction=0.3)]
     eq = sa.solve(arm, loads, s=101)
     assert eq.method == "numeric.tip_contact"
-    assert eq.contact_wrench[1] != 0.0  # (the friction holds the tip against the pull)
+    assert -0.05 < eq.contact_wrench[1] < 0.0  # (the friction holds the tip against the pull)
     assert _lean(eq.contact_wrench) == pytest.approx(0.3, rel=1e-9)
-    monkeypatch.setattr(tip_friction, "FRICTION_STEPS", (64, 128, 256))
+    monkeypatch.setattr(tip_friction, "FRICTION_STEPS", (64, 128))
     refined = sa.solve(arm, loads, s=101)
-    assert np.abs(eq.positions - refined.positions).max() < 2e-8 * L
+    assert np.abs(eq.positions - refined.positions).max() < 2e-8 * L  # (1.1e-9 L)
 
 
 def test_a_chained_solver_follows_the_path_of_its_solves(arm, stuck):
