@@ -80,6 +80,31 @@ def test_a_tip_held_on_a_pin_matches_the_reissner_rod_with_its_reaction():
     assert eq.stability.stable
 
 
+def test_a_reaction_past_the_free_arms_buckling_follows_the_contacts_path():
+    """A tip pressed by 2 N onto a plane tilted 50° (rising ahead of it): the plane pushes
+    it back towards the clamp with 2.4 N, past the free arm's buckling load π²/4 EI/L² =
+    1.55 N. The free arm under that dead reaction, solved from the unloaded arm, ends on
+    another branch whose tip is on the plane too (0.77 L away: it was returned, stable);
+    the answer is the contact path's, as the Reissner rod's continuation finds it, with
+    the out-of-plane direction in which the compressed arm, its tip free to slide along y,
+    buckles (Morse index 1)."""
+    arm = sa.Arm(L, sa.Circle(RADIUS), sa.Material(youngs_modulus=2e7, poisson_ratio=0.5,
+                                                    density=1000.0))
+    rig = arm.rigidities
+    tilt = np.radians(50.0)
+    normal = (-np.sin(tilt), np.cos(tilt))
+    point = (L - RADIUS * normal[0], -0.01 - RADIUS * normal[1])
+    ref = tip_on_plane(L, rig.EA, rig.GAy, rig.EIy, RADIUS, 0.0, (0.0, -2.0), point, normal)
+    assert -ref.reaction @ np.array([1.0, 0.0]) > np.pi ** 2 / 4 * rig.EIy / L ** 2
+    with pytest.warns(sa.StabilityWarning, match="Morse index 1"):
+        eq = sa.solve(arm, [sa.TipLoad(force=(0.0, 0.0, -2.0)),
+                            sa.Contact(_plane(point, normal))], s=101)
+    assert eq.method == "numeric.tip_contact"
+    assert np.abs(eq.positions - ref.positions(eq.s)).max() < 1e-7 * L  # (6.8e-11 L)
+    assert eq.contact_wrench[[0, 2]] == pytest.approx(ref.reaction, rel=1e-7)
+    assert eq.stability.index == 1 and eq.stability.conservative
+
+
 @pytest.mark.parametrize(("ratio", "index"), [(0.98, 2), (1.02, 0)])
 def test_a_tip_pulled_against_a_ball_slides_off_where_the_closed_form_says(ratio, index):
     """A tip force P pulls the straight arm's tip against a ball ahead of it, whose centre

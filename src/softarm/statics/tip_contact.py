@@ -60,6 +60,7 @@ the reaction by δf = δλ n̂ + λ ∇²d δp(L); holding n̂ · δp(L) = 0 giv
 from __future__ import annotations
 
 import dataclasses
+import math
 import warnings
 
 import numpy as np
@@ -89,6 +90,9 @@ TURNS = 20
 TURNED = 1e-12
 #: The step of the curvature's differences, as a fraction of the obstacle's radius.
 CURVATURE_STEP = 1e-5
+#: The part of the free arm's buckling load beyond which a reaction pushing the tip back
+#: towards the base has its answer checked against the contact's path (solve_tip_contact).
+DOUBT = 0.25
 #: The route's name in ``Equilibrium.method``.
 METHOD = "numeric.tip_contact"
 
@@ -203,14 +207,58 @@ def solve_tip_contact(solver, loads, shape, jacobians: bool, fine, asked, last=N
             held &= touches | np.all(on_the_way >= -depth, axis=(0, -1))
     if not held.any():
         return None
-    if contact.friction > 0.0:  # (a single case: Solver._held_at_tip)
+    single = math.prod(shape) == 1
+    if contact.friction > 0.0 or single:
         case = (0,) * len(shape)
-        obstacle = obstacles[which[case]]
-        bracket = [(t, obstacle.distance(positions[case][-1])[0] - radii[-1])
+        bracket = [(t, obstacles[which[case]].distance(positions[case][-1])[0] - radii[-1])
                    for t, positions in zip([*factors, 1.0], [*path, eq.positions],
                                            strict=True)]
+    if contact.friction > 0.0:  # (a single case: Solver._held_at_tip)
         return _with_friction(solver, coarse, loads, free, contact, int(which[case]), shape,
                               depth, jacobians, fine, asked, bracket=bracket)
+    eligible = held.copy()
+    try:
+        answer = _frictionless(solver, coarse, loads, free, contact, which, held, depth,
+                               factors, curved, eq, jacobians, fine, asked)
+    except ConvergenceError:
+        if not single:
+            raise
+        answer = None
+    held = answer[1] if answer is not None else np.zeros(shape, dtype=bool)
+    doubtful = eligible & ~held
+    if answer is not None:  # (the reaction's compression against the free arm's buckling)
+        tangent = answer[0].poses[..., -1, :3, 0]
+        pushed = -np.einsum("...j,...j->...", answer[0].contact_wrench[..., :3], tangent)
+        lateral = np.linalg.eigvalsh(eq.tip_compliance[..., :3, :3])[..., -1]
+        doubtful |= held & (pushed > DOUBT * np.pi ** 2 / 12.0 * solver.length / lateral)
+    if not doubtful.any() or jacobians:
+        return answer
+    # The dead reaction's solves start from the unloaded arm: where the reaction pushes the
+    # arm back towards its base with a good part of the free arm's buckling load (π²/4
+    # EI/L² for a uniform one, estimated from its lateral tip compliance c as π²L/12c),
+    # that path may pass it and end on another branch than the contact's path from the
+    # first touch (a tip on a plane tilted 50° under 2 N, E 20 MPa: 0.77 L away, the
+    # right one having an unstable direction), or fail. Such a case is held along the
+    # contact's path (tip_friction.py with μ = 0), one case at a time: the answer where
+    # the two agree to tol·L, else the path's
+    if not single:
+        raise ConvergenceError("a reaction near the free arm's buckling: case by case", 0.0)
+    path_answer = _with_friction(solver, coarse, loads, free, contact, int(which[case]),
+                                 shape, depth, jacobians, fine, asked, bracket=bracket,
+                                 mu=0.0)
+    if path_answer is None:
+        return None if not held.any() else answer
+    if held.any() and np.abs(path_answer[0].positions - answer[0].positions).max() <= depth:
+        return answer
+    return path_answer
+
+
+def _frictionless(solver, coarse, loads, free, contact, which, held, depth, factors, curved,
+                  eq, jacobians, fine, asked):
+    """solve_tip_contact's answer without friction: Newton's method on λ over solves of the
+    free arm with the dead reaction (module docstring)."""
+    obstacles, shape = contact.obstacles, held.shape
+    radii = contact.station_radii(solver.arm, coarse.s)
     lam, normal, held = _normal_reaction(coarse, free, obstacles, radii, which, held, depth,
                                          factors, curved, eq)
     held &= lam >= 0.0
@@ -266,12 +314,15 @@ def _key(contact) -> str:
 
 
 def _with_friction(solver, coarse, loads, free, contact, which, shape, depth, jacobians,
-                   fine, asked, *, bracket=None, last=None):
+                   fine, asked, *, bracket=None, last=None, mu=None):
     """solve_tip_contact's answer with Coulomb friction (tip_friction.py) for a single
     case (batch shape () or (1,): a batch is held case by case, Solver._held_at_tip), its
     tip on the obstacle ``which``: along the loads' path from the unloaded arm (the free
     arm's tip's gaps ``bracket`` on it), or from a chained Solver's ``last`` answer. Sets
-    ``solver._friction_found``: the answer a chained solve goes on from."""
+    ``solver._friction_found``: the answer a chained solve goes on from. ``mu``: the
+    contact's μ by default; 0 for a frictionless tip held along its path (past the free
+    arm's buckling load: solve_tip_contact), a case left to the penalty where it fails."""
+    mu = contact.friction if mu is None else mu
     case = (0,) * len(shape)
     obstacle = contact.obstacles[which]
     radius = contact.station_radii(solver.arm, np.array([solver.length]))[-1]
@@ -279,12 +330,14 @@ def _with_friction(solver, coarse, loads, free, contact, which, shape, depth, ja
     fine_solver = solver._with_stations(fine, stability=solver.stability)
     try:
         if last is None:
-            found = with_friction(coarse, fine_solver, one, obstacle, contact.friction,
-                                  radius, depth, GAP * depth, bracket, jacobians)
+            found = with_friction(coarse, fine_solver, one, obstacle, mu, radius, depth,
+                                  GAP * depth, bracket, jacobians)
         else:
-            found = follow_on(coarse, fine_solver, last[2:], one, obstacle, contact.friction,
-                              radius, depth, GAP * depth, jacobians)
+            found = follow_on(coarse, fine_solver, last[2:], one, obstacle, mu, radius,
+                              depth, GAP * depth, jacobians)
     except ConvergenceError as error:
+        if not mu:
+            return None
         warnings.warn(f"Contact.friction: the tip's path with friction did not solve "
                       f"({error}); solved frictionless, with the penalty", stacklevel=5)
         return None
@@ -297,8 +350,16 @@ def _with_friction(solver, coarse, loads, free, contact, which, shape, depth, ja
     tip = final.poses[-1, :3, 3]
     changes = dict.fromkeys(("tip_compliance", "compliance", "actuation_jacobian",
                              "station_actuation_jacobian", "tendon_length_jacobian"))
-    if solver.stability:  # (friction is not conservative: the index with the friction force
-        # taken as dead; the verdict undecided where the obstacle pushes)
+    if solver.stability and not mu:  # (the free arm's index less what holding the normal
+        # takes away: module docstring, "Stability")
+        lam = float(found.force @ obstacle.distance(tip)[1])
+        bent = np.zeros((3, 3)) if obstacle.kind == "plane" else -lam * _curvature(
+            obstacle, tip, CURVATURE_STEP * obstacle.radius)
+        index = int(final.stability.index) + int(_held_index(
+            final.tip_compliance[None], obstacle.distance(tip)[1][None], bent[None])[0])
+        changes["stability"] = Stability.of(index, final.stability.conservative, ())
+    elif solver.stability:  # (friction is not conservative: the index with the friction
+        # force taken as dead; the verdict undecided where the obstacle pushes)
         index = held_index(final.stability.index, final.tip_compliance, found.arm)
         pushes = np.any(found.force != 0.0)
         changes["stability"] = Stability.of(index, bool(final.stability.conservative)
@@ -306,7 +367,8 @@ def _with_friction(solver, coarse, loads, free, contact, which, shape, depth, ja
     answer = _answer(final, solver, asked, loads if not shape else
                      tuple(load.part(shape, case) for load in loads), tip + found.arm,
                      found.force, changes)
-    solver._friction_found = (_key(contact), which, one, found)
+    if mu:
+        solver._friction_found = (_key(contact), which, one, found)
     return (_batched(answer, shape) if shape else answer), np.ones(shape, dtype=bool)
 
 

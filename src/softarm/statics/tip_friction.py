@@ -179,7 +179,7 @@ def _on_grids(shots, fine, free, start_state, start, depth) -> FrictionalTip:
         found, grid = _finished(shots, fine, free, state)
         if grid <= start_state.steps:
             return found
-        mode = "stick" if start_state.touching else "free"
+        mode = ("stick" if shots.mu else "normal") if start_state.touching else "free"
         x = shots.solve(replace(start_state, steps=grid), start, start_state, mode,
                         start_state.x, start_state.force).x
         start_state = replace(start_state, x=x, steps=grid)
@@ -213,7 +213,8 @@ def _finished(shots, fine, free, state) -> tuple:
     gap's tolerance."""
     arm = -shots.radius * state.normal if state.touching else np.zeros(3)
     for _ in range(REFINEMENTS):
-        tip = TipLoad(force=state.force, moment=np.cross(arm, state.force))
+        tip = TipLoad(force=state.force, moment=np.cross(arm, state.force) if shots.mu
+                      else np.zeros(3))  # (frictionless: along the normal, through p(L))
         final = fine._solve_near((*free, tip), state.x, 2 * state.steps,
                                  jacobians=fine.stability)
         x, steps = fine.last_solution()
@@ -223,7 +224,7 @@ def _finished(shots, fine, free, state) -> tuple:
                             normal=shots.obstacle.distance(p)[1], rate=None)
             return FrictionalTip(state.force, arm, state.sliding, final, state), steps
         state = replace(shots.solve(replace(state, x=x, steps=steps), 1.0, state,
-                                    "slide" if state.sliding else "stick", x, state.force,
+                                    _held_mode(shots, state), x, state.force,
                                     onward=False), sliding=state.sliding)
         arm = -shots.radius * state.normal
     raise ConvergenceError("the held tip's gap on the solver's stations did not settle",
@@ -233,6 +234,11 @@ def _finished(shots, fine, free, state) -> tuple:
 _NO_JACOBIANS = ("solve(..., jacobians=True) is not available with Contact.friction > 0 "
                  "where a free tip touches an obstacle (its Jacobians with friction are not "
                  "built: docs/contact.md, \"Friction\"); give jacobians=False or friction=0")
+
+
+def _held_mode(shots, state) -> str:
+    """The mode in which ``state`` is solved again (on a finer grid)."""
+    return "normal" if not shots.mu else "slide" if state.sliding else "stick"
 
 
 class _Grid(NamedTuple):
@@ -305,6 +311,15 @@ def _step(shots, state, t, size) -> _State:
             return free
         force = np.zeros(3)  # (closed within the step: touching where it began)
         state = replace(state, touching=True)
+    if not shots.mu:  # (frictionless: the normal force alone)
+        held = shots.solve(state, t, state, "normal", x, force)
+        if held.force @ held.normal >= 0.0:
+            return held
+        free = shots.solve(state, t, state, "free", held.x, np.zeros(3))
+        if shots.gap(free.p) >= -shots.gap_tol:
+            return replace(free, touching=False)
+        raise ConvergenceError("the tip pulls on the obstacle and its free arm is inside it",
+                               float(shots.gap(free.p)))
     stuck = shots.solve(state, t, state, "stick", x, force)
     normal = stuck.force @ stuck.normal
     along = stuck.force - normal * stuck.normal
@@ -369,6 +384,7 @@ class _Shots:
     loads' shooting at t (Solver.shooter's). The unknowns after x, per mode:
 
     - "free": none (the free arm);
+    - "normal": the normal force f_n (frictionless, f = f_n n̂), the condition the gap;
     - "stick": the force f (3), the contact conditions the gap and the slide Δw (m);
     - "slide": the normal force f_n, the slide's angle φ in the tangent plane of the last
       state's normal (ŝ = cos φ t̂₁ + sin φ t̂₂) and its length w, with f = f_n (n̂ - μ ŝ)
@@ -398,6 +414,8 @@ class _Shots:
             return np.zeros(0)
         if mode == "stick":
             return np.array(force, dtype=float)
+        if mode == "normal":
+            return np.array([force @ before.normal])
         n = before.normal
         along = _tangents(n).T @ (force - (force @ n) * n)
         return np.array([max(force @ n, 0.0), np.arctan2(-along[1], -along[0]), 0.0])
@@ -408,6 +426,8 @@ class _Shots:
         if mode == "free":
             return np.zeros(3), np.zeros(0)
         d, n = self.obstacle.distance(p) if near is None else near
+        if mode == "normal":
+            return unknowns[0] * n, np.array([d - self.radius])
         slide = self.slide(before, p, R, n)
         basis = self.basis
         if mode == "stick":
@@ -481,7 +501,7 @@ class _Shots:
     def solve(self, base, t, before, mode, x, force, *, onward=True,
               history=None) -> _State:
         """The state at the load factor ``t`` on ``base``'s grid, ``mode`` "stick",
-        "slide" or "free", from the guess (x, f), ``before`` the state one step back (the
+        "slide", "normal" or "free", from the guess (x, f), ``before`` the state one step back (the
         slide's start; ``onward``: a slide must go its way, w >= 0, not where a state is
         solved again on a finer grid; ``history``: (a, b Δw₀) of the slide's rate at the
         step's end, a Δw - b Δw₀, Δw₀ the last step's slide, or None for Δw): Newton's
