@@ -33,6 +33,10 @@ penalty, case by case, so that a batch's answers are its cases' alone):
   obstacle to tol·L, and λ >= 0;
 - where the solver gives verdicts, the free arm with the dead force λ n̂ is stable
   (conservative, Morse index 0);
+- where the reaction pushes the tip back towards the base with more than DOUBT of the free
+  arm's buckling load, the answer agrees with the contact's own path from the first touch
+  (tip_friction.py with μ = 0), else that path's answer is returned (the dead force's path
+  from the unloaded arm may pass the buckling load onto another branch);
 - with ``jacobians``, no tendon (their length Jacobian would need the tendons' response to
   the tip's reaction, which the solve does not return).
 
