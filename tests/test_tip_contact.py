@@ -103,6 +103,17 @@ def test_a_reaction_past_the_free_arms_buckling_follows_the_contacts_path():
     assert np.abs(eq.positions - ref.positions(eq.s)).max() < 1e-7 * L  # (6.8e-11 L)
     assert eq.contact_wrench[[0, 2]] == pytest.approx(ref.reaction, rel=1e-7)
     assert eq.stability.index == 1 and eq.stability.conservative
+    # its compliance (the normal held) against central differences of such solves
+    h, plane = 1e-3, sa.Contact(_plane(point, normal))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", sa.StabilityWarning)
+        held = sa.solve(arm, [sa.TipLoad(force=(0.0, 0.0, -2.0)), plane], s=101,
+                        jacobians=True)
+        moved = [sa.solve(arm, [sa.TipLoad(force=(sign * h, 0.0, -2.0)), plane],
+                          s=101).tip_position for sign in (1.0, -1.0)]
+    column = (moved[0] - moved[1]) / (2 * h)
+    assert held.tip_compliance[:3, 0] == pytest.approx(column, rel=1e-4,
+                                                        abs=1e-4 * np.abs(column).max())
 
 
 @pytest.mark.parametrize(("ratio", "index"), [(0.98, 2), (1.02, 0)])

@@ -11,7 +11,9 @@
 - a chained Solver follows the quasi-static path of its solves: loaded in steps it ends
   where one solve does (a slide's end does not depend on the way), and unloaded after the
   slide its tip sticks, rolling from where it slid to (the reference rolls from there);
-- a batch equals its cases one by one; Jacobians with friction are refused, saying why.
+- a stuck tip's compliance against central differences of chained solves; a batch equals
+  its cases one by one; Jacobians where they are not built (a sliding tip) are refused,
+  saying why.
 """
 
 from __future__ import annotations
@@ -161,7 +163,36 @@ def test_a_batch_with_friction_equals_its_cases_one_by_one(arm, stuck):
         assert np.array_equal(batch.contact_wrench[case], one.contact_wrench)
 
 
-def test_jacobians_with_friction_at_a_held_tip_are_refused(arm):
-    with pytest.raises(ValueError, match=r"jacobians=True\) is not available with "
-                                         r"Contact\.friction > 0"):
-        sa.solve(arm, [sa.Gravity(), sa.Contact(FLOOR, friction=0.5)], jacobians=True)
+def test_a_stuck_tips_compliance_is_the_chained_solves_finite_differences(arm, stuck):
+    """The stuck tip's compliance (the cap's point held: δp + δθ × a = 0) against central
+    differences of a chained Solver moved by ±h of extra tip force from the same answer
+    (the quasi-static response: the tip stays stuck; a solve from the unloaded arm would
+    touch elsewhere)."""
+    mu = stuck.ratios.max() / 0.9
+    contact = sa.Contact(FLOOR, friction=mu)
+    s = np.linspace(0.0, L, 51)
+    eq = sa.solve(arm, [sa.Gravity(), contact], s=s, jacobians=True)
+    assert "stuck" in _contact_line(eq)
+    solver, h = Solver(arm, s=s), 1e-2
+    for k in range(3):
+        moved = []
+        for sign in (1.0, -1.0):
+            solver.reset()
+            solver.solve([sa.Gravity(), contact])
+            moved.append(solver.solve([sa.Gravity(), sa.TipLoad(force=sign * h * np.eye(3)[k]),
+                                       contact]).tip_position)
+        column = (moved[0] - moved[1]) / (2 * h)
+        assert eq.tip_compliance[:3, k] == pytest.approx(  # (agree to 1e-8 of the largest)
+            column, rel=1e-4, abs=1e-4 * np.abs(eq.tip_compliance[:3, :3]).max())
+    # held: the cap's point in contact (offset -r n̂) does not move, to first order
+    offset = -RADIUS * np.array([0.0, 0.0, 1.0])
+    point_motion = eq.tip_compliance[:3, :] + np.cross(eq.tip_compliance[3:, :].T, offset).T
+    assert np.abs(point_motion).max() < 1e-9 * np.abs(eq.tip_compliance).max()
+
+
+def test_jacobians_with_friction_where_they_are_not_built_are_refused(arm, stuck):
+    mu = stuck.ratios.min() / 1.1  # (it slides)
+    with pytest.raises(ValueError, match=r"jacobians=True\) with Contact\.friction > 0 "
+                                         r"holds a stuck tip on a plane only: here the tip "
+                                         r"slides"):
+        sa.solve(arm, [sa.Gravity(), sa.Contact(FLOOR, friction=mu)], jacobians=True)

@@ -72,7 +72,7 @@ import numpy as np
 from ..equilibrium import Stability
 from ..errors import ConvergenceError
 from ..loads import TipLoad
-from .tip_friction import follow_on, held_index, with_friction
+from .tip_friction import follow_on, held_index, stuck_jacobians, with_friction
 
 __all__ = ["METHOD", "solve_tip_contact"]
 
@@ -183,7 +183,7 @@ def solve_tip_contact(solver, loads, shape, jacobians: bool, fine, asked, last=N
     (Solver._friction), from which a single case with the same Contact goes on."""
     contact = next(load for load in loads if load.kind == "contact")
     obstacles = contact.obstacles
-    if jacobians and any(load.kind == "tendon" for load in loads):
+    if jacobians and not contact.friction and any(load.kind == "tendon" for load in loads):
         return None  # (their length Jacobians would need their response to the reaction)
     free = tuple(load for load in loads if load.kind != "contact")
     depth = solver.tol * solver.length
@@ -235,7 +235,7 @@ def solve_tip_contact(solver, loads, shape, jacobians: bool, fine, asked, last=N
         pushed = -np.einsum("...j,...j->...", answer[0].contact_wrench[..., :3], tangent)
         lateral = np.linalg.eigvalsh(eq.tip_compliance[..., :3, :3])[..., -1]
         doubtful |= held & (pushed > DOUBT * np.pi ** 2 / 12.0 * solver.length / lateral)
-    if not doubtful.any() or jacobians:
+    if not doubtful.any():
         return answer
     # The dead reaction's solves start from the unloaded arm: where the reaction pushes the
     # arm back towards its base with a good part of the free arm's buckling load (π²/4
@@ -354,6 +354,15 @@ def _with_friction(solver, coarse, loads, free, contact, which, shape, depth, ja
     tip = final.poses[-1, :3, 3]
     changes = dict.fromkeys(("tip_compliance", "compliance", "actuation_jacobian",
                              "station_actuation_jacobian", "tendon_length_jacobian"))
+    if jacobians and mu:
+        changes.update(_frictional_jacobians(final, asked, found, obstacle, loads))
+    elif jacobians:  # (frictionless: the normal held, as _held_jacobians for a batch)
+        normal = obstacle.distance(tip)[1]
+        bent = np.zeros((3, 3)) if obstacle.kind == "plane" else -float(
+            found.force @ normal) * _curvature(obstacle, tip, CURVATURE_STEP * obstacle.radius)
+        one = _held_jacobians(_batched(final, (1,)), asked, normal[None], bent[None],
+                              np.array([True]))
+        changes.update({name: value[0] for name, value in one.items()})
     if solver.stability and not mu:  # (the free arm's index less what holding the normal
         # takes away: module docstring, "Stability")
         lam = float(found.force @ obstacle.distance(tip)[1])
@@ -374,6 +383,21 @@ def _with_friction(solver, coarse, loads, free, contact, which, shape, depth, ja
     if mu:
         solver._friction_found = (_key(contact), which, one, found)
     return (_batched(answer, shape) if shape else answer), np.ones(shape, dtype=bool)
+
+
+def _frictional_jacobians(final, asked, found, obstacle, loads) -> dict:
+    """A tip held with friction: its Jacobians while it sticks on a plane (the cap's point
+    held: tip_friction.stuck_jacobians); a ValueError where they are not built."""
+    why = ("the tip slides (a sliding contact's response is one-sided)" if found.sliding
+           else "the obstacle is curved (the contact point's turn is not built)"
+           if obstacle.kind != "plane" else "a tendon's length Jacobian would need its "
+           "response to the tip's force" if any(load.kind == "tendon" for load in loads)
+           else None)
+    if why is not None:
+        raise ValueError(f"solve(..., jacobians=True) with Contact.friction > 0 holds a "
+                         f"stuck tip on a plane only: here {why} (docs/contact.md, "
+                         f"\"Friction\"); give jacobians=False or friction=0")
+    return stuck_jacobians(final, asked, found.arm)
 
 
 def _batched(eq, shape):

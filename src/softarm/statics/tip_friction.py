@@ -57,7 +57,8 @@ import numpy as np
 from ..errors import ConvergenceError
 from ..loads import TipLoad
 
-__all__ = ["FRICTION_STEPS", "FrictionalTip", "follow_on", "held_index", "with_friction"]
+__all__ = ["FRICTION_STEPS", "FrictionalTip", "follow_on", "held_index", "stuck_jacobians",
+           "with_friction"]
 
 #: The path's steps after the first touch: doubled from the first until two answers agree.
 FRICTION_STEPS = (2, 4, 8, 16, 32, 64, 128)
@@ -120,8 +121,6 @@ def with_friction(coarse, fine, free, obstacle, mu, radius, depth, gap_tol, brac
     the gap and the slide solved to (m); ``bracket``: the load factors where the free arm's
     tip was checked and its gaps there, (t, gap) pairs in increasing t. ConvergenceError
     where a step or the answer does not solve or the steps do not converge."""
-    if jacobians:
-        raise ValueError(_NO_JACOBIANS)
     start = _first_touch(coarse, free, obstacle, radius, gap_tol, bracket)
     if start is None:
         return None
@@ -139,7 +138,7 @@ def with_friction(coarse, fine, free, obstacle, mu, radius, depth, gap_tol, brac
         grids.append(last[1])
     shooter = coarse.shooter(free)
     shots = _Shots(lambda x, t, steps: shooter(x, load_factor=t, steps=steps), obstacle,
-                   radius, mu, gap_tol)
+                   radius, mu, gap_tol, jacobians)
     x, steps = last
     if grids[0] > steps:
         x, steps = shots.solve(_Grid(grids[0]), start, None, "free", x, None).x, grids[0]
@@ -154,8 +153,6 @@ def follow_on(coarse, fine, last, free, obstacle, mu, radius, depth, gap_tol,
     between their loads, the tip on ``obstacle`` with Coulomb's ``mu`` (the quasi-static
     path of a chain of solves: the app's slider, a quasi-static sweep). The rest as
     :func:`with_friction`."""
-    if jacobians:
-        raise ValueError(_NO_JACOBIANS)
     before, found = last
     shooters = {}
 
@@ -165,7 +162,7 @@ def follow_on(coarse, fine, last, free, obstacle, mu, radius, depth, gap_tol,
                                           *(load.scaled(t) for load in free)))
         return shooters[t](x, steps=steps)
 
-    shots = _Shots(shoot, obstacle, radius, mu, gap_tol)
+    shots = _Shots(shoot, obstacle, radius, mu, gap_tol, jacobians)
     return _on_grids(shots, fine, free, found.state, 0.0, depth)
 
 
@@ -216,7 +213,7 @@ def _finished(shots, fine, free, state) -> tuple:
         tip = TipLoad(force=state.force, moment=np.cross(arm, state.force) if shots.mu
                       else np.zeros(3))  # (frictionless: along the normal, through p(L))
         final = fine._solve_near((*free, tip), state.x, 2 * state.steps,
-                                 jacobians=fine.stability)
+                                 jacobians=fine.stability or shots.jacobians)
         x, steps = fine.last_solution()
         p, R = final.poses[-1, :3, 3], final.poses[-1, :3, :3]
         if not state.touching or abs(shots.gap(p)) <= shots.gap_tol:
@@ -229,11 +226,6 @@ def _finished(shots, fine, free, state) -> tuple:
         arm = -shots.radius * state.normal
     raise ConvergenceError("the held tip's gap on the solver's stations did not settle",
                            float(shots.gap(p)))
-
-
-_NO_JACOBIANS = ("solve(..., jacobians=True) is not available with Contact.friction > 0 "
-                 "where a free tip touches an obstacle (its Jacobians with friction are not "
-                 "built: docs/contact.md, \"Friction\"); give jacobians=False or friction=0")
 
 
 def _held_mode(shots, state) -> str:
@@ -392,9 +384,10 @@ class _Shots:
       where ŝ = Δw/|Δw| is not.
     """
 
-    def __init__(self, shoot, obstacle, radius, mu, gap_tol):
+    def __init__(self, shoot, obstacle, radius, mu, gap_tol, jacobians):
         self.shoot, self.obstacle = shoot, obstacle
         self.radius, self.mu, self.gap_tol = radius, mu, gap_tol
+        self.jacobians = jacobians  # (the answer's solve: with its compliance)
         # (:meth:`solve`'s: the slide's rate's ``history``, the tangent plane's basis)
         self.history = self.basis = None
 
@@ -536,6 +529,30 @@ class _Shots:
                 break
         raise ConvergenceError(f"the tip's state ({mode}) did not converge at load factor "
                                f"{t:.6g}", best)
+
+
+def stuck_jacobians(final, asked, arm) -> dict:
+    """The Jacobians of ``final`` (the free arm with the tip's force as a dead load, its
+    compliance computed) with the tip stuck: the cap rolls without sliding, so to first
+    order its material point at ``arm`` from the centre stays, Gᵀ δx = δp + δθ × arm = 0
+    (G = [I; arm~], δx the tip's (δp; δθ)), and the force changes by δf at it: a column W
+    (a tip wrench, an input) moves the tip by C_W W + C G δf with
+    δf = -(Gᵀ C G)⁻¹ Gᵀ C_W W, every station by its own columns likewise. On a plane the
+    point's offset -r n̂ does not turn; the asked stations ``asked``."""
+    G = np.vstack([np.eye(3), _skew(arm)])
+    C, stations = final.tip_compliance, final.compliance[..., asked, :, :]
+    solve = np.linalg.inv(G.T @ C @ G) @ G.T
+
+    def held(columns, station_columns):
+        change = -solve @ columns  # δf per column (3, n)
+        return columns + C @ G @ change, station_columns + stations @ G @ change
+
+    out = dict(zip(("tip_compliance", "compliance"), held(C, stations), strict=True))
+    if final.actuation_jacobian is not None:
+        out.update(zip(("actuation_jacobian", "station_actuation_jacobian"),
+                       held(final.actuation_jacobian,
+                            final.station_actuation_jacobian[..., asked, :, :]), strict=True))
+    return out
 
 
 def held_index(free_index, compliance, arm) -> np.ndarray:
