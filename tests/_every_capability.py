@@ -113,6 +113,13 @@ CASES = {
                                                        sa.DistributedForce([0.0, 1e-3, 0.0])]),
     "critical load of an actuated arm": lambda: sa.critical_load(
         arm(), [sa.Gravity(), sa.Tendon(0.1, Straight(0.0, 0.006))], max_factor=2.0),
+    # a free tip held with friction (single shooting from the base, tip_friction.py), stuck
+    # with its Jacobians, then sliding along a chained Solver's path
+    "a tip held with friction": lambda: (
+        sa.solve(arm(), [sa.Gravity(), sa.Contact(sa.Plane((0.0, 0.0, -0.03), (0.0, 0.0, 1.0)),
+                                                  friction=5.0)], jacobians=True),
+        [Solver(arm()).solve([sa.Gravity().scaled(g), sa.Contact(sa.Plane(
+            (0.0, 0.0, -0.03), (0.0, 0.0, 1.0)), friction=0.1)]) for g in (0.8, 1.0)]),
     # statics, multiple shooting: passive, actuated, touching; verdict and Jacobians or not
     **{f"multiple shooting, {who}{', verdict' * verdict}{', Jacobians' * jacobians}":
        (lambda make=make, verdict=verdict, jacobians=jacobians:

@@ -218,7 +218,8 @@ def _finished(shots, fine, free, state) -> tuple:
         p, R = final.poses[-1, :3, 3], final.poses[-1, :3, :3]
         if not state.touching or abs(shots.gap(p)) <= shots.gap_tol:
             state = replace(state, x=x, steps=steps, p=p, R=R,
-                            normal=shots.obstacle.distance(p)[1], rate=None)
+                            normal=shots.obstacle.distance(p)[1], rate=None, size=None,
+                            slid=None)  # (a chain's next path starts afresh from here)
             return FrictionalTip(state.force, arm, state.sliding, final, state), steps
         state = replace(shots.solve(replace(state, x=x, steps=steps), 1.0, state,
                                     _held_mode(shots, state), x, state.force,
