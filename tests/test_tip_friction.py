@@ -121,6 +121,7 @@ def test_a_slide_across_the_bending_plane_converges_as_the_paths_steps_are_refin
     assert np.abs(eq.positions - refined.positions).max() < 2e-8 * L  # (1.1e-9 L)
 
 
+@pytest.mark.slow
 def test_a_chained_solver_follows_the_path_of_its_solves(arm, stuck):
     mu = stuck.ratios.min() / 1.1
     rig, weight = arm.rigidities, arm.linear_density * 9.81
