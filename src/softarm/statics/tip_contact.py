@@ -354,22 +354,20 @@ def _with_friction(solver, coarse, loads, free, contact, which, shape, depth, ja
     tip = final.poses[-1, :3, 3]
     changes = dict.fromkeys(("tip_compliance", "compliance", "actuation_jacobian",
                              "station_actuation_jacobian", "tendon_length_jacobian"))
-    if jacobians and mu:
-        changes.update(_frictional_jacobians(final, asked, found, obstacle, loads))
-    elif jacobians:  # (frictionless: the normal held, as _held_jacobians for a batch)
+    if not mu:  # (the normal held: the reaction's turn with the tip, -λ ∇²d, as above)
         normal = obstacle.distance(tip)[1]
         bent = np.zeros((3, 3)) if obstacle.kind == "plane" else -float(
             found.force @ normal) * _curvature(obstacle, tip, CURVATURE_STEP * obstacle.radius)
-        one = _held_jacobians(_batched(final, (1,)), asked, normal[None], bent[None],
-                              np.array([True]))
-        changes.update({name: value[0] for name, value in one.items()})
+    if jacobians and mu:
+        changes.update(_frictional_jacobians(final, asked, found, obstacle, loads))
+    elif jacobians:  # (as _held_jacobians for a batch of one)
+        columns = _held_jacobians(_batched(final, (1,)), asked, normal[None], bent[None],
+                                  np.array([True]))
+        changes.update({name: value[0] for name, value in columns.items()})
     if solver.stability and not mu:  # (the free arm's index less what holding the normal
         # takes away: module docstring, "Stability")
-        lam = float(found.force @ obstacle.distance(tip)[1])
-        bent = np.zeros((3, 3)) if obstacle.kind == "plane" else -lam * _curvature(
-            obstacle, tip, CURVATURE_STEP * obstacle.radius)
         index = int(final.stability.index) + int(_held_index(
-            final.tip_compliance[None], obstacle.distance(tip)[1][None], bent[None])[0])
+            final.tip_compliance[None], normal[None], bent[None])[0])
         changes["stability"] = Stability.of(index, final.stability.conservative, ())
     elif solver.stability:  # (friction is not conservative: the index with the friction
         # force taken as dead; the verdict undecided where the obstacle pushes)
