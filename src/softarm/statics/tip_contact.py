@@ -72,7 +72,7 @@ import numpy as np
 from ..equilibrium import Stability
 from ..errors import ConvergenceError
 from ..loads import TipLoad
-from .tip_friction import follow_on, held_index, stuck_jacobians, with_friction
+from .tip_friction import follow_on, held_columns, held_index, stuck_jacobians, with_friction
 
 __all__ = ["METHOD", "solve_tip_contact"]
 
@@ -536,9 +536,4 @@ def _held_jacobians(final, asked, normal, bent, pressed) -> dict:
         return (columns + tip[..., :, :3] @ reaction,
                 station_columns + stations[..., :, :3] @ reaction[..., None, :, :])
 
-    out = dict(zip(("tip_compliance", "compliance"), held(tip, stations), strict=True))
-    if final.actuation_jacobian is not None:
-        out.update(zip(("actuation_jacobian", "station_actuation_jacobian"),
-                       held(final.actuation_jacobian,
-                            final.station_actuation_jacobian[..., asked, :, :]), strict=True))
-    return out
+    return held_columns(final, asked, held)

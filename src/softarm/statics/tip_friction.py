@@ -57,8 +57,8 @@ import numpy as np
 from ..errors import ConvergenceError
 from ..loads import TipLoad
 
-__all__ = ["FRICTION_STEPS", "FrictionalTip", "follow_on", "held_index", "stuck_jacobians",
-           "with_friction"]
+__all__ = ["FRICTION_STEPS", "FrictionalTip", "follow_on", "held_columns", "held_index",
+           "stuck_jacobians", "with_friction"]
 
 #: The path's steps after the first touch: doubled from the first until two answers agree.
 FRICTION_STEPS = (2, 4, 8, 16, 32, 64, 128)
@@ -548,7 +548,16 @@ def stuck_jacobians(final, asked, arm) -> dict:
         change = -solve @ columns  # δf per column (3, n)
         return columns + C @ G @ change, station_columns + stations @ G @ change
 
-    out = dict(zip(("tip_compliance", "compliance"), held(C, stations), strict=True))
+    return held_columns(final, asked, held)
+
+
+def held_columns(final, asked, held) -> dict:
+    """The Jacobian fields of ``final`` (the free arm with the tip's force as a dead load)
+    with the tip held: ``held`` (the tip's columns, the asked stations' columns) -> the
+    same held, applied to the compliances and the actuation Jacobians."""
+    out = dict(zip(("tip_compliance", "compliance"),
+                   held(final.tip_compliance, final.compliance[..., asked, :, :]),
+                   strict=True))
     if final.actuation_jacobian is not None:
         out.update(zip(("actuation_jacobian", "station_actuation_jacobian"),
                        held(final.actuation_jacobian,
