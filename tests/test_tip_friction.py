@@ -18,14 +18,22 @@
 
 from __future__ import annotations
 
+import sys
+
 import numpy as np
 import pytest
 from _tip_reference import tip_sliding_on_plane, tip_stuck_from, tip_stuck_on_plane
 
 import softarm as sa
+from softarm.case import parse_case, solve_case
 from softarm.cli import _contact_line
 from softarm.contact import balance
 from softarm.statics import Solver, tip_friction
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover
+    import tomli as tomllib
 
 L = 0.5
 RADIUS = 0.01
@@ -151,6 +159,51 @@ def test_a_chained_solver_follows_the_path_of_its_solves(arm, stuck):
     solver.reset()
     again = solver.solve([sa.Gravity().scaled(0.7), contact])
     assert np.abs(again.positions - fresh.positions).max() < 1e-8 * L
+
+
+SWEEP = """
+name = "floor_sweep"
+[arm]
+length = 0.5
+section = { kind = "circle", radius = 0.01 }
+material = { E = 2.0e7, nu = 0.5, density = 1000.0 }
+[[load]]
+kind = "gravity"
+[[load]]
+kind = "tip"
+force = [0.02, 0.0, -0.1]
+[[obstacle]]
+kind = "plane"
+point = [0.0, 0.0, -0.04]
+normal = [0.0, 0.0, 1.0]
+[contact]
+friction = %s
+[solve]
+stations = 21
+[sweep]
+load = 2
+field = "force"
+component = "magnitude"
+start = 0.0
+stop = 0.2
+steps = 3
+"""
+
+
+@pytest.mark.parametrize("mu", [0.0, 1.0])
+def test_a_case_files_sweep_over_a_held_tip_is_its_steps_solved_one_by_one(arm, mu):
+    """A [sweep] whose every step is a tip held exactly (it failed when no step had a
+    penalty: the sweep's contact law had no stiffness to report)."""
+    case = parse_case(tomllib.loads(SWEEP % mu), "sweep.toml")
+    swept = solve_case(case)
+    assert swept.method == "numeric.tip_contact"
+    assert swept.loads[-1].stiffness is None  # (no penalty: "hard at a free tip")
+    for k in range(3):  # (each step's own loads, as the case file gives them)
+        one = sa.solve(arm, [load.take(k) if load.batch_shape else load
+                             for load in case.batched_loads], s=21)
+        assert np.array_equal(swept.positions[k], one.positions)
+        assert np.array_equal(swept.contact_wrench[k], one.contact_wrench)
+    assert np.linalg.norm(swept.contact_wrench[-1, :3]) > 0.1  # (the tip pressed, held)
 
 
 def test_a_batch_with_friction_equals_its_cases_one_by_one(arm, stuck):

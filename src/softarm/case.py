@@ -665,10 +665,13 @@ def _with_contact(loads: tuple, parts: list[Equilibrium]) -> tuple:
     case's penalty stiffness (the solver's choice per case, softarm.Contact), one array
     over the sweep's steps, or one number where they are all the same."""
     laws = [_contact_of(part.loads) for part in parts]
-    if laws[0] is None:
-        return loads
-    stiffness = np.concatenate([np.broadcast_to(law.stiffness, part.batch_shape).ravel()
-                                for law, part in zip(laws, parts, strict=True)])
+    if laws[0] is None or all(law.stiffness is None for law in laws):
+        return loads  # (no penalty: every case a tip held exactly, statics/tip_contact.py)
+    # (a part whose cases are all held at the tip has no stiffness: none of them, as a
+    # part partly held says with zeros, Solver._held_at_tip)
+    stiffness = np.concatenate([np.broadcast_to(
+        0.0 if law.stiffness is None else law.stiffness, part.batch_shape).ravel()
+        for law, part in zip(laws, parts, strict=True)])
     law = laws[0].replace(stiffness=float(stiffness[0]) if np.all(stiffness == stiffness[0])
                           else stiffness)
     return tuple(law if isinstance(load, Contact) else load for load in loads)
@@ -724,6 +727,10 @@ def _concatenate(parts: list[Equilibrium], loads: tuple) -> Equilibrium:
             np.concatenate([np.atleast_1d(p.stability.index) for p in parts]),
             np.concatenate([np.broadcast_to(p.stability.conservative, p.batch_shape)
                             for p in parts]), (sum(p.batch_shape[0] for p in parts),))
+    # the contact wrench each part took from its own balance (a tip held exactly has no
+    # contact force per length to integrate), and the base wrench, where every part has them
+    kept = {name: fields(name) for name in ("contact_resultant", "base_wrench")
+            if all(getattr(p, name) is not None for p in parts)}
     return Equilibrium(
         s=first.s,
         poses=fields("poses"),
@@ -731,7 +738,8 @@ def _concatenate(parts: list[Equilibrium], loads: tuple) -> Equilibrium:
         stresses=fields("stresses"),
         arm=first.arm, loads=loads, method="+".join(methods),
         exact=all(bool(p.exact) for p in parts),
-        residual=cat("residual"), error_estimate=cat("error_estimate"), stability=stability)
+        residual=cat("residual"), error_estimate=cat("error_estimate"), stability=stability,
+        **kept)
 
 
 # --------------------------------------------------------------------------------------------
