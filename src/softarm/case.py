@@ -685,8 +685,10 @@ def _batched(eq: Equilibrium) -> Equilibrium:
     if verdict is not None:
         verdict = Stability.of(np.array([verdict.index]), np.array([verdict.conservative]),
                                  (1,))
+    resultant = None if eq.contact_resultant is None else eq.contact_resultant[None]
     return replace(eq, poses=eq.poses[None], strains=eq.strains[None],
                    stresses=eq.stresses[None], residual=np.array([eq.residual]),
+                   contact_resultant=resultant,
                    error_estimate=np.array([eq.error_estimate]), stability=verdict,
                    tip_compliance=None, compliance=None, base_wrench=None,
                    tendon_tensions=None, tendon_lengths=None, tendon_length_changes=None,
