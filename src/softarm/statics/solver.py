@@ -1665,19 +1665,20 @@ class Solver:
             return None  # (a penalty asked for)
         _check_outside(self, contact)
         fine, asked = _contact_stations(self._s_kernel, self.length, np.array([self.length]))
-        try:
-            if contact.friction > 0.0 and math.prod(shape) > 1:
-                # (friction: each case's own path, tip_friction.py)
-                raise ConvergenceError("friction: case by case", 0.0)
-            found = solve_tip_contact(self, loads, shape, jacobians, fine, asked,
-                                      self._friction if chained and not shape else None)
-            if found is not None:
-                held = np.flatnonzero(found[1].reshape(-1))
-                found = ([(held, found[0], held)], found[1])
-        except ConvergenceError:  # (some case's free arm, or a held iterate, failed)
-            if not shape:
-                return None  # (the penalty follows the path, or says where it fails)
+        if contact.friction > 0.0 and math.prod(shape) > 1:
+            # (friction: each case's own path, tip_friction.py)
             found = self._held_case_by_case(loads, shape, jacobians, fine, asked)
+        else:
+            try:
+                found = solve_tip_contact(self, loads, shape, jacobians, fine, asked,
+                                          self._friction if chained and not shape else None)
+                if found is not None:
+                    held = np.flatnonzero(found[1].reshape(-1))
+                    found = ([(held, found[0], held)], found[1])
+            except ConvergenceError:  # (some case's free arm, or a held iterate, failed)
+                if not shape:
+                    return None  # (the penalty follows the path, or says where it fails)
+                found = self._held_case_by_case(loads, shape, jacobians, fine, asked)
         if found is None:
             return None
         parts, which = found

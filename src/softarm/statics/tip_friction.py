@@ -540,7 +540,7 @@ def stuck_jacobians(final, asked, arm) -> dict:
     (a tip wrench, an input) moves the tip by C_W W + C G δf with
     δf = -(Gᵀ C G)⁻¹ Gᵀ C_W W, every station by its own columns likewise. On a plane the
     point's offset -r n̂ does not turn; the asked stations ``asked``."""
-    G = np.vstack([np.eye(3), _skew(arm)])
+    G = _at_point(arm)
     C, stations = final.tip_compliance, final.compliance[..., asked, :, :]
     solve = np.linalg.inv(G.T @ C @ G) @ G.T
 
@@ -565,10 +565,10 @@ def held_columns(final, asked, held) -> dict:
     return out
 
 
-def held_index(free_index, compliance, arm) -> np.ndarray:
+def held_index(free_index, compliance, arm) -> int:
     """The Morse index of the arm with its tip held at the contact point, from the free
     arm's ``free_index`` under the tip's force and couple as dead loads and its tip
-    compliance C (*shape, 6, 6): holding the point (G = [I; arm~], the contact point's
+    compliance C (6, 6): holding the point (G = [I; arm~], the contact point's
     three directions) takes away as many unstable directions as Gᵀ C G has negative
     eigenvalues (the inertia of the bordered matrix, tip_contact.py's "Stability", with
     the constraint's stiffness K → ∞; the force's turn with the tip, O(r |f|), left out).
@@ -577,9 +577,13 @@ def held_index(free_index, compliance, arm) -> np.ndarray:
     a slide: the tip at rest on the cone's edge is held against every motion but the
     slide's going on, which friction does not resist beyond μ N. An index above 0 is an
     unstable direction with the tip held where it is, the most friction can do."""
-    G = np.concatenate([np.broadcast_to(np.eye(3), (*arm.shape[:-1], 3, 3)),
-                        -np.cross(arm[..., None, :], np.eye(3))], axis=-2)
-    reduced = np.swapaxes(G, -1, -2) @ compliance @ G
-    negative = np.sum(np.linalg.eigvalsh(0.5 * (reduced + np.swapaxes(reduced, -1, -2)))
-                      < 0.0, axis=-1)
-    return np.maximum(np.asarray(free_index) - negative, 0)
+    G = _at_point(arm)
+    reduced = G.T @ compliance @ G
+    negative = np.sum(np.linalg.eigvalsh(0.5 * (reduced + reduced.T)) < 0.0)
+    return max(int(free_index) - int(negative), 0)
+
+
+def _at_point(arm) -> np.ndarray:
+    """(6, 3) G: the tip wrench (f; arm × f) of a force f at ``arm`` (spatial, m) from the
+    tip's centre; Gᵀ (δp; δθ) = δp + δθ × arm is that point's motion."""
+    return np.vstack([np.eye(3), _skew(arm)])
