@@ -32,7 +32,7 @@ import numpy as np
 
 import softarm
 from softarm.routing import Straight
-from softarm.statics.solver import _kernels
+from softarm import kernels
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from actuation import GRAVITY, OFFSETS, TENSIONS, L, loads, robot
@@ -45,7 +45,7 @@ class _KernelClock:
 
     def __init__(self):
         self.wall = self.cpu = 0.0
-        module = _kernels()
+        module = kernels
         for name in KERNELS:
             setattr(module, name, self._timed(getattr(module, name)))
 

@@ -98,7 +98,7 @@ def compile_report(cold: bool) -> dict:
     """Import time, first-call time of softarm.solve and whether numba loaded it from cache."""
     w0 = time.perf_counter()
     import softarm
-    from softarm.statics import _kernels
+    from softarm import kernels
 
     t_import = time.perf_counter() - w0
     arm = softarm.Arm.from_stiffness(1.0, EA=1e9, GAy=1e9, GAz=1e9, GJ=1.0, EIy=1.0, EIz=1.0)
@@ -109,7 +109,7 @@ def compile_report(cold: bool) -> dict:
     w0 = time.perf_counter()
     softarm.solve(arm, load, method="numeric")
     t_second = time.perf_counter() - w0
-    stats = _kernels.solve_cases.stats
+    stats = kernels.solve_cases.stats
     hits, misses = sum(stats.cache_hits.values()), sum(stats.cache_misses.values())
     out = {
         "import_s": t_import,

@@ -11,12 +11,12 @@ from pathlib import Path
 #: a passive solve; prints numba's cache misses of the kernels named on its command line
 PASSIVE_SOLVE = """
 import sys, numpy as np, softarm
-from softarm.statics.solver import _kernels
+from softarm import kernels
 silicone = softarm.Material(youngs_modulus=1.5e6, poisson_ratio=0.49, density=1070.0)
 arm = softarm.Arm(0.2, softarm.Circle(0.01), silicone)
 eq = softarm.solve(arm, [softarm.Gravity(), softarm.TipLoad(force=[0.0, 0.01, 0.0])],
                    method="numeric")
-k = _kernels()
+k = kernels
 # what this process compiled: numba's cache misses per kernel (a load from the cache is a hit)
 print({name: sum(getattr(k, name).stats.cache_misses.values()) for name in sys.argv[1:]})
 print(repr(eq.tip_position.tolist()))
@@ -25,7 +25,7 @@ print(repr(eq.tip_position.tolist()))
 
 def python_with(code: str, *args: str, cache: Path, notice: bool = True, prefetch: bool = False):
     """``python -c code args`` with its own numba cache, the compile notice on or off, and
-    the verdict's compile on another core (statics/_prefetch.py) or in the process."""
+    the verdict's compile on another core (kernels/_prefetch.py) or in the process."""
     return subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True,
                           timeout=900, env=cache_env(cache, notice, prefetch))
 

@@ -72,9 +72,9 @@ def test_the_estimate_is_this_machines_measurement_once_there_is_one(first_solve
     assert first.returncode == 0, first.stderr
     code = """
 from softarm._jit import compile_seconds
-from softarm.statics.solver import _kernels
-print(compile_seconds("solve", _kernels().solve_cases))
-print(compile_seconds("solve+jacobians", _kernels().solve_cases))
+from softarm import kernels
+print(compile_seconds("solve", kernels.solve_cases))
+print(compile_seconds("solve+jacobians", kernels.solve_cases))
 """
     run = python_with(code, cache=cache)
     assert run.returncode == 0, run.stderr
@@ -251,13 +251,13 @@ def test_every_capability_of_softarm_compile_has_a_reference_time():
 
 
 def test_the_verdict_compiles_beside_only_where_a_core_is_idle(monkeypatch):
-    """statics/_prefetch.py launches the other process where the 1-minute load average
+    """kernels/_prefetch.py launches the other process where the 1-minute load average
     leaves the second core free (2 cores: load < 1), or always with SOFTARM_PREFETCH=1, never
     with 0 (a cold demo on a 2-core machine: 19.4 s with it, 26.9 s without at load 0.8;
     46.0 s and 33.5 s at load 1.5-2.5; 104 s and 64 s at load 6.7)."""
     from types import SimpleNamespace
 
-    from softarm.statics import _prefetch
+    from softarm.kernels import _prefetch
 
     launched = []
 

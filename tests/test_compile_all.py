@@ -106,7 +106,7 @@ def test_after_compile_all_no_capability_compiles_anything(runs):
     assert runs.every.returncode == 0, runs.every.stdout + runs.every.stderr
     assert len(runs.every.stdout.splitlines()) >= 40, runs.every.stdout
     # the kernels of the statics, the dynamics and the closed forms, in several versions
-    assert {"softarm.statics._kernels.solve_cases", "softarm.statics._kernels.dynamic_steps",
+    assert {"softarm.kernels.shooting.solve_cases", "softarm.kernels.dynamics.dynamic_steps",
             "softarm.analytic._compiled.solve"} <= set(runs.every_used)
     assert sum(map(len, runs.every_used.values())) >= 30, runs.every_used
     missed = {kernel: sorted(set(versions) - set(runs.compile_all_used.get(kernel, ())))

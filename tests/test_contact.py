@@ -470,7 +470,7 @@ def test_a_chained_solver_starts_at_the_stiffest_law_it_needed(monkeypatch):
 def _shootings_of_stiff_solves(monkeypatch) -> list:
     """The shootings (integrations of the arm) of every case the multiple-shooting kernel
     solves from now on, one list per call: a spy on ``solve_stiff_cases``."""
-    from softarm.statics import _kernels as kernels
+    from softarm import kernels
 
     calls, solve = [], kernels.solve_stiff_cases
 

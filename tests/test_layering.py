@@ -36,10 +36,19 @@ def _imported_modules(path: Path) -> set[str]:
         elif isinstance(node, ast.ImportFrom):
             base = parts[: len(parts) - node.level + 1] if node.level else []
             module = ".".join([*base, *([node.module] if node.module else [])])
-            names.add(module)
-            # `from . import x` may load the submodule module.x
-            names.update(f"{module}.{alias.name}" for alias in node.names)
+            # `from . import x` may load the submodule module.x; where every x is one, a
+            # relative `from .. import x` reads nothing of the package (an enclosing one of
+            # this module, loaded before it)
+            submodules = {f"{module}.{alias.name}" for alias in node.names}
+            names.update(submodules)
+            if node.module or not node.level or not all(map(_is_module, submodules)):
+                names.add(module)
     return names
+
+
+def _is_module(name: str) -> bool:
+    path = PACKAGE.joinpath(*name.split(".")[1:])
+    return path.with_suffix(".py").is_file() or (path / "__init__.py").is_file()
 
 
 def _reaches(name: str, target: str) -> bool:
@@ -105,6 +114,7 @@ LAYERS = (
     ("geometry", "view"),  # pictures from arrays: numpy (plotly when a page is written)
     ("equilibrium", "_admissible"),  # the result type both routes build, and the model's
     # limits both routes check it against
+    ("kernels",),  # the compiled kernels (numba; imported lazily: importing them loads nothing)
     ("analytic", "statics"),  # two independent routes (see the tests above)
     ("dispatch",),
     ("stability", "control", "dynamics"),
@@ -117,7 +127,7 @@ LAYERS = (
 )
 #: What a module below the front ends may import inside a function: the compiled kernels
 #: (numba compiles them on first use) and the viewer (Equilibrium.show, which needs plotly).
-LAZY = ("softarm.statics._kernels", "softarm.analytic._compiled", "softarm.view")
+LAZY = ("softarm.analytic._compiled", "softarm.view")
 FRONT_ENDS = LAYERS[-1]
 
 

@@ -29,7 +29,10 @@ when stderr is not a terminal. ``SOFTARM_COMPILE_NOTICE=0`` silences both.
 
 from __future__ import annotations
 
+import ast
+import functools
 import hashlib
+import inspect
 import json
 import os
 import sys
@@ -40,6 +43,7 @@ from collections.abc import Callable
 
 from numba import njit
 from numba.core import event
+from numba.core.caching import CompileResultCacheImpl, FunctionCache
 
 __all__ = ["COMPILED", "PROGRESS_AFTER", "REFERENCE_SECONDS", "compile_seconds", "jit",
            "notices", "on_cold_compile"]
@@ -101,7 +105,7 @@ _STATE = threading.local()
 _LOCK = threading.Lock()
 #: The capabilities compiled in this process, in order: (key, text, seconds)
 COMPILED: list[tuple[str, str, float]] = []
-#: Whether compile times are recorded (not in statics/_prefetch.py's process, whose times
+#: Whether compile times are recorded (not in kernels/_prefetch.py's process, whose times
 #: include what the solver's process compiles beside it)
 _RECORD_TIMES = os.environ.get("SOFTARM_COMPILE_RECORD", "1") != "0"
 #: Whether a compile prints its notice (``softarm compile`` draws a progress bar instead)
@@ -109,7 +113,7 @@ notices = os.environ.get("SOFTARM_COMPILE_NOTICE", "1") != "0"
 
 
 def jit(function=None, *, what: str = "softarm's compiled kernels", capability=None,
-        **options):
+        key_on_imports: bool = False, **options):
     """``njit(cache=True, **options)``, or without the cache where numba has nowhere to write.
 
     Numba stores its cache beside the source file or in a user cache directory; with a
@@ -121,9 +125,15 @@ def jit(function=None, *, what: str = "softarm's compiled kernels", capability=N
     ``capability``: for an entry point (a kernel called from Python), a function of the
     argument types of a compile returning (key, text): the capability being compiled, a key
     of :data:`REFERENCE_SECONDS` and the words of the notice ("the solver for passive arms").
+
+    ``key_on_imports``: the cache is keyed on the function's file *and* every file of its
+    package that the file imports, directly or through others (:func:`imports_stamp`), not
+    on its own file only (numba's rule, under which a caller keeps a changed callee's old
+    code): for functions that call compiled functions of other files (softarm/kernels).
     """
     if function is None:
-        return lambda f: jit(f, what=what, capability=capability, **options)
+        return lambda f: jit(f, what=what, capability=capability,
+                             key_on_imports=key_on_imports, **options)
     try:
         dispatcher = njit(cache=True, **options)(function)
     except RuntimeError as error:
@@ -139,14 +149,81 @@ def jit(function=None, *, what: str = "softarm's compiled kernels", capability=N
                    if "NUMBA_CACHE_DIR" in os.environ else ""),
                 RuntimeWarning, stacklevel=2)
         dispatcher = njit(cache=False, **options)(function)
+    else:
+        if key_on_imports:
+            dispatcher._cache = _ImportsKeyedCache(function)
     if capability is not None:
         _ENTRIES[function] = capability
     return dispatcher
 
 
+class _ImportsKeyedCache(FunctionCache):
+    """numba's on-disk cache of a function, its source stamp extended by
+    :func:`imports_stamp` (``jit(..., key_on_imports=True)``)."""
+
+    class _impl_class(CompileResultCacheImpl):
+        def __init__(self, py_func):
+            super().__init__(py_func)
+            self._locator = _StampedLocator(self._locator, imports_stamp(
+                inspect.getfile(py_func)))
+
+
+class _StampedLocator:
+    """numba's cache locator of a function (where its cache lives, its own file's stamp),
+    with ``stamp`` added to that stamp: a cached index whose stamp differs is not loaded
+    (numba compiles again and overwrites it)."""
+
+    def __init__(self, locator, stamp: str):
+        self._locator, self._stamp = locator, stamp
+
+    def get_source_stamp(self):
+        return self._locator.get_source_stamp(), self._stamp
+
+    def __getattr__(self, name):
+        return getattr(self._locator, name)
+
+
+def imports_stamp(path: str) -> str:
+    """A digest of the Python file ``path`` and of every file of its folder (its package)
+    that it imports by a relative import (``from .rod import ...``, ``from . import x``),
+    directly or through those files: what a function compiled in ``path`` may link. Imports
+    from outside the folder (``from .._jit import``, numpy) are not compiled code of it."""
+    folder, name = os.path.split(os.path.abspath(path))
+    seen, todo = set(), [name.removesuffix(".py")]
+    while todo:
+        module = todo.pop()
+        if module not in seen and os.path.isfile(os.path.join(folder, f"{module}.py")):
+            seen.add(module)
+            todo.extend(_sibling_imports(os.path.join(folder, f"{module}.py")))
+    digest = hashlib.sha256()
+    for module in sorted(seen):
+        digest.update(module.encode("utf-8") + b"\0")
+        digest.update(_file_digest(os.path.join(folder, f"{module}.py")))
+    return digest.hexdigest()
+
+
+@functools.cache
+def _sibling_imports(path: str) -> tuple[str, ...]:
+    """The modules of its own folder that the file ``path`` imports (relative, level 1)."""
+    with open(path, "rb") as file:
+        tree = ast.parse(file.read())
+    names = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom) and node.level == 1:
+            names += [node.module.split(".")[0]] if node.module else \
+                [alias.name for alias in node.names]
+    return tuple(names)
+
+
+@functools.cache
+def _file_digest(path: str) -> bytes:
+    with open(path, "rb") as file:
+        return hashlib.sha256(file.read()).digest()
+
+
 def on_cold_compile(dispatcher, callback: Callable) -> None:
     """Call ``callback(argument types)`` when the entry point ``dispatcher`` starts a compile
-    that missed numba's cache (statics/_prefetch.py starts the verdict's compile then); what
+    that missed numba's cache (kernels/_prefetch.py starts the verdict's compile then); what
     it returns, if not None, is added to the notice."""
     _ON_COLD.setdefault(getattr(dispatcher, "py_func", dispatcher), []).append(callback)
 

@@ -38,7 +38,7 @@ from .loads import Key, Load, applied_wrench
 __all__ = ["Capsule", "Contact", "Obstacle", "Plane", "Sphere", "along_the_arm", "balance",
            "penalty_energy", "pressure", "resultant"]
 
-# The kernel's obstacle kinds (statics/_kernels.py: PLANE, SPHERE, CAPSULE, one row of 8).
+# The kernel's obstacle kinds (kernels/rod.py: PLANE, SPHERE, CAPSULE, one row of 8).
 _PLANE, _SPHERE, _CAPSULE = 0, 1, 2
 #: The default contact distance δ, as a fraction of the arm's length.
 DISTANCE = 1e-5
@@ -79,7 +79,7 @@ class Obstacle:
 
     def kernel_row(self) -> np.ndarray:
         """The solver's row (8,): kind, two points or a point and a direction, radius
-        (statics/_kernels.py's ``_nearest``: a plane's point and normal, a ball's surface
+        (kernels/rod.py's ``_nearest``: a plane's point and normal, a ball's surface
         point and outward normal there, a capsule's axis ends)."""
         raise NotImplementedError
 

@@ -28,6 +28,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from . import kernels
 from ._validate import count, format_value, real
 from .dispatch import warn_unstable, warn_verdict
 from .equilibrium import Equilibrium, Stability
@@ -36,7 +37,7 @@ from .loads import InputRules, as_actuators, as_loads
 from .statics import Solver
 from .statics._bounded import regularised_step
 from .statics.displacement import displaced_columns, displacement_jacobians
-from .statics.solver import Snapshot, _kernels
+from .statics.solver import Snapshot
 
 __all__ = ["ForwardResult", "ForwardSolver", "InverseResult", "InverseSolver", "inverse"]
 
@@ -525,7 +526,7 @@ class InverseSolver:
         kernel's ``task_error``, which the fast route computes in its iteration."""
         t = 3 if orientation is None else 6
         e = np.empty(t)
-        _kernels().task_error(np.concatenate([tip[:3, 3], tip[:3, :3].ravel()]),
+        kernels.task_error(np.concatenate([tip[:3, 3], tip[:3, :3].ravel()]),
                               np.array(target, dtype=np.float64),
                               _EYE3 if orientation is None else np.array(orientation,
                                                                          dtype=np.float64),
@@ -547,7 +548,7 @@ class InverseSolver:
     def _redundant(self, J) -> bool:
         """More inputs than the rank of the weighted task Jacobian J in scaled inputs (the
         kernel's ``redundant_task``, the fast route's rule)."""
-        return bool(_kernels().redundant_task(self._singular(J), self.n_inputs))
+        return bool(kernels.redundant_task(self._singular(J), self.n_inputs))
 
     def _step(self, J, b, q, mu, redundant):
         """The bounded Gauss–Newton step δq for the weighted task Jacobian J and right-hand
@@ -613,7 +614,7 @@ class InverseSolver:
         if warm is not None and not (warm.q.tobytes() == q.tobytes()
                                      and warm.x.tobytes() == x.tobytes()):
             warm = None  # the Solver or the inputs moved since
-        k = _kernels()
+        k = kernels
         steps, base, arm, units = shooter.kernel_arrays(("solution", N))
         every = shooter.inputs.copy()  # every input of the loads, the actuators' at slots
         x, q = x.copy(), q.copy()

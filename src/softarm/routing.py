@@ -78,7 +78,7 @@ class Routing:
         return float(total)
 
     def kernel_row(self, degree: int, length: float) -> np.ndarray:
-        """The solver's routing row (see ``statics/_kernels.py``) on an arm of this length:
+        """The solver's routing row (see ``softarm/kernels/rod.py``) on an arm of this length:
         the bound of |r|, helix radius, angular rate 2π n, phase, then ``degree``
         coefficients of y and of z."""
         row = np.zeros(4 + 2 * degree)

@@ -366,6 +366,6 @@ def _dispatcher(key: str):
         from .analytic._elastica_math import compiled
 
         return compiled().solve
-    from .statics.solver import _kernels
+    from . import kernels
 
-    return _kernels().solve_cases
+    return kernels.solve_cases

@@ -1,4 +1,4 @@
-"""Simulation: the time loop around the compiled implicit step (statics/_kernels.py,
+"""Simulation: the time loop around the compiled implicit step (softarm/kernels/dynamics.py,
 section "dynamics"). The equations, the scheme and its accuracy: docs/dynamics.md."""
 
 from __future__ import annotations
@@ -8,6 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import kernels
 from .._admissible import load_case
 from .._threads import in_threads, threads_for
 from .._validate import (
@@ -23,7 +24,7 @@ from ..equilibrium import Equilibrium, _frozen
 from ..errors import ApproximationWarning, ConvergenceError
 from ..loads import Gravity, InputRules, as_actuators, as_loads
 from ..statics import Solver
-from ..statics.solver import _check_outside, _kernels, check_tol
+from ..statics.solver import _check_outside, check_tol
 from ._results import Energy, State, Trajectory
 
 __all__ = ["Damping", "Simulator", "simulate"]
@@ -112,7 +113,7 @@ def _node_bytes() -> tuple[int, int]:
     twice); the banded Jacobian's rows (DUNK a node: 3 KL + 1 columns of the band, KL of
     the multipliers, a pivot). Measured (tracemalloc and the peak resident memory): 24.5 kB
     a node over the steps of one case, 1.8 kB after construction (tests/test_memory.py)."""
-    k = _kernels()
+    k = kernels
     state = 8 * (9 * (3 * k.DYN + k.DHIST) + 2 * 30)
     storage = 8 * k.DUNK * ((3 * k._DKL + 1) + k._DKL + 1)
     return state, storage
@@ -310,7 +311,7 @@ class Simulator:
 
     def _properties(self, pieces, coef) -> np.ndarray:
         """(P, DPROPS): each piece's K, B, (K + c0 B)⁻¹, ε⁰, μ and ρJ."""
-        k = _kernels()
+        k = kernels
         P = pieces[0].size
         segments = self.arm.segments
         props = np.zeros((P, k.DPROPS))
@@ -344,7 +345,7 @@ class Simulator:
         ``props``), and f⁰ as a scratch the kernel fills per node."""
         if act is None:
             return None
-        k = _kernels()
+        k = kernels
         P = pieces[0].size
         compliance = np.ascontiguousarray(props[:, k._PKD:k._PKD + 36].reshape(P, 6, 6))
         stiffness = np.ascontiguousarray(np.linalg.inv(compliance))
@@ -382,7 +383,7 @@ class Simulator:
         contact = channels.resolve_contact(self._contact_sized.copy(), dt=self.dt)
         self.loads = tuple(contact if load.kind == "contact" else load for load in self.loads)
         self._contact = contact
-        k = _kernels()
+        k = kernels
         for array in (self._loads, self._loads0[0]):  # (each case's k in its channel CT)
             array[:, :, k.CT] = channels.piece[:, :, k.CT]
         self._act = channels.arm_tuple()[1]  # (the obstacles' rows and the law's band)
@@ -435,7 +436,7 @@ class Simulator:
         """(Z, Zold, H, aux) of the initial state: a State's own; or at rest: the unloaded
         arm (ε = ε⁰, no stress), or the equilibrium of an Equilibrium's loads solved again
         on this grid (:meth:`_settle`)."""
-        k = _kernels()
+        k = kernels
         B = int(np.prod(self.shape))
         if isinstance(initial, State):
             if initial._signature != self._signature:
@@ -557,7 +558,7 @@ class Simulator:
         answer. The same discretisation as the steps, so the arm starts at rest to tol
         (the solver's own answer differs from it by the grid's O(h²) error), and the
         total wrench of rod and actuators is the state's."""
-        k = _kernels()
+        k = kernels
         _, shape, _, pieces, channels = self._solver._prepare(loads, tuple(self._pieces[0]))
         if not np.array_equal(pieces[0], self._pieces[0]):
             raise ValueError("initial: the Equilibrium's loads cut the arm where this "
@@ -598,7 +599,7 @@ class Simulator:
         the nodes, as the steps' lengths) for the strains in H, or None without tendons."""
         if not self._tendon_columns.size:
             return None
-        k = _kernels()
+        k = kernels
         routes, active = self._act[0], self._act[2]
         out = np.zeros((H.shape[0], self._tendon_columns.size))
         v, u = H[..., 0:3], H[..., 3:6]
@@ -641,7 +642,7 @@ class Simulator:
     # ------------------------------------------------------------------ stepping
 
     def _storage(self, per_case: bool, B: int):
-        k = _kernels()
+        k = kernels
         n = k.DUNK * (self._nodes.size - 1) + 6
         C = B if per_case else 1
         return (np.zeros((C, n, 3 * k._DKL + 1)), np.zeros((C, n, k._DKL)),
@@ -677,7 +678,7 @@ class Simulator:
 
     def _kernel_run(self, arrays, times, coef, props, factors, threads, q, skip):
         """The kernel over ``times`` (advancing ``arrays`` in place where a case succeeds)."""
-        k = _kernels()
+        k = kernels
         Z, Zold, H, aux = arrays
         B, S, steps = Z.shape[0], self._at.size, times.size
         base = self._base_rows(times)
@@ -923,7 +924,7 @@ class Simulator:
                     "spins": initial.angular_velocities.reshape(*shape, 3),
                     "strains": initial.strains.reshape(*shape, 6),
                     "stresses": initial.stresses.reshape(*shape, 6)}
-        k = _kernels()
+        k = kernels
         Z, _, H, _ = self._arrays
         z = Z[:, self._at]
         R = z[..., k._DR:k._DR + 9].reshape(*z.shape[:2], 3, 3)
@@ -963,7 +964,7 @@ class Simulator:
 
     def _energy_now(self, first: State) -> np.ndarray:
         """(B, 4): the energies of ``first`` (the trajectory's first row), from its arrays."""
-        k = _kernels()
+        k = kernels
         Z, _, H, aux = first._arrays
         w = np.zeros(self._nodes.size)
         w[:-1] += 0.5 * self._h

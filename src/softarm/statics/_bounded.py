@@ -1,20 +1,16 @@
 """Bounded least squares for the bounded Newton methods of the solver (displacement-controlled
 tendons, :mod:`softarm.statics.displacement`) and of inverse statics (:mod:`softarm.control`).
-The step is compiled, in the solver's kernels (``_kernels.py`` beside this file, imported on
-first use: inverse statics' compiled iteration calls it there): a control loop takes one per
-iteration, where scipy's bounded least squares costs about 90 µs a call."""
+The step is compiled (softarm/kernels/inverse.py, beside inverse statics' compiled iteration,
+which calls it): a control loop takes one per iteration, where scipy's bounded least squares
+costs about 90 µs a call."""
 
 from __future__ import annotations
 
 import numpy as np
 
+from .. import kernels
+
 __all__ = ["box_least_squares", "regularised_step"]
-
-
-def _compiled():
-    from . import _kernels  # compiled on first use: importing this module compiles nothing
-
-    return _kernels
 
 
 def _floats(value):
@@ -28,7 +24,7 @@ def box_least_squares(A, b, lower, upper, iterations: int = 100):
     Householder least squares; a variable that would leave its box is fixed at the bound it
     reaches first along the way; a fixed one is freed when the objective's slope points into
     the box. After ``iterations`` without convergence, the last iterate (in the box)."""
-    x, _ = _compiled().box_least_squares(_floats(A), _floats(b), _floats(lower),
+    x, _ = kernels.box_least_squares(_floats(A), _floats(b), _floats(lower),
                                          _floats(upper), int(iterations))
     return x
 
@@ -41,7 +37,7 @@ def regularised_step(J, b, q, scales, mu, lower, upper, iterations: int = 100, *
     compiled code. ε = 1e-12 for a ``redundant`` task (the least effort along its null
     space, moving the task solution by ~1e-12 relative), else 0 (it would only bias the
     answer: along J s's weakest direction, of singular value σ / c, it weighs ε c²)."""
-    k = _compiled()
+    k = kernels
     return k.regularised_step(_floats(J), _floats(b), _floats(q), _floats(scales), float(mu),
                               k.EFFORT if redundant else 0.0, _floats(lower), _floats(upper),
                               int(iterations))

@@ -1,5 +1,5 @@
 """Which load cases are stiff: where single shooting's map grows like e^{kL} beyond what
-double precision carries, and the multiple-shooting route (``_kernels.solve_stiff_cases``)
+double precision carries, and the multiple-shooting route (``softarm.kernels.solve_stiff_cases``)
 takes them (docs/solver.md, "Multiple shooting")."""
 
 from __future__ import annotations

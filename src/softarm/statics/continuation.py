@@ -16,12 +16,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .. import kernels
 from .._admissible import check_stretch, inside_out, stretched
 from ..equilibrium import Equilibrium
 from ..errors import ConvergenceError
 from ..loads import as_loads
 from ._stiff import STIFF_KL, tension_kl
-from .solver import METHOD, Solver, _kernels
+from .solver import METHOD, Solver
 from .stability import conservative, make
 
 __all__ = ["Branch", "CriticalPoint", "Mode", "Path", "Stopped"]
@@ -93,7 +94,7 @@ class Path:
     """A homotopy loads(λ) = fixed + λ varied on an arm, on a fixed grid of RK4 steps."""
 
     def __init__(self, solver: Solver, fixed, varied, steps: int = STEPS):
-        k = _kernels()
+        k = kernels
         self.k = k
         self.solver = solver
         fixed, varied = as_loads(fixed), as_loads(varied)

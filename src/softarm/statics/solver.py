@@ -3,7 +3,7 @@ the loading path (see docs/solver.md and README.md beside this file).
 
 Python-side preparation (validation, cutting the arm into uniform pieces at segment joints,
 point loads and span ends, writing every load into the kernel's load channels) lives here;
-the numerical work, for the whole batch at once, is :func:`softarm.statics._kernels.solve_cases`.
+the numerical work, for the whole batch at once, is :func:`softarm.kernels.solve_cases`.
 """
 
 from __future__ import annotations
@@ -18,6 +18,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .. import kernels
 from .._admissible import batch_part, check_stretch, load_case, tendon_limit
 from .._threads import in_threads, threads_for
 from .._validate import (
@@ -34,6 +35,7 @@ from .._validate import (
 from ..contact import balance
 from ..equilibrium import Equilibrium, Stability
 from ..errors import ApproximationWarning, ConvergenceError, InadmissibleStateError
+from ..kernels import _prefetch
 from ..lie import se3
 from ..loads import (
     Gravity,
@@ -46,7 +48,6 @@ from ..loads import (
 )
 from ..model import Arm, Circle, Material, SegmentedArm
 from ..routing import Straight
-from . import _prefetch
 from ._stiff import STIFF_KL, tension_kl
 from .displacement import solve_displaced
 from .stability import verdict
@@ -63,20 +64,6 @@ _IDENTITY = np.eye(4)
 _IDENTITY.setflags(write=False)
 #: Fewest load cases per thread of a batch: below it a thread costs more than it saves.
 CASES_PER_THREAD = 16
-
-
-def _kernels():
-    """The compiled module, imported on first use: ``import softarm`` compiles nothing and
-    does not import numba."""
-    global _KERNELS
-    if _KERNELS is None:
-        from . import _kernels as module
-
-        _KERNELS = module
-    return _KERNELS
-
-
-_KERNELS = None
 
 
 def check_base(base) -> np.ndarray:
@@ -207,7 +194,7 @@ class _ArmData:
                 self.mu[segment], segment)
 
 
-#: ``act``'s contact arrays out of contact: no obstacle (statics/_kernels.py, act[5], act[6])
+#: ``act``'s contact arrays out of contact: no obstacle (kernels/rod.py, act[5], act[6])
 _NO_CONTACT = (np.zeros((0, 8)), np.zeros((1, 5)))
 
 
@@ -372,7 +359,7 @@ class _Channels:
     without broadcast copies."""
 
     def __init__(self, data: _ArmData, pieces: tuple, shape: tuple, count: int):
-        k = _kernels()
+        k = kernels
         self.k = k
         self.arm = data.arm
         self.length = data.length
@@ -464,7 +451,7 @@ class _Channels:
     def arm_tuple(self) -> tuple:
         """The kernel's (arm, act) pair, passed on as ``*arm_tuple()``: the pieces, and the
         actuators' paths, the magnets and the obstacles, or None for a passive arm out of
-        contact (see _kernels: a passive arm's solve is compiled without them)."""
+        contact (see softarm.kernels: a passive arm's solve is compiled without them)."""
         arm, act = self._actuated_arm()[0]
         if self.contact_load is None:
             return arm, (None if act is None else (*act, *_NO_CONTACT))
@@ -676,7 +663,7 @@ class Shooter:
                              f"input of the loads, in load order), got {q.shape}")
         lam = float(load_factor)
         piece, tip = self._at(q)
-        k = _kernels()
+        k = kernels
         case = (piece, self._rates[0], tip, self._rates[1]) if lam == 1.0 else (
             lam * piece, lam * self._rates[0], lam * tip, lam * self._rates[1])
         result = _shoot(k, x, 0.0, self._steps(steps), self._solver._base_kernel, self._arm,
@@ -763,7 +750,7 @@ class PreparedSolve:
     """
 
     def __init__(self, solver, loads, *, jacobians: bool):
-        k = _kernels()
+        k = kernels
         loads, shape, _, pieces, channels = solver._prepare(loads)
         if shape != ():
             raise ValueError(f"Solver.prepared takes a single load case, got batch shape "
@@ -1142,7 +1129,7 @@ class _StiffChain:
     MOST_INTERVALS = 8192
 
     def __init__(self, key, pieces: int, width: int, intervals: int):
-        k = _kernels()
+        k = kernels
         state = 18 + width - k.PIECE_LOADS  # the kernel's: p, R, n, m, tendon lengths
         self.key = key
         self.arrays = (np.zeros(6), np.zeros((intervals, state)),
@@ -1155,7 +1142,7 @@ def _chain_off() -> tuple:
     global _CHAIN_OFF
     if _CHAIN_OFF is None:
         _CHAIN_OFF = (np.zeros(6), np.zeros((1, 1)), np.ones(1, dtype=np.int64), np.zeros(4),
-                      np.zeros((1, 1)), np.zeros(_kernels().TIP_LOADS))
+                      np.zeros((1, 1)), np.zeros(kernels.TIP_LOADS))
     return _CHAIN_OFF
 
 
@@ -1462,7 +1449,7 @@ class Solver:
                         self.reset()
                         self._friction = found
                     return held
-        k = _kernels()
+        k = kernels
         last = self._last if chained else None
         loads, shape, count, pieces, channels = self._prepare(
             loads, () if last is None else tuple(last[0]), checked=checked)
@@ -1494,7 +1481,7 @@ class Solver:
             if contact_retry is None:  # (a retry solves the same arm from the same start)
                 _check_outside(self, channels.contact_load.replace(stiffness=None))
             loads = tuple(contact if load.kind == "contact" else load for load in loads)
-        # unchained: no first loads, no memory (that code is not even compiled, _kernels)
+        # unchained: no first loads, no memory (that code is not even compiled, softarm.kernels)
         first = memory = None
         if chained or near:
             if last is None:  # from the unloaded arm
@@ -1772,7 +1759,7 @@ class Solver:
         return self._solve_near(loads, x, steps)
 
     def _solve_near(self, loads, x, steps, jacobians: bool = False) -> Equilibrium:
-        k = _kernels()
+        k = kernels
         self.reset()
         memory = np.zeros(k.MEMORY)
         memory[0:6] = memory[6:12] = np.asarray(x, dtype=np.float64)
@@ -1795,7 +1782,7 @@ class Solver:
         """
         if inputs:
             return self.shooter(loads)(x, load_factor=load_factor, steps=steps)
-        k = _kernels()
+        k = kernels
         loads, shape, _, pieces, channels = self._prepare(loads)
         if shape != ():
             raise ValueError(f"Solver.shoot takes a single load case, got batch shape {shape}")
@@ -1908,7 +1895,7 @@ def _recut(old_starts, old_piece, new_starts) -> np.ndarray:
     piece, point wrenches where an old piece started."""
     if np.array_equal(old_starts, new_starts):  # the same cut (a control loop's usual case)
         return old_piece.copy()
-    k = _kernels()
+    k = kernels
     out = np.zeros((new_starts.size, old_piece.shape[1]))
     inside = np.clip(np.searchsorted(old_starts, new_starts, side="right") - 1, 0, None)
     out[:, :k.JD] = old_piece[inside, :k.JD]
@@ -1921,7 +1908,7 @@ def _recut(old_starts, old_piece, new_starts) -> np.ndarray:
 def _compliances(jac, motion, shape, tendons):
     """Tip and station compliances C(s) = E_x(s) J_x⁻¹ (dead tip wrench → (δp; δθ)
     spatial) and the actuation Jacobians E_q - E_x J_x⁻¹ J_q, as the kernel left them
-    (``_kernels._implicit_function``): ``motion`` (B, S, 6, 6 + n) per station, ``jac``
+    (``kernels.shooting._implicit_function``): ``motion`` (B, S, 6, 6 + n) per station, ``jac``
     (B, 6 + A, 6 + n) rows 6 + a per actuator length (``tendons`` the actuators that are
     tendons). Returns (tip compliance, station compliances, tip actuation Jacobian, station
     actuation Jacobians, tendon length Jacobian (B..., T, n)), frozen; the last three None
@@ -1962,7 +1949,7 @@ def _input_channels(loads, pieces, data, width) -> tuple[np.ndarray, np.ndarray]
     every component, in the order of the loads): (piece (n, P, W), tip (n, TIP_LOADS)).
     The channels are linear in the inputs, so each is the channels of all loads zeroed but
     that one component at 1 (all loads applied, so that the actuator columns line up)."""
-    k = _kernels()
+    k = kernels
     if not any(load.inputs for load in loads):
         return np.zeros((0, pieces[0].size, width)), np.zeros((0, k.TIP_LOADS))
     zeroed = [load.take((0,) * len(load.batch_shape)).scaled(0.0) for load in loads]
@@ -2318,7 +2305,7 @@ def compile_beside(kind: str) -> None:
     out = (np.empty((count, S, 4, 4)), np.empty((count, S, 6)), np.empty((count, S, 6)),
            np.zeros((count, 5)), np.zeros(count, dtype=np.int64), solver._unused((0, 6, 6)),
            solver._unused((1, S, 6, 6)), np.empty((count, 6)), np.empty((count, A)))
-    _kernels().record_points(solver._base_kernel, *channels.arm_tuple(),
+    kernels.record_points(solver._base_kernel, *channels.arm_tuple(),
                              (channels.piece, channels.tip_loads), np.zeros((count, 6)),
                              np.full(pieces[0].size, 4, dtype=np.int64), solver._s_kernel, out)
     verdict(channels, solver._base_kernel, np.zeros((count, 6)), np.full(count, 8.0), shape,

@@ -1,6 +1,6 @@
 """Stability of equilibria by the backward sweep of the linearised equations (docs/stability.md).
 
-The numerical work is in :mod:`softarm.statics._kernels` (``stability_cases``,
+The numerical work is in :mod:`softarm.kernels.stability` (``stability_cases``,
 ``sweep_point``); this module prepares its inputs and reads its outputs.
 """
 
@@ -10,26 +10,15 @@ import math
 
 import numpy as np
 
+from .. import kernels
 from .._threads import in_threads
 from .._validate import PART_BYTES
 from ..equilibrium import Stability
+from ..kernels import _prefetch
 from ..loads import TipLoad, as_loads
-from . import _prefetch
 from ._stiff import STIFF_KL, tension_kl
 
 __all__ = ["conservative", "verdict"]
-
-
-def _k():
-    global _KERNELS
-    if _KERNELS is None:  # (a function-level import costs about 5 µs a call)
-        from . import _kernels
-
-        _KERNELS = _kernels
-    return _KERNELS
-
-
-_KERNELS = None
 
 
 def conservative(piece: np.ndarray, tip: np.ndarray) -> np.ndarray:
@@ -43,7 +32,7 @@ def conservative(piece: np.ndarray, tip: np.ndarray) -> np.ndarray:
     Structural Stability*: the work of an axial couple depends on the path of finite
     rotations), so a dead couple also makes the static test inconclusive.
     """
-    k = _k()
+    k = kernels
     piece = np.abs(piece)
     tip = np.abs(tip)
     follower = (piece[..., k.FF:k.FF + 3].sum((-1, -2)) + piece[..., k.LF:k.LF + 3].sum((-1, -2))
@@ -74,7 +63,7 @@ def verdict(channels, base, xs, Ns, shape, tips=None, factor=1, threads=1,
             index[rest] = part.index.reshape(-1)
             flags[rest] = part.conservative.reshape(-1)
         return make(index, flags, shape)
-    k = _k()
+    k = kernels
     count = xs.shape[0]
     index = np.zeros(count, dtype=np.int64)
     theta0 = np.zeros((count, 6, 6))
@@ -105,7 +94,7 @@ def _closed_form_steps(channels, data) -> np.ndarray:
     scales 1/√(F/EI) and EI/(F L), EI/M; 8 + 2 (kL + F L²/EI + M L/EI) steps keep h k and
     the turning per step below about 1/2, in [12, 256]; and at least 2 per radian of the
     unloaded arm's own turning Σ |κ⁰| L (a step turning by more than 2.8 rad is unstable)."""
-    k = _k()
+    k = kernels
     EI, L = data.least_bending, data.length
     curved = math.ceil(2.0 * data.turning)
     if channels.count == 1:  # one case: scalar arithmetic (numpy's per-call cost dominates)
@@ -211,7 +200,7 @@ def closed_form_verdict(solver, loads, eq, states_at=None) -> Stability | None:
 
 
 def _sweep_grid(channels, N: int) -> np.ndarray:
-    """The sweep's grid on N steps spread over the pieces (_kernels._fill_steps), base to
+    """The sweep's grid on N steps spread over the pieces (kernels.shooting._fill_steps), base to
     tip: each piece's step starts, then L."""
     starts, lengths = channels.starts, channels.lengths
     counts = np.maximum(1, np.floor(N * lengths / channels.length + 0.5)).astype(int)
