@@ -344,7 +344,10 @@ def test_ctrl_c_wherever_it_lands_in_the_first_seconds(tmp_path):
 
     Only the interpreter's own start-up (site, the entry script's ``import re``: before any
     line of softarm runs) is out of the command's reach: a traceback whose frames are all
-    outside softarm is accepted there, and nowhere after 0.5 s."""
+    outside softarm is accepted there, and nowhere after 0.5 s. So is, there, Python's
+    "Exception ignored" for a KeyboardInterrupt that landed in importlib's module-lock
+    callback, after which the command runs to its end (exit 0: seen once in three CI runs,
+    at 0.05 s, frames all in ``<frozen importlib._bootstrap>``)."""
     import signal
     import threading
     import time
@@ -380,6 +383,15 @@ def test_ctrl_c_wherever_it_lands_in_the_first_seconds(tmp_path):
             assert said == ["softarm: interrupted"], where
             assert files == [], where
             outcomes.append("stopped")
+        elif process.returncode == 0 and said and said[0].startswith("Exception ignored"):
+            # Python's own start-up: a KeyboardInterrupt raised by the default handler inside
+            # one of importlib's weakref callbacks is printed and dropped, and the command,
+            # which never saw it, runs to its end
+            frames = _frames(stderr)
+            assert delay < 0.5 and frames and not any(f.startswith(ours[0]) or
+                                                      f.endswith(ours[1]) for f in frames), where
+            assert said[-1].startswith("KeyboardInterrupt") and files == ["out.csv"], where
+            outcomes.append("interpreter start-up")
         elif process.returncode == 0:
             assert said == [] and files == ["out.csv"], where
             assert any(line == f"wrote {out}\n" for _, line in lines), where
