@@ -9,7 +9,8 @@ Prints, each in fresh processes with an empty numba cache of their own:
    runs it: the ``softarm`` command of a fresh virtual environment where this tree was just
    installed (``pip install .[plot]``: no byte-code of softarm yet, the wheel's own
    ``softarm`` launcher); with ``--baseline REV``, the demo of another revision of this
-   repository side by side (e.g. the last release), and the ratio;
+   repository side by side (e.g. the last release), and the ratio, and (unless
+   ``--no-capabilities``) both trees' cold ``softarm compile --all``, one after the other;
 2. ``softarm compile --all``: every capability in the order of ``softarm.warmup.STEPS``, each
    after the ones before it (what a user meets who adds capabilities one by one), and the
    compile time recorded per kernel capability (``softarm._jit``: the figures its notice
@@ -77,13 +78,15 @@ def demo(src: Path | None, command=None, **extra) -> tuple[tuple[float, float],
     return cold, warm
 
 
-def capabilities(src: Path) -> tuple[str, dict, dict, str]:
+def capabilities(src: Path) -> tuple[str, dict, dict, str, tuple[float, float]]:
     """(``softarm compile --all``'s output, the compile record per capability key, (wall,
-    CPU) seconds, the closed forms' record, the load average before and after)."""
+    CPU) seconds, the closed forms' record, the load average before and after, the whole
+    command's (wall, CPU) seconds)."""
     with tempfile.TemporaryDirectory() as cache:
         env = _env(cache, src)
         loads = load()
-        _, _, done = _run([sys.executable, "-m", "softarm", "compile", "--all"], env, ROOT)
+        wall, cpu, done = _run([sys.executable, "-m", "softarm", "compile", "--all"], env,
+                               ROOT)
         loads += f" -> {load()}"
         records = {}  # per capability, (wall, CPU) s: the sums of its compiled versions
         for path in Path(cache).rglob("softarm-compile-seconds.json"):
@@ -92,7 +95,9 @@ def capabilities(src: Path) -> tuple[str, dict, dict, str]:
                       sum(cpu for _, cpu in versions.values()))
                 for key, versions in json.loads(path.read_text()).items()
                 if isinstance(versions, dict)}
-    return done.stdout, records.get("statics", {}), records.get("analytic", {}), loads
+    # (the kernels' folder: softarm/kernels, softarm/statics before issue 41)
+    kernels = records.get("kernels", records.get("statics", {}))
+    return done.stdout, kernels, records.get("analytic", {}), loads, (wall, cpu)
 
 
 def fresh_venv(into: str) -> list[str]:
@@ -146,11 +151,19 @@ def main() -> None:
             ours = min(cold_demo["this tree"])
             theirs = min(cold_demo[f"baseline {args.baseline}"])
             print(f"  cold demo: {theirs / ours:.2f}× faster than {args.baseline}")
+            if not args.no_capabilities:  # every capability of both, one after the other
+                times = {name: capabilities(where)[4] for name, where in
+                         (("this tree", src), (args.baseline, rows[-1][1]))}
+                for name, (wall, cpu) in times.items():
+                    print(f"  softarm compile --all, cold: {wall:6.1f} s wall, {cpu:6.1f} s "
+                          f"CPU ({name})")
+                print(f"  compile --all: {times[args.baseline][0] / times['this tree'][0]:.2f}×"
+                      f" faster than {args.baseline} (wall)")
             subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force",
                             f"{scratch}/base"], capture_output=True)
     if args.no_capabilities:
         return
-    output, statics, analytic, loads = capabilities(src)
+    output, statics, analytic, loads, _ = capabilities(src)
     print(f"softarm compile --all (each step after the ones before it; load {loads}):")
     for line in output.splitlines():
         print("  " + line)
