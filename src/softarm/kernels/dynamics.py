@@ -95,19 +95,19 @@ def _inverse_jacobian(a0, a1, a2, sign, out):
 
 
 @_jit
-def _node_rates(z, s, j, props, now, hist_h, coef, out, eps, act, actuation, lengths):
+def _node_rates(z, s, j, props, now, hist_h, coef, out, eps, act, actuation, lengths, tmp):
     """The node's rates (p', u, n', m', q', ω') on piece j (arc length s) with the step's
     history terms ``hist_h`` (ε_h, q_h, ω_h) and loads ``now`` (the statics' channels per
     piece); ``eps`` gets the strain f = (v; u). With actuators (``act``; ``actuation`` =
     the constitutive law's arm and scratch), (n, m) is the total wrench of rod, tendons and
     fluid and the strain solves the actuated law with the damping folded into its
     stiffness (:func:`_law`: K(ε - f⁰) + B ε̇ = (K + c0 B) ε - K f⁰ + B ε_h); ``lengths``
-    gets each tendon's |w| = dℓ/ds."""
+    gets each tendon's |w| = dℓ/ds. ``tmp`` (12,): scratch (no allocation in the step's
+    inner loops: a node's rates are evaluated about 700 times a step with a new Jacobian)."""
     c0 = coef[0]
     pr = props[j]
-    sig = np.empty(6)
-    for k in range(6):
-        sig[k] = z[_DN + k]
+    n0, n1, n2 = z[_DN], z[_DN + 1], z[_DN + 2]
+    m0, m1, m2 = z[_DN + 3], z[_DN + 4], z[_DN + 5]
     actuated = act is not None and _actuated(act, j)
     if act is not None and actuated:
         law_arm, law = actuation[0], actuation[1]
@@ -123,15 +123,15 @@ def _node_rates(z, s, j, props, now, hist_h, coef, out, eps, act, actuation, len
             for k in range(6):
                 acc += Kd[j, i, k] * eps[k]
             f0s[j, i] = acc
-        e0, e1, e2, e3, e4, e5, _ = _law(law_arm, act, j, s, now, law, np.int64(0), sig[0],
-                                         sig[1], sig[2], sig[3], sig[4], sig[5])
+        e0, e1, e2, e3, e4, e5, _ = _law(law_arm, act, j, s, now, law, np.int64(0), n0, n1,
+                                         n2, m0, m1, m2)
         eps[0], eps[1], eps[2], eps[3], eps[4], eps[5] = e0, e1, e2, e3, e4, e5
         for a in range(lengths.size):
             lengths[a] = law[1][a, 3] if act[2][j, a] != 0.0 and act[1][a] == TENDON else 0.0
     else:
-        rhs = np.empty(6)
+        rhs = tmp  # (K + c0 B) ε = σ + K f⁰ - B ε_h
         for i in range(6):
-            acc = sig[i]
+            acc = z[_DN + i]
             for k in range(6):
                 acc += (pr[_PK + 6 * i + k] * pr[_PF0 + k]
                         - pr[_PB + 6 * i + k] * hist_h[k])
@@ -157,8 +157,6 @@ def _node_rates(z, s, j, props, now, hist_h, coef, out, eps, act, actuation, len
     wt0 = c0 * w0 + hist_h[9]
     wt1 = c0 * w1 + hist_h[10]
     wt2 = c0 * w2 + hist_h[11]
-    n0, n1, n2 = sig[0], sig[1], sig[2]
-    m0, m1, m2 = sig[3], sig[4], sig[5]
     # p' = R v
     for i in range(3):
         out[i] = z[_DR + 3 * i] * v0 + z[_DR + 3 * i + 1] * v1 + z[_DR + 3 * i + 2] * v2
@@ -166,7 +164,7 @@ def _node_rates(z, s, j, props, now, hist_h, coef, out, eps, act, actuation, len
     out[4] = u1
     out[5] = u2
     # the loads per length, material: Rᵀ f_d + f_f, Rᵀ l_d + l_f (+ a magnetisation's)
-    fd = np.empty(6)
+    fd, fl = tmp[0:6], tmp[6:12]
     for k in range(3):
         fd[k] = now[j, _FD + k]
         fd[3 + k] = now[j, _LD + k]
@@ -180,7 +178,6 @@ def _node_rates(z, s, j, props, now, hist_h, coef, out, eps, act, actuation, len
             fd[k] += law[2][3, k]
     if act is not None and act[5].shape[0] > 0 and now[j, _CT] != 0.0:
         _moving_contact(z, act[5], act[6][j], now[j, _CT], fd)
-    fl = np.empty(6)
     _mat_t_vec(z, _DR, fd[0], fd[1], fd[2], fl, 0)
     _mat_t_vec(z, _DR, fd[3], fd[4], fd[5], fl, 3)
     for k in range(3):
@@ -298,9 +295,10 @@ def _dyn_residual(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, r, 
     strains and dℓ/ds. Returns the largest |r|."""
     h, node_piece, node_s = grid
     G = Z.shape[0]
+    tmp = np.empty(12)
     for k in range(G):
         _node_rates(Z[k], node_s[k], node_piece[k], props, now, hh[k], coef, rates[k], eps[k],
-                    act, actuation, lengths[k])
+                    act, actuation, lengths[k], tmp)
     lg = np.empty(3)
     jw = np.empty(6)
     worst = 0.0
@@ -363,6 +361,7 @@ def _dyn_jacobian(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, rat
     Ja = np.empty((3, 3))
     Jb = np.empty((3, 3))
     lg = np.empty(3)
+    tmp = np.empty(12)
     # the rates depend on the position p only through loads that depend on where the
     # section is: contact (the penalty's stiffness ∂f/∂p, the largest term of a touching
     # node's Jacobian: without it Newton crept and failed on touchdown, friction or a
@@ -384,7 +383,7 @@ def _dyn_jacobian(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, rat
             else:
                 zp[_DN + c - 6] += d
             _node_rates(zp, node_s[k], node_piece[k], props, now, hh[k], coef, g1, e1, act,
-                        actuation, l1)
+                        actuation, l1, tmp)
             for i in range(DUNK):
                 Gk[k, i, c] = (g1[i] - rates[k, i]) / d
         for i in range(DUNK):
@@ -669,15 +668,14 @@ def _dyn_energies(Z, h, node_piece, props, eps, hh, coef, gravity, out):
             e += 0.5 * wl * (mu * z[_DQ + i] ** 2 + pr[_PRJ + i] * z[_DW + i] ** 2)
             grav -= wl * mu * gravity[i] * z[_DP + i]
         kin = e
-        et = np.empty(6)
         for i in range(6):
-            et[i] = c0 * eps[k, i] + hh[k, i]
-        for i in range(6):
+            de_i = eps[k, i] - pr[_PF0 + i]
+            et_i = c0 * eps[k, i] + hh[k, i]
             for j in range(6):
-                de_i = eps[k, i] - pr[_PF0 + i]
                 de_j = eps[k, j] - pr[_PF0 + j]
+                et_j = c0 * eps[k, j] + hh[k, j]
                 ela += 0.5 * wl * de_i * pr[_PK + 6 * i + j] * de_j
-                power += wl * et[i] * pr[_PB + 6 * i + j] * et[j]
+                power += wl * et_i * pr[_PB + 6 * i + j] * et_j
     out[0] = kin
     out[1] = ela
     out[2] = grav

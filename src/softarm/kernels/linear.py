@@ -174,12 +174,29 @@ def _crossings(old, new, n, work, M, floor):
 
 
 @_jit
-def _band_factor(B, n, kl, piv, Lm):
+def _band_factor(B, n, kl, pivots, Lm):
     """Gaussian elimination with partial pivoting of the band matrix B (n rows; row r holds
     columns r - kl .. r + 2 kl, the last kl for the fill of the row exchanges; the upper
-    width is at most kl) in place: U in B, the multipliers in Lm, the exchanges in piv
-    (LAPACK's gbtrf, written out). Returns the sign of the determinant, 0.0 if singular."""
+    width is at most kl) in place: U in B, the multipliers in Lm, and in ``pivots`` (3, n)
+    the row exchanges (row 0) and the factors' extents (LAPACK's gbtrf, written out, with
+    the extents). Returns the sign of the determinant, 0.0 if singular.
+
+    Design note: the extents. The systems solved here are staircases (the rows of a
+    shooting interval or of a time step's interval touch the unknowns of its two nodes
+    only): half of the band is zero, in L and in U, and stays so. So each row of U keeps the
+    last column it can hold a nonzero in (``pivots[2]``: its own at first, grown by the
+    rows subtracted from it), and each column of L the last row with a nonzero multiplier
+    (``pivots[1]``); elimination and :func:`_band_solve` stop there. Measured on the
+    dynamics' step (40 stations: 708 unknowns, kl = 29): a solve 62 -> 27 µs, a
+    factorisation 620 -> 280 µs (benchmarks/dynamics.py for the step)."""
     sign = 1.0
+    for r in range(n):  # each row's last nonzero column
+        e = r
+        for col in range(min(n - 1, r + 2 * kl), r, -1):
+            if B[r, col - r + kl] != 0.0:
+                e = col
+                break
+        pivots[2, r] = e
     for c in range(n):
         last = min(n - 1, c + kl)
         p = c
@@ -191,43 +208,52 @@ def _band_factor(B, n, kl, piv, Lm):
                 p = r
         if not (best > 0.0 and math.isfinite(best)):
             return 0.0
-        right = min(n - 1, c + 2 * kl)
-        piv[c] = p
+        pivots[0, c] = p
         if p != c:
             sign = -sign
+            right = min(c + 2 * kl, max(pivots[2, c], pivots[2, p]))
             for col in range(c, right + 1):
                 a = B[c, col - c + kl]
                 B[c, col - c + kl] = B[p, col - p + kl]
                 B[p, col - p + kl] = a
+            e = pivots[2, c]
+            pivots[2, c] = pivots[2, p]
+            pivots[2, p] = e
         pivot = B[c, kl]
         if pivot < 0.0:
             sign = -sign
+        right = pivots[2, c]
+        lowest = c
         for r in range(c + 1, last + 1):
             g = B[r, c - r + kl] / pivot
             Lm[c, r - c - 1] = g
             B[r, c - r + kl] = 0.0
             if g != 0.0:
+                lowest = r
                 for col in range(c + 1, right + 1):
                     B[r, col - r + kl] -= g * B[c, col - c + kl]
+                if right > pivots[2, r]:
+                    pivots[2, r] = right
+        pivots[1, c] = lowest
     return sign
 
 
 @_jit
-def _band_solve(B, n, kl, piv, Lm, b):
+def _band_solve(B, n, kl, pivots, Lm, b):
     """b ← A⁻¹ b from :func:`_band_factor`'s factors. False if the result is not finite."""
     for c in range(n):
-        p = piv[c]
+        p = pivots[0, c]
         if p != c:
             a = b[c]
             b[c] = b[p]
             b[p] = a
-        for r in range(c + 1, min(n - 1, c + kl) + 1):
+        for r in range(c + 1, pivots[1, c] + 1):
             b[r] -= Lm[c, r - c - 1] * b[c]
     for c in range(n - 1, -1, -1):
         # four partial sums: one sum's chain of dependent additions is latency bound
         # (measured 88 -> 30 µs a solve of 726 unknowns, kl = 29)
         a0, a1, a2, a3 = b[c], 0.0, 0.0, 0.0
-        last = min(n - 1, c + 2 * kl)
+        last = pivots[2, c]
         col = c + 1
         while col + 3 <= last:
             o = col - c + kl

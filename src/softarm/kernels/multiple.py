@@ -854,10 +854,11 @@ def _motion_entry(y, T, d, r_, which):
 @_jit
 def _ms_work(M, width):
     """Work arrays of the block system with M intervals: F, the band B, G, the interval end
-    states, the tendons' lengths, pivots, multipliers, a step, a motion."""
+    states, the tendons' lengths, pivots (and extents: _band_factor), multipliers, a step, a
+    motion."""
     n = 12 * M - 6
     return (np.empty(n), np.empty((n, 3 * _BAND + 1)), np.empty(n), np.empty((M, width)),
-            np.empty(width - 18), np.empty(n, dtype=np.int64), np.empty((n, _BAND)),
+            np.empty(width - 18), np.empty((3, n), dtype=np.int64), np.empty((n, _BAND)),
             np.empty(n), np.empty(6))
 
 
