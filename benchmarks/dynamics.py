@@ -4,8 +4,8 @@
    Δt = 2 ms, α = -0.2): ``Simulator.step`` (the real-time call) and a trajectory's cost per
    step, against their C++ at -O3 on this machine (tests/data/till_rucker/README.md, built
    and timed by tests/reference_scripts/till_rucker_dynamics.py; their numbers are read from
-   that README, not re-measured here) and against the targets of issue 32 (a cantilever step
-   ≤ 0.15 ms; a 3-tendon robot step ≤ 0.25 ms).
+   that README, not re-measured here) and against the targets of issue 40 (a cantilever step
+   ≤ 60 µs, faster than their C++; a 3-tendon robot step ≤ 200 µs at 41 stations).
 2. One step of benchmarks/actuation.py's 3-tendon robot at tol 1e-6 and Δt = 1 ms, new
    tensions every step, at 41 and 101 stations.
 3. The heavy soft arm swinging over one period (1.5 s) to 1e-3 L of the method-of-lines
@@ -46,8 +46,8 @@ from _mol_rod import load_reference  # noqa: E402
 
 import softarm  # noqa: E402
 
-TARGET_CANTILEVER = 0.15e-3  # s a step (issue 32)
-TARGET_ROBOT = 0.25e-3
+TARGET_CANTILEVER = 60e-6  # s a step (issue 40)
+TARGET_ROBOT = 200e-6
 
 
 def _till_rucker():
@@ -215,7 +215,7 @@ def markdown(steps, swings, peers, batch, theirs, builds=()) -> str:
              "tests/data/till_rucker/README.md): cantilever (N = 40, Δt = 2 ms) "
              f"{theirs['cantilever']} CPU a step; tendon robot (N = 200, Δt = 50 ms) "
              f"{theirs['tendon']}.", "",
-             "| one time step | stations | wall | CPU | issue 32 target |",
+             "| one time step | stations | wall | CPU | issue 40 target |",
              "|---|---|---|---|---|"]
     for what, stations, wall, cpu, target in steps:
         lines.append(f"| {what} | {stations} | {1e6 * wall:.0f} µs | {1e6 * cpu:.0f} µs | "

@@ -646,7 +646,7 @@ class Simulator:
         n = k.DUNK * (self._nodes.size - 1) + 6
         C = B if per_case else 1
         return (np.zeros((C, n, 3 * k._DKL + 1)), np.zeros((C, n, k._DKL)),
-                np.zeros((C, 3, n), dtype=np.int64), np.zeros(C, dtype=np.int64))
+                np.zeros((C, 3, n), dtype=np.int64), np.zeros((C, 2)))
 
     def _advance(self, steps: int, factors, threads: int | None = None, *, arrays,
                  inputs=None):
