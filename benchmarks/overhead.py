@@ -31,8 +31,8 @@ from pathlib import Path
 import numpy as np
 
 import softarm
-from softarm.routing import Straight
 from softarm import kernels
+from softarm.routing import Straight
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from actuation import GRAVITY, OFFSETS, TENSIONS, L, loads, robot

@@ -16,9 +16,13 @@ silicone = softarm.Material(youngs_modulus=1.5e6, poisson_ratio=0.49, density=10
 arm = softarm.Arm(0.2, softarm.Circle(0.01), silicone)
 eq = softarm.solve(arm, [softarm.Gravity(), softarm.TipLoad(force=[0.0, 0.01, 0.0])],
                    method="numeric")
-k = kernels
-# what this process compiled: numba's cache misses per kernel (a load from the cache is a hit)
-print({name: sum(getattr(k, name).stats.cache_misses.values()) for name in sys.argv[1:]})
+# what this process compiled: numba's cache misses per kernel (a load from the cache is a hit),
+# each found by its name in the module of softarm.kernels that defines it
+defined = {}
+for module in [m for n, m in list(sys.modules.items()) if n.startswith("softarm.kernels.")]:
+    defined.update({n: v for n, v in vars(module).items()
+                    if getattr(getattr(v, "py_func", None), "__module__", None) == module.__name__})
+print({name: sum(defined[name].stats.cache_misses.values()) for name in sys.argv[1:]})
 print(repr(eq.tip_position.tolist()))
 """
 

@@ -587,8 +587,8 @@ def test_the_compiled_rotation_log_equals_the_lie_module():
     """The fast route's orientation error is computed in the kernel (``_rotation_log``):
     against ``softarm.lie.so3.log`` on random rotations and at the edges of its three
     branches (θ below 1e-4, θ about 3, θ within 1e-9 of π), to 1e-12 rad."""
-    from softarm.lie import so3
     from softarm import kernels as k
+    from softarm.lie import so3
 
     rng = np.random.default_rng(3)
     axes = rng.normal(size=(40, 3))
