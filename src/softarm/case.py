@@ -569,12 +569,13 @@ def load_case(path: str | os.PathLike) -> Case:
 
 
 def _solver():
-    """``softarm.solve`` that warm-starts each call from the previous one (sweep chunks).
+    """``softarm.solve`` with the arm's preparation kept from one call to the next (sweep
+    chunks).
 
     One prepared :class:`softarm.statics.Solver` per (arm, stations, tol) serves every call
-    through :func:`softarm.dispatch.solve_prepared`: the same routes and checks as
-    ``softarm.solve``, but each chunk of a sweep starts from the last solution of the previous
-    chunk instead of from the unloaded arm.
+    through :func:`softarm.dispatch.solve_prepared`: the same routes, checks and answers as
+    ``softarm.solve`` (every case from the unloaded arm, so a sweep's answers do not depend on
+    how it is cut into chunks); only the arm's preparation is not paid again.
     """
     prepared = {}
 
@@ -594,8 +595,8 @@ def solve_case(case: Case, *, method: str | None = None, stations: int | None = 
                solve: Callable | None = None) -> Equilibrium:
     """Solve a case (every step of its sweep, if it has one).
 
-    A sweep is solved as batched calls of ``softarm.solve`` (warm-started along the batch inside
-    the solver, and from one call to the next). When the first step shows that the whole sweep
+    A sweep is solved as batched calls of ``softarm.solve`` (each case from the unloaded arm,
+    the arm prepared once for all calls). When the first step shows that the whole sweep
     will take more than about a second, the rest is solved in a few consecutive chunks so that
     ``progress(done, total)`` can report; otherwise in one call.
 
@@ -607,8 +608,8 @@ def solve_case(case: Case, *, method: str | None = None, stations: int | None = 
     progress : callable, optional
         Called as ``progress(steps_done, steps_total)`` after each chunk of a long sweep.
     solve : callable, optional
-        The solver, with the signature of ``softarm.solve``; by default ``softarm.solve``
-        warm-started from one call to the next (:func:`_solver`).
+        The solver, with the signature of ``softarm.solve``; by default ``softarm.solve`` on
+        an arm prepared once for all calls (:func:`_solver`).
 
     Returns
     -------
