@@ -483,8 +483,9 @@ class Simulator:
         if initial is not None:
             Z[:, :, k._DN:k._DN + 6] = stresses[:, index]  # (the rod's: a first guess)
             self._settle(loads, Z, H, base0)
-        H[..., 12:24] = H[..., 0:12]
-        H[..., 24:36] = 0.0
+        for o in (0, 36):  # x and its slope in s: the same two steps before, at rest
+            H[..., o + 12:o + 24] = H[..., o:o + 12]
+            H[..., o + 24:o + 36] = 0.0
         return Z, np.stack([Z, Z], axis=1), H, np.zeros((B, 2))
 
     def _check_start(self, eq, s) -> None:

@@ -24,8 +24,12 @@ DYN = 24
 DUNK = 18
 _DYN_HALVINGS = 12  # the most halvings of a damped Newton step (contact, _dyn_newton)
 _DKL = 29  # the band's lower width: rows of interval k meet node k's columns 29 back
-# History per node (DHIST = 36): x = (ε (6), q, ω) at t - Δt, at t - 2Δt, and ẋ at t - Δt.
-DHIST = 36
+# History per node (DHIST = 72): x = (ε (6), q, ω) at t - Δt, at t - 2Δt, and ẋ at t - Δt;
+# then the same of x's slope in s (Hermite's rule needs the history terms' slopes; from the
+# steps' own slopes, so that a settled state's ε̇ = c0 ε + ε_h has the slope zero too: a
+# slope of ε_h by differences on the nodes, O(h²) but multiplied by c0 ~ 1/Δt, made a
+# settled arm creep at 9 µm/s).
+DHIST = 72
 # Per-piece properties (DPROPS): K (36), B (36), (K + c0 B)⁻¹ (36), f⁰ (6), μ (1), ρJ (3).
 # The loads are the statics' channels (PIECE_LOADS + actuators per piece, TIP_LOADS).
 _PK, _PB, _PKD, _PF0, _PMU, _PRJ = 0, 36, 72, 108, 114, 115
@@ -38,6 +42,22 @@ DYN_OK, DYN_NEWTON, DYN_NOT_FINITE, DYN_INADMISSIBLE = 0, 1, 2, 3
 # factorisation costs about ten iterations, an aged factor one more iteration a step for
 # tens of steps (measured: 3.0 -> 2.x iterations a step).
 _DYN_REFRESH = 4
+# The step in s is Hermite's rule, fourth order (issue 40): on an interval of length h,
+#   y_b - y_a = h/2 (f_a + f_b) + h²/12 (f'_a - f'_b)
+# for p, n, m, q, ω (their stored components), and for the frame
+#   log(R_aᵀ R_b) = h/2 (u_a + u_b) + h²/12 (u'_a - u'_b + u_a × u_b)
+# (Magnus' second term, R' = R û; the local error O(h⁵) measured on a frame with quadratic
+# u). f' = df/ds along the solution is a central difference of the node's rates at the
+# node moved along them (_node_slopes), the history terms moved by their own slopes in s
+# (_history_terms: three-point differences within a piece, O(h²), enough for an O(h⁴)
+# scheme since their error is smooth). For f' = λ y the rule is the (2, 2) Padé
+# approximant of e^{λh}: A-stable as the trapezoidal rule was, so any Δt and any kL still
+# solve. Newton keeps the trapezoidal rule's band (a node meets only its intervals' rows):
+# the rule's Jacobian is the trapezoidal one plus ∓h²/12 G² per node (G the node's rates'
+# Jacobian), the change of G along the state left out (a chord iteration anyway).
+# The settled state is then softarm.solve's to O(h⁴) instead of the trapezoidal O(h²).
+_SLOPE_STEP = 1e-3  # the central difference's step in s, in mean spacings
+_TOUCHING = DUNK + 6  # the column of the slopes' array that says a node touches (_hermite)
 
 
 @_jit
@@ -176,8 +196,9 @@ def _node_rates(z, s, j, props, now, hist_h, coef, out, eps, act, actuation, len
         _dipole(z, law[2], np.int64(0), ma0, ma1, ma2, now[j], now[j], law[2][3])
         for k in range(6):
             fd[k] += law[2][3, k]
+    touching = False
     if act is not None and act[5].shape[0] > 0 and now[j, _CT] != 0.0:
-        _moving_contact(z, act[5], act[6][j], now[j, _CT], fd)
+        touching = _moving_contact(z, act[5], act[6][j], now[j, _CT], fd)
     _mat_t_vec(z, _DR, fd[0], fd[1], fd[2], fl, 0)
     _mat_t_vec(z, _DR, fd[3], fd[4], fd[5], fl, 3)
     for k in range(3):
@@ -205,6 +226,7 @@ def _node_rates(z, s, j, props, now, hist_h, coef, out, eps, act, actuation, len
     out[15] = ut0 - (u1 * w2 - u2 * w1)
     out[16] = ut1 - (u2 * w0 - u0 * w2)
     out[17] = ut2 - (u0 * w1 - u1 * w0)
+    return touching
 
 
 @_jit
@@ -215,7 +237,8 @@ def _moving_contact(z, obstacles, params, scale, out):
     point's sliding velocity (its velocity R q + (R ω) × (-r n), less the normal part) and
     w_ε = ``params[4]`` (m/s): sliding where |w| >> w_ε, sticking as a creep of speed
     about w_ε |f_t| / (μ φ) below the friction cone (contact.md). ``params`` = the piece's
-    (r, δ, k, μ, w_ε); ``scale`` the penalty's (the channel CT)."""
+    (r, δ, k, μ, w_ε); ``scale`` the penalty's (the channel CT). Returns whether an
+    obstacle pushes."""
     px, py, pz = z[_DP], z[_DP + 1], z[_DP + 2]
     r, mu, slip = params[0], params[3], params[4]
     # the section's velocity and spin, spatial
@@ -225,12 +248,14 @@ def _moving_contact(z, obstacles, params, scale, out):
     wx = z[_DR] * z[_DW] + z[_DR + 1] * z[_DW + 1] + z[_DR + 2] * z[_DW + 2]
     wy = z[_DR + 3] * z[_DW] + z[_DR + 4] * z[_DW + 1] + z[_DR + 5] * z[_DW + 2]
     wz = z[_DR + 6] * z[_DW] + z[_DR + 7] * z[_DW + 1] + z[_DR + 8] * z[_DW + 2]
+    touching = False
     for k in range(obstacles.shape[0]):
         d, n0, n1, n2, _, _, _, _ = _nearest(px, py, pz, obstacles[k])
         phi, _ = _pressure(d - r, params[1], params[2])
         phi *= scale
         if phi == 0.0:
             continue
+        touching = True
         out[0] += phi * n0
         out[1] += phi * n1
         out[2] += phi * n2
@@ -251,6 +276,7 @@ def _moving_contact(z, obstacles, params, scale, out):
         out[3] += a1 * t2 - a2 * t1
         out[4] += a2 * t0 - a0 * t2
         out[5] += a0 * t1 - a1 * t0
+    return touching
 
 
 @_jit
@@ -286,19 +312,24 @@ def _dyn_column(k, c):
 
 @_jit
 def _dyn_residual(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, r, rates, eps,
-                  lengths):
-    """The scaled residual r (18 (G - 1) + 6) of the step's discrete equations: the
-    trapezoidal rule in s on every interval (a joint of zero length: continuity, n and m
-    jumping by the point wrench at the next piece's start), then the tip's boundary
-    condition. ``grid`` = (interval lengths, piece of each node, s of each node).
-    ``rates`` (G, 18), ``eps`` (G, 6) and ``lengths`` (G, tendons) get each node's rates,
-    strains and dℓ/ds. Returns the largest |r|."""
+                  lengths, slopes):
+    """The scaled residual r (18 (G - 1) + 6) of the step's discrete equations: Hermite's
+    rule in s on every interval (the trapezoidal rule corrected with the rates' slopes,
+    fourth order; above) (a joint of zero length: continuity, n and m jumping by the point
+    wrench at the next piece's start), then the tip's boundary condition. ``grid`` =
+    (interval lengths, piece of each node, s of each node). ``rates`` (G, 18), ``eps`` (G,
+    6) and ``lengths`` (G, tendons) get each node's rates, strains and dℓ/ds, ``slopes``
+    (G, 25) the rates' and the strain's slopes in s and 1.0 where the node touches an
+    obstacle. Returns the largest |r|."""
     h, node_piece, node_s = grid
     G = Z.shape[0]
     tmp = np.empty(12)
     for k in range(G):
-        _node_rates(Z[k], node_s[k], node_piece[k], props, now, hh[k], coef, rates[k], eps[k],
-                    act, actuation, lengths[k], tmp)
+        touching = _node_rates(Z[k], node_s[k], node_piece[k], props, now, hh[k], coef,
+                               rates[k], eps[k], act, actuation, lengths[k], tmp)
+        if touching:  # (kept for the rest of the step: cleared at each step's start)
+            slopes[k, _TOUCHING] = 1.0
+    _node_slopes(Z, grid, props, coef, now, hh, act, actuation, rates, eps, slopes, tmp)
     lg = np.empty(3)
     jw = np.empty(6)
     worst = 0.0
@@ -306,13 +337,22 @@ def _dyn_residual(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, r, 
         za, zb = Z[k], Z[k + 1]
         o = DUNK * k
         hk = h[k]
+        c12 = _hermite(hk, slopes, k)
+        fa, fb, ga, gb = rates[k], rates[k + 1], slopes[k], slopes[k + 1]
         _log_relative(za, zb, lg)
+        # the rotation's Magnus term h²/12 u_a × u_b (R' = R û)
+        x0 = fa[4] * fb[5] - fa[5] * fb[4]
+        x1 = fa[5] * fb[3] - fa[3] * fb[5]
+        x2 = fa[3] * fb[4] - fa[4] * fb[3]
         for i in range(3):
-            r[o + i] = zb[_DP + i] - za[_DP + i] - 0.5 * hk * (rates[k, i] + rates[k + 1, i])
-            r[o + 3 + i] = lg[i] - 0.5 * hk * (rates[k, 3 + i] + rates[k + 1, 3 + i])
+            r[o + i] = (zb[_DP + i] - za[_DP + i] - 0.5 * hk * (fa[i] + fb[i])
+                        - c12 * (ga[i] - gb[i]))
+        r[o + 3] = lg[0] - 0.5 * hk * (fa[3] + fb[3]) - c12 * (ga[3] - gb[3] + x0)
+        r[o + 4] = lg[1] - 0.5 * hk * (fa[4] + fb[4]) - c12 * (ga[4] - gb[4] + x1)
+        r[o + 5] = lg[2] - 0.5 * hk * (fa[5] + fb[5]) - c12 * (ga[5] - gb[5] + x2)
         for i in range(12):
-            r[o + 6 + i] = (zb[_DN + i] - za[_DN + i]
-                            - 0.5 * hk * (rates[k, 6 + i] + rates[k + 1, 6 + i]))
+            r[o + 6 + i] = (zb[_DN + i] - za[_DN + i] - 0.5 * hk * (fa[6 + i] + fb[6 + i])
+                            - c12 * (ga[6 + i] - gb[6 + i]))
         if hk == 0.0:  # a joint: n and m jump by the point wrench at the next piece's start
             _point_wrench(za, now, tip_now, node_piece[k + 1], act, actuation, jw)
             for i in range(6):
@@ -327,6 +367,57 @@ def _dyn_residual(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, r, 
         r[o + i] = (zt[_DN + i] - jw[i]) / S[6 + i]
         worst = max(worst, abs(r[o + i]))
     return worst
+
+
+@_jit
+def _hermite(hk, slopes, k):
+    """Hermite's coefficient h²/12 of interval k; 0 (the trapezoidal rule) where a node
+    of it touches an obstacle, or touched at an iterate of this step: the penalty's rates
+    are not smooth there (their slope jumps at the band's edge, and friction's with the
+    sliding), and Newton, whose Jacobian leaves out the change of the slopes, failed at a
+    touchdown with friction."""
+    if slopes[k, _TOUCHING] != 0.0 or slopes[k + 1, _TOUCHING] != 0.0:
+        return 0.0
+    return hk * hk / 12.0
+
+
+@_jit
+def _node_slopes(Z, grid, props, coef, now, hh, act, actuation, rates, eps, slopes, tmp):
+    """slopes[k] = the derivative in s of node k's rates (18) and strain (6, ``eps``) along
+    the solution: a central difference of :func:`_node_rates` at the node's state moved
+    by ±ε times its own rates (R by exp(±ε u)), its arc length by ±ε and its history terms
+    by ±ε times their slopes (``hh[:, 12:]``), ε = _SLOPE_STEP × the mean spacing. (A
+    forward difference left Newton a floor of 1e-11 in the residual, the rounding of
+    terms such as c0 q over a step of 1e-4 spacings.)"""
+    _, node_piece, node_s = grid
+    G = Z.shape[0]
+    zp = np.empty(DYN)
+    fm = np.empty(DUNK)
+    e1 = np.empty(6)
+    em = np.empty(6)
+    l1 = np.empty(max(1, 0 if act is None else act[0].shape[0]))
+    hp = np.empty(12)
+    step = _SLOPE_STEP * (node_s[G - 1] - node_s[0]) / max(G - 1, 1)
+    for k in range(G):
+        z, f, g = Z[k], rates[k], slopes[k]
+        for side in range(2):
+            e = step if side == 0 else -step
+            for i in range(DYN):
+                zp[i] = z[i]
+            for i in range(3):
+                zp[_DP + i] += e * f[i]
+            for i in range(12):
+                zp[_DN + i] += e * f[6 + i]
+            _rotated(zp, e * f[3], e * f[4], e * f[5], zp)
+            for i in range(12):
+                hp[i] = hh[k, i] + e * hh[k, 12 + i]
+            _node_rates(zp, node_s[k] + e, node_piece[k], props, now, hp, coef,
+                        g if side == 0 else fm, e1 if side == 0 else em, act, actuation, l1,
+                        tmp)
+        for i in range(DUNK):
+            g[i] = (g[i] - fm[i]) / (2.0 * step)
+        for i in range(6):
+            g[DUNK + i] = (e1[i] - em[i]) / (2.0 * step)
 
 
 @_jit
@@ -345,12 +436,14 @@ def _magnetised(act):
 
 
 @_jit
-def _dyn_jacobian(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, rates, Gk, Bm,
-                  kl):
-    """The scaled Jacobian of :func:`_dyn_residual` in band storage (``rates`` as the
-    residual left them). Each node's ∂(rates)/∂(unknowns) by forward differences; the
-    rotation of the point wrenches at the joints and the tip is exact for the dead channels
-    (a dipole's own turning is left out: the iteration is a chord iteration anyway)."""
+def _dyn_jacobian(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, rates, slopes,
+                  Gk, G2, Bm, kl):
+    """The scaled Jacobian of :func:`_dyn_residual` in band storage (``rates`` and
+    ``slopes`` as the residual left them). Each node's ∂(rates)/∂(unknowns) G by forward
+    differences, and the slopes' G² (``G2``, Hermite's term); the rotation of the point
+    wrenches at the joints and the tip is exact for the dead channels (a dipole's own
+    turning and the change of G along the state are left out: the iteration is a chord
+    iteration anyway)."""
     h, node_piece, node_s = grid
     G = Z.shape[0]
     Bm[:, :] = 0.0
@@ -389,11 +482,20 @@ def _dyn_jacobian(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, rat
         for i in range(DUNK):
             for c in range(first):
                 Gk[k, i, c] = 0.0
+        for i in range(DUNK):  # G² (G is sparse: the products of its nonzeros)
+            for c in range(DUNK):
+                G2[k, i, c] = 0.0
+            for m in range(DUNK):
+                g = Gk[k, i, m]
+                if g != 0.0:
+                    for c in range(DUNK):
+                        G2[k, i, c] += g * Gk[k, m, c]
     jw = np.empty(6)
     for k in range(G - 1):
         za, zb = Z[k], Z[k + 1]
         row0 = DUNK * k
         hk = h[k]
+        c12 = _hermite(hk, slopes, k)
         _log_relative(za, zb, lg)
         _inverse_jacobian(lg[0], lg[1], lg[2], -1.0, Ja)
         _inverse_jacobian(lg[0], lg[1], lg[2], 1.0, Jb)
@@ -405,7 +507,7 @@ def _dyn_jacobian(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, rat
                     continue
                 col = _dyn_column(node, c)
                 for i in range(DUNK):
-                    v = -0.5 * hk * Gk[node, i, c]
+                    v = -0.5 * hk * Gk[node, i, c] + sgn * c12 * G2[node, i, c]
                     if 3 <= i < 6 and 3 <= c < 6:
                         v += (Jb[i - 3, c - 3] if side == 1 else -Ja[i - 3, c - 3])
                     elif i == c and not (3 <= i < 6):
@@ -579,7 +681,7 @@ def _dyn_newton(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, tol, 
     again (one Newton solve and residual fewer a step: 2.2 -> 1.6 iterations on Till &
     Rucker's cantilever)."""
     Bm, Lm, piv, valid = factors
-    r, dx, rates, eps, lengths, Gk = work
+    r, dx, rates, eps, lengths, Gk, slopes, G2 = work
     n = r.size
     last = math.inf
     factored = 0
@@ -590,14 +692,14 @@ def _dyn_newton(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, tol, 
     before_step = np.empty((Z.shape[0], Z.shape[1]) if damped else (1, 1))
     merit_before = 0.0
     worst = _dyn_residual(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, r, rates,
-                          eps, lengths)
+                          eps, lengths, slopes)
     for it in range(max_iter):
         if not math.isfinite(worst):
             return DYN_NOT_FINITE, worst, it, factored
         fresh = valid[0] == 0
         if valid[0] == 0:
-            _dyn_jacobian(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, rates, Gk,
-                          Bm, kl)
+            _dyn_jacobian(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, rates,
+                          slopes, Gk, G2, Bm, kl)
             if _band_factor(Bm, n, kl, piv, Lm) == 0.0:
                 return DYN_NEWTON, worst, it, factored
             valid[0] = 1
@@ -617,7 +719,7 @@ def _dyn_newton(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, tol, 
         _dyn_apply(Z, dx, S)
         before = worst
         worst = _dyn_residual(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, r,
-                              rates, eps, lengths)
+                              rates, eps, lengths, slopes)
         halvings = 0
         if damped and fresh:  # (merit: the residual's 2-norm; the max norm can stall)
             merit = _sum_squares(r)
@@ -629,7 +731,7 @@ def _dyn_newton(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, tol, 
                 step *= 0.5
                 _dyn_apply(Z, dx, S)
                 worst = _dyn_residual(Z, grid, props, coef, S, now, tip_now, hh, act,
-                                      actuation, r, rates, eps, lengths)
+                                      actuation, r, rates, eps, lengths, slopes)
                 merit = _sum_squares(r)
         # converged when the residual is below tol and so is the error left, estimated
         # from the contraction ρ of the last two corrections: ρ/(1 - ρ) × this one
@@ -645,11 +747,13 @@ def _dyn_newton(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, tol, 
 
 @_jit
 def _dyn_history_terms(H, coef, hh):
-    """x_h = c1 x(t-Δt) + c2 x(t-2Δt) + d1 ẋ(t-Δt) for x = (ε, q, ω) at every node."""
+    """x_h = c1 x(t-Δt) + c2 x(t-2Δt) + d1 ẋ(t-Δt) for x = (ε, q, ω) at every node
+    (hh[:, :12]), and the same of their slopes in s (hh[:, 12:], from H[:, 36:])."""
     c1, c2, d1 = coef[1], coef[2], coef[3]
     for k in range(H.shape[0]):
-        for i in range(12):
-            hh[k, i] = c1 * H[k, i] + c2 * H[k, 12 + i] + d1 * H[k, 24 + i]
+        for i in range(24):
+            o = 36 * (i // 12) + i % 12
+            hh[k, i] = c1 * H[k, o] + c2 * H[k, o + 12] + d1 * H[k, o + 24]
 
 
 @_jit
@@ -759,9 +863,10 @@ def dynamic_steps(Z, Zold, H, aux, props, loads, tip, grid, coef, S, options, ba
     n = DUNK * (G - 1) + 6
     A = 1 if act is None else max(1, act[0].shape[0])
     work = (np.empty(n), np.empty(n), np.empty((G, DUNK)), np.empty((G, 6)),
-            np.zeros((G, A)), np.empty((G, DUNK, DUNK)))
-    eps, lengths = work[3], work[4]
-    hh = np.empty((G, 12))
+            np.zeros((G, A)), np.empty((G, DUNK, DUNK)), np.empty((G, DUNK + 7)),
+            np.empty((G, DUNK, DUNK)))
+    eps, lengths, rates, slopes = work[3], work[4], work[2], work[6]
+    hh = np.empty((G, 24))  # the history terms and their slopes in s
     Zw = np.empty((G, DYN))
     Zp = np.empty((G, DYN))
     en = np.empty(4)
@@ -808,6 +913,8 @@ def dynamic_steps(Z, Zold, H, aux, props, loads, tip, grid, coef, S, options, ba
                 for i in range(3):
                     Zp[k, i] = Zw[k, _DP + i]  # (the predicted centreline)
             _set_base(Zw, base[bb, t])
+            for k in range(G):
+                slopes[k, _TOUCHING] = 0.0
             code, res, its, nf = _dyn_newton(Zw, grid, props, coef, S, now, tip_now, hh, act,
                                              actuation, tol, max_iter, fac, kl, work)
             if code != DYN_OK and act is not None and act[5].shape[0] > 0:
@@ -854,11 +961,15 @@ def dynamic_steps(Z, Zold, H, aux, props, loads, tip, grid, coef, S, options, ba
                     Zold[b, 1, k, i] = Zold[b, 0, k, i]
                     Zold[b, 0, k, i] = Z[b, k, i]
                     Z[b, k, i] = Zw[k, i]
-                for i in range(12):
-                    x = eps[k, i] if i < 6 else Zw[k, _DQ + i - 6]
-                    H[b, k, 12 + i] = H[b, k, i]
-                    H[b, k, i] = x
-                    H[b, k, 24 + i] = c0 * x + hh[k, i]
+                for i in range(24):  # x = (ε, q, ω), then its slope (ε', q', ω')
+                    if i < 12:
+                        x = eps[k, i] if i < 6 else Zw[k, _DQ + i - 6]
+                    else:
+                        x = slopes[k, DUNK + i - 12] if i < 18 else rates[k, i - 6]
+                    o = 36 * (i // 12) + i % 12
+                    H[b, k, o + 12] = H[b, k, o]
+                    H[b, k, o] = x
+                    H[b, k, o + 24] = c0 * x + hh[k, i]
             _dyn_energies(Zw, h, node_piece, props, eps, hh, coef, gravity[b], en)
             aux[b, 0] += 0.5 * (aux[b, 1] + en[3]) * coef[4]
             aux[b, 1] = en[3]
