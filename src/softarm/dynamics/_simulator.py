@@ -438,12 +438,15 @@ class Simulator:
         on this grid (:meth:`_settle`)."""
         k = kernels
         B = int(np.prod(self.shape))
+        self._initial_lengths = None  # the tendons' lengths at the start, where known
         if isinstance(initial, State):
             if initial._signature != self._signature:
                 raise ValueError("initial: this State belongs to another simulation (its arm, "
                                  "stations, dt, alpha, actuators or batch shape differ)")
             self.t0 = initial.time
             self._starts_at_rest = initial._fresh
+            if initial.tendon_lengths is not None:
+                self._initial_lengths = np.reshape(initial.tendon_lengths, (B, -1)).copy()
             return tuple(a.copy() for a in initial._arrays)
         if initial is not None and not isinstance(initial, Equilibrium):
             raise TypeError("initial must be None, a softarm.Equilibrium or a "
@@ -582,13 +585,18 @@ class Simulator:
                  (("p", 3), ("R", 9), ("v", 3), ("w", 3), ("e", 6), ("s", 6))}
         info, done = np.zeros((B, 1, 4)), np.zeros(B, dtype=np.int64)
         options = np.array([min(self.tol, 1e-9), 4 * MAX_ITERATIONS])
+        tendons = None  # (their lengths by the steps' own rule: _tendon_lengths' is O(h²))
+        if self._tendon_columns.size:
+            tendons = np.zeros((B, 1, act[0].shape[0]))
         k.dynamic_steps(Z, np.stack([Z, Z], axis=1), H, np.zeros((B, 2)), props,
                         np.ascontiguousarray(piece.reshape(B, P, -1)),
                         np.ascontiguousarray(tip.reshape(B, -1)), self._grid, coef,
                         self._scales, options, base, self._gravity, self._at, 0, B,
                         self._storage(False, 1), dummy["p"], dummy["R"], dummy["v"],
                         dummy["w"], dummy["e"], dummy["s"], np.zeros((B, 1, 4)), info, done,
-                        act, self._actuation(pieces, props, act), None, None)
+                        act, self._actuation(pieces, props, act), None, tendons)
+        if tendons is not None:
+            self._initial_lengths = tendons[:, 0, self._tendon_columns]
         if np.any(done < 1):
             b = int(np.flatnonzero(done < 1)[0])
             raise ConvergenceError("initial: the Equilibrium's loads could not be balanced "
@@ -597,7 +605,10 @@ class Simulator:
 
     def _tendon_lengths(self, H) -> np.ndarray | None:
         """(B, tendons): each tendon's length ∫ |v + u × r + r'| ds (the trapezoidal rule on
-        the nodes, as the steps' lengths) for the strains in H, or None without tendons."""
+        the nodes) for the strains in H, or None without tendons: the unloaded start's (a
+        settled start and the steps take Hermite's rule in the kernel, fourth order; the
+        two agree where |w| is constant along a piece, as on an unloaded arm with straight
+        or helical paths)."""
         if not self._tendon_columns.size:
             return None
         k = kernels
@@ -623,7 +634,7 @@ class Simulator:
         self._arrays = tuple(a.copy() for a in self._initial)
         self.time = self.t0
         self._q = self.inputs[None].copy() if self.actuators else None  # (C, n)
-        self._lengths_now = None  # the tendons' lengths of the current state, if known
+        self._lengths_now = self._initial_lengths  # the current state's, if known
         #: (case index, time the failed step would have reached (s), residual) of every
         #: case that failed in a run(failures="keep")
         self.failures = []
