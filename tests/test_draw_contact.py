@@ -104,7 +104,7 @@ def test_a_trajectory_picture_draws_the_obstacles_forces_and_contact_energy(tmp_
 
     pin = softarm.Capsule((0.3, -0.1, -0.04), (0.3, 0.1, -0.04), 0.01)
     path = softarm.simulate(ARM, [softarm.Gravity(), softarm.Contact([OBSTACLES[0], pin])],
-                            duration=0.12, dt=1e-3, stations=51)
+                            duration=0.11, dt=1e-3, stations=51)  # (on the table at the end)
     fig = plot.plot_trajectory(path, path=tmp_path / "drop.png")
     side, energy = fig.axes[0], fig.axes[2]  # (fig.axes[1]: the tip; [3]: the colour bar)
     gids = [a.get_gid() for a in side.get_children() if a.get_gid()]

@@ -111,11 +111,13 @@ def _node_bytes() -> tuple[int, int]:
     (the initial state, the current one, a step's working copy, the last and the new
     State's, their stacks and temporaries) with the outputs at the stations (30 numbers,
     twice); the banded Jacobian's rows (DUNK a node: 3 KL + 1 columns of the band, KL of
-    the multipliers, a pivot). Measured (tracemalloc and the peak resident memory): 24.5 kB
-    a node over the steps of one case, 1.8 kB after construction (tests/test_memory.py)."""
+    the multipliers, a pivot) and Hermite's work (a node's G², DUNK², and its slopes,
+    DUNK + 7). Measured (tracemalloc and the peak resident memory): 24.5 kB a node over the
+    steps of one case, 1.8 kB after construction (tests/test_memory.py; before Hermite's
+    rule, issue 40)."""
     k = kernels
     state = 8 * (9 * (3 * k.DYN + k.DHIST) + 2 * 30)
-    storage = 8 * k.DUNK * ((3 * k._DKL + 1) + k._DKL + 1)
+    storage = 8 * (k.DUNK * ((3 * k._DKL + 1) + k._DKL + 1) + k.DUNK * k.DUNK + k.DUNK + 7)
     return state, storage
 
 
