@@ -47,16 +47,19 @@ _DYN_REFRESH = 4
 # for p, n, m, q, ω (their stored components), and for the frame
 #   log(R_aᵀ R_b) = h/2 (u_a + u_b) + h²/12 (u'_a - u'_b + u_a × u_b)
 # (Magnus' second term, R' = R û; the local error O(h⁵) measured on a frame with quadratic
-# u). f' = df/ds along the solution is a central difference of the node's rates at the
-# node moved along them (_node_slopes), the history terms moved by their own slopes in s
-# (_history_terms: three-point differences within a piece, O(h²), enough for an O(h⁴)
-# scheme since their error is smooth). For f' = λ y the rule is the (2, 2) Padé
-# approximant of e^{λh}: A-stable as the trapezoidal rule was, so any Δt and any kL still
-# solve. Newton keeps the trapezoidal rule's band (a node meets only its intervals' rows):
-# the rule's Jacobian is the trapezoidal one plus ∓h²/12 G² per node (G the node's rates'
-# Jacobian), the change of G along the state left out (a chord iteration anyway).
-# The settled state is then softarm.solve's to O(h⁴) instead of the trapezoidal O(h²).
+# u). f' = df/ds along the solution is a difference of the node's rates at the node moved
+# along them, its history terms moved by their own slopes (_node_slopes; forward, or
+# central for a tol below 1e-9). Those slopes are the history's own (DHIST, below): the
+# slopes of x = (ε, q, ω) found at the steps before. For f' = λ y the rule is the (2, 2)
+# Padé approximant of e^{λh}: A-stable as the trapezoidal rule was, so any Δt and any kL
+# still solve. Newton keeps the trapezoidal rule's band (a node meets only its intervals'
+# rows): the rule's Jacobian is the trapezoidal one plus ∓h²/12 G² per node (G the node's
+# rates' Jacobian), the change of G along the state left out (a chord iteration anyway).
+# The settled state is softarm.solve's to O(h⁴) instead of the trapezoidal O(h²). A step
+# in which the arm touches an obstacle takes the trapezoidal rule (_hermite).
 _SLOPE_STEP = 1e-3  # the central difference's step in s, in mean spacings
+_SLOPE_STEP_FORWARD = 1e-4  # the forward difference's (_node_slopes)
+_CENTRAL_BELOW = 1e-9  # Newton's tol below which the slopes take central differences
 _TRAPEZOID = DUNK + 6  # the slopes' column that asks for the trapezoidal rule (_hermite)
 
 
@@ -312,7 +315,7 @@ def _dyn_column(k, c):
 
 @_jit
 def _dyn_residual(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, r, rates, eps,
-                  lengths, slopes):
+                  lengths, slopes, central):
     """The scaled residual r (18 (G - 1) + 6) of the step's discrete equations: Hermite's
     rule in s on every interval (the trapezoidal rule corrected with the rates' slopes,
     fourth order; above) (a joint of zero length: continuity, n and m jumping by the point
@@ -338,8 +341,8 @@ def _dyn_residual(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, r, 
             for a in range(lengths[1].shape[1]):
                 lengths[1][k, a] = 0.0
     else:
-        _node_slopes(Z, grid, props, coef, now, hh, act, actuation, rates, eps, slopes,
-                     lengths[1], tmp)
+        _node_slopes(Z, grid, props, coef, now, hh, act, actuation, rates, eps, lengths[0],
+                     slopes, lengths[1], central, tmp)
     lg = np.empty(3)
     jw = np.empty(6)
     worst = 0.0
@@ -395,15 +398,17 @@ def _hermite(hk, slopes, k):
 
 
 @_jit
-def _node_slopes(Z, grid, props, coef, now, hh, act, actuation, rates, eps, slopes, lslopes,
-                 tmp):
+def _node_slopes(Z, grid, props, coef, now, hh, act, actuation, rates, eps, lengths0, slopes,
+                 lslopes, central, tmp):
     """slopes[k] = the derivative in s of node k's rates (18) and strain (6, ``eps``), and
-    lslopes[k] that of its tendons' dℓ/ds, along the solution: a central difference of
-    :func:`_node_rates` at the node's state moved by ±ε times its own rates (R by
-    exp(±ε u)), its arc length by ±ε and its history terms by ±ε times their slopes
-    (``hh[:, 12:]``), ε = _SLOPE_STEP × the mean spacing. (A forward difference left
-    Newton a floor of 1e-11 in the residual, the rounding of terms such as c0 q over a step
-    of 1e-4 spacings.)"""
+    lslopes[k] that of its tendons' dℓ/ds, along the solution: a difference of
+    :func:`_node_rates` at the node's state moved by ε times its own rates (R by exp(ε u)),
+    its arc length by ε and its history terms by ε times their slopes (``hh[:, 12:]``):
+    central (±ε, ε = _SLOPE_STEP mean spacings) if ``central``, else forward (ε =
+    _SLOPE_STEP_FORWARD mean spacings, one evaluation fewer: 1/3 of the residual's cost,
+    2/3 of the slopes', but a floor of about 1e-11 in Newton's scaled residual, the
+    rounding of terms such as c0 q over that step: _dyn_newton asks for central
+    differences below a tol of _CENTRAL_BELOW)."""
     _, node_piece, node_s = grid
     G = Z.shape[0]
     zp = np.empty(DYN)
@@ -414,10 +419,11 @@ def _node_slopes(Z, grid, props, coef, now, hh, act, actuation, rates, eps, slop
     l1 = np.zeros(A)
     lm = np.zeros(A)
     hp = np.empty(12)
-    step = _SLOPE_STEP * (node_s[G - 1] - node_s[0]) / max(G - 1, 1)
+    spacing = (node_s[G - 1] - node_s[0]) / max(G - 1, 1)
+    step = (_SLOPE_STEP if central else _SLOPE_STEP_FORWARD) * spacing
     for k in range(G):
         z, f, g = Z[k], rates[k], slopes[k]
-        for side in range(2):
+        for side in range(2 if central else 1):
             e = step if side == 0 else -step
             for i in range(DYN):
                 zp[i] = z[i]
@@ -431,12 +437,20 @@ def _node_slopes(Z, grid, props, coef, now, hh, act, actuation, rates, eps, slop
             _node_rates(zp, node_s[k] + e, node_piece[k], props, now, hp, coef,
                         g if side == 0 else fm, e1 if side == 0 else em, act, actuation,
                         l1 if side == 0 else lm, tmp)
+        if not central:  # (the other end of the difference: the node itself)
+            for i in range(DUNK):
+                fm[i] = f[i]
+            for i in range(6):
+                em[i] = eps[k, i]
+            for a in range(lm.size):
+                lm[a] = lengths0[k, a]
+        width = 2.0 * step if central else step
         for i in range(DUNK):
-            g[i] = (g[i] - fm[i]) / (2.0 * step)
+            g[i] = (g[i] - fm[i]) / width
         for i in range(6):
-            g[DUNK + i] = (e1[i] - em[i]) / (2.0 * step)
+            g[DUNK + i] = (e1[i] - em[i]) / width
         for a in range(lslopes.shape[1]):
-            lslopes[k, a] = (l1[a] - lm[a]) / (2.0 * step)
+            lslopes[k, a] = (l1[a] - lm[a]) / width
         g[_TRAPEZOID] = 0.0
 
 
@@ -706,6 +720,7 @@ def _dyn_newton(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, tol, 
     Rucker's cantilever)."""
     Bm, Lm, piv, valid = factors
     r, dx, rates, eps, lengths, Gk, slopes, G2 = work
+    central = tol < _CENTRAL_BELOW
     n = r.size
     last = math.inf
     factored = 0
@@ -716,7 +731,7 @@ def _dyn_newton(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, tol, 
     before_step = np.empty((Z.shape[0], Z.shape[1]) if damped else (1, 1))
     merit_before = 0.0
     worst = _dyn_residual(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, r, rates,
-                          eps, lengths, slopes)
+                          eps, lengths, slopes, central)
     for it in range(max_iter):
         if not math.isfinite(worst):
             return DYN_NOT_FINITE, worst, it, factored
@@ -743,7 +758,7 @@ def _dyn_newton(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, tol, 
         _dyn_apply(Z, dx, S)
         before = worst
         worst = _dyn_residual(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, r,
-                              rates, eps, lengths, slopes)
+                              rates, eps, lengths, slopes, central)
         halvings = 0
         if damped and fresh:  # (merit: the residual's 2-norm; the max norm can stall)
             merit = _sum_squares(r)
@@ -755,7 +770,7 @@ def _dyn_newton(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, tol, 
                 step *= 0.5
                 _dyn_apply(Z, dx, S)
                 worst = _dyn_residual(Z, grid, props, coef, S, now, tip_now, hh, act,
-                                      actuation, r, rates, eps, lengths, slopes)
+                                      actuation, r, rates, eps, lengths, slopes, central)
                 merit = _sum_squares(r)
         # converged when the residual is below tol and so is the error left, estimated
         # from the contraction ρ of the last two corrections: ρ/(1 - ρ) × this one
