@@ -7,10 +7,12 @@
    that README, not re-measured here) and against the targets of issue 40 (a cantilever step
    ≤ 60 µs, faster than their C++; a 3-tendon robot step ≤ 200 µs at 41 stations).
 2. One step of benchmarks/actuation.py's 3-tendon robot at tol 1e-6 and Δt = 1 ms, new
-   tensions every step, at 41 and 101 stations.
-3. The heavy soft arm swinging over one period (1.5 s) to 1e-3 L of the method-of-lines
-   reference (tests/_mol_rod.py): softarm's cheapest setting that reaches it, beside
-   PyElastica's settings (benchmarks/dynamics_pyelastica.py; none of them reaches it).
+   tensions every step, at 41 and 101 stations; and its accuracy in s per cost (21 and 41
+   stations against 161, :func:`robot_accuracy`).
+3. The heavy soft arm swinging over one period (1.5 s) against the method-of-lines
+   reference (tests/_mol_rod.py, its own error 2e-5 L): softarm's settings down to 1e-4 L
+   (fourth order in s since issue 40, so Δt's error dominates from 26 stations on), beside
+   PyElastica's settings (benchmarks/dynamics_pyelastica.py; none of them reaches 1e-3 L).
 4. Throughput: a batch of trajectories of 1 s at Δt = 1 ms, all cases in each call (threads
    over the cores), run in chunks of steps of which only the tips are kept (1000
    trajectories whole would take 30 GB), and the projection to a Dask cluster of W workers.
@@ -144,6 +146,30 @@ def swing(settings, repeats: int) -> list[tuple]:
     return rows
 
 
+def robot_accuracy(counts=(21, 41), reference: int = 161, steps: int = 300) -> list[tuple]:
+    """Rows (stations, CPU µs a step, tip error m): the 3-tendon robot pulled over 0.3 s
+    (tensions ramped in 50 steps, Δt = 1 ms, tol 1e-8), its tip at the end against the same
+    run on ``reference`` stations (the time step's error is the same on every grid: the
+    difference is the error in s)."""
+    robot = actuation.robot()
+    tendons = actuation.loads(np.zeros(3))[1:]
+    schedule = [actuation.TENSIONS * min(1.0, k / 50) for k in range(steps + 1)]
+    tips, rows = {}, []
+    for stations in (*counts, reference):
+        sim = softarm.Simulator(robot, tendons, [softarm.Gravity(actuation.GRAVITY)], dt=1e-3,
+                                stations=stations, tol=1e-8,
+                                damping=softarm.Damping(retardation=0.01))
+        sim.step(schedule[0])
+        c0 = time.process_time()
+        for q in schedule[1:]:
+            state = sim.step(q)
+        cpu = (time.process_time() - c0) / steps
+        tips[stations] = state.positions[-1]
+        rows.append((stations, cpu))
+    return [(n, cpu, float(np.abs(tips[n] - tips[reference]).max())) for n, cpu in rows
+            if n != reference]
+
+
 def pyelastica_rows() -> list[tuple]:
     """PyElastica's settings on the same swing (benchmarks/dynamics_pyelastica.py)."""
     import dynamics_pyelastica as pe
@@ -208,7 +234,7 @@ def construction(counts) -> list[tuple]:
     return rows
 
 
-def markdown(steps, swings, peers, batch, theirs, builds=()) -> str:
+def markdown(steps, swings, peers, batch, theirs, builds=(), accuracy=()) -> str:
     lines = ["## Dynamics", "",
              "`python benchmarks/dynamics.py`: best of several runs after a warm-up, CPU time "
              "beside wall time. Till & Rucker's C++ (-O3, this machine, "
@@ -220,6 +246,11 @@ def markdown(steps, swings, peers, batch, theirs, builds=()) -> str:
     for what, stations, wall, cpu, target in steps:
         lines.append(f"| {what} | {stations} | {1e6 * wall:.0f} µs | {1e6 * cpu:.0f} µs | "
                      f"≤ {1e6 * target:.0f} µs: {'met' if wall <= target else 'NOT met'} |")
+    if accuracy:
+        lines += ["", "The 3-tendon robot pulled over 0.3 s (tol 1e-8): its tip against a "
+                  "161-station run (the error in s) and the cost of a step:", "",
+                  "| stations | CPU a step | tip error |", "|---|---|---|"]
+        lines += [f"| {n} | {1e6 * cpu:.0f} µs | {error:.1e} m |" for n, cpu, error in accuracy]
     lines += ["", "The heavy soft arm swinging for 1.5 s (one period), tip error against the "
               "method-of-lines reference:", "",
               "| tool | setting | max tip error | wall | CPU |", "|---|---|---|---|---|"]
@@ -253,8 +284,12 @@ def measure(quick: bool, with_pyelastica: bool = False) -> str:
     for row in steps:
         print(f"  step: {row[0]} ({row[1]} stations): {1e6 * row[2]:.0f} µs wall, "
               f"{1e6 * row[3]:.0f} µs CPU", flush=True)
-    settings = [(51, 1e-3)] if quick else [(26, 2e-3), (41, 2e-3), (51, 1e-3), (101, 2e-3),
-                                           (101, 1e-3), (151, 1e-3)]
+    accuracy = robot_accuracy()
+    for stations, cpu, error in accuracy:
+        print(f"  robot accuracy: {stations} stations: {1e6 * cpu:.0f} µs CPU a step, tip "
+              f"{error:.1e} m from 161 stations", flush=True)
+    settings = [(26, 1e-3)] if quick else [(26, 2e-3), (26, 1e-3), (26, 5e-4), (26, 2.5e-4),
+                                           (41, 2.5e-4), (101, 1e-3)]
     swings = swing(settings, repeats)
     for row in swings:
         print(f"  swing: {row[0]} stations, dt {row[1]:g}: error {row[2]:.1e} L, "
@@ -266,7 +301,7 @@ def measure(quick: bool, with_pyelastica: bool = False) -> str:
                           (1000, 10_000, 100_000, 400_000))
     for stations, wall, cpu in builds:
         print(f"  build: {stations} stations: {wall:.3f} s wall, {cpu:.3f} s CPU", flush=True)
-    return markdown(steps, swings, peers, batch, their_costs(), builds)
+    return markdown(steps, swings, peers, batch, their_costs(), builds, accuracy)
 
 
 def main(argv=None) -> int:

@@ -164,9 +164,9 @@ class Simulator:
     loop of a controller or an estimator.
 
     Each step of Δt discretises the rod's equations of motion in time by BDF-α and solves
-    the resulting boundary value problem in s (the trapezoidal rule on the stations, all
-    nodes' states solved together by Newton on a banded system), warm-started from the
-    last step (docs/dynamics.md).
+    the resulting boundary value problem in s (Hermite's rule on the stations, fourth
+    order, all nodes' states solved together by Newton on a banded system), warm-started
+    from the last step (docs/dynamics.md).
 
     Parameters
     ----------
@@ -192,7 +192,8 @@ class Simulator:
         velocity is taken by central differences).
     stations : int
         Uniform stations on [0, L] (≥ 3): the grid of the step's equations (its error is of
-        second order in L/stations) and the outputs.
+        fourth order in L/stations; second in a step that touches an obstacle) and the
+        outputs.
     tol : float
         Newton tolerance of each step, relative (positions in L).
     alpha : float
@@ -562,7 +563,7 @@ class Simulator:
         at rest on this grid: the equations
         of a step without inertia (c0 = 0: no time derivative), by Newton from the solver's
         answer. The same discretisation as the steps, so the arm starts at rest to tol
-        (the solver's own answer differs from it by the grid's O(h²) error), and the
+        (the solver's own answer differs from it by the grid's O(h⁴) error), and the
         total wrench of rod and actuators is the state's."""
         k = kernels
         _, shape, _, pieces, channels = self._solver._prepare(loads, tuple(self._pieces[0]))
