@@ -42,6 +42,37 @@ def test_a_damped_drop_comes_to_rest_at_the_static_answer():
     assert path.gaps[0].min() > 0.03 and path.gaps[-1].min() < law.distance
 
 
+@pytest.mark.slow  # (~8 s)
+def test_an_arm_lifted_off_a_table_settles_as_if_it_had_never_touched():
+    """Issue 40: a step that touches takes the trapezoidal rule, the others Hermite's; the
+    history keeps the slopes in s through the contact, so that after it the arm settles as
+    the same motion without the table does (a history without them leaves ε̇'s slope off).
+    The base dips the arm onto a table 3 cm under its sag and lifts it off again."""
+    arm = sa.Arm(0.3, sa.Circle(0.01),
+                 sa.Material(youngs_modulus=1e6, poisson_ratio=0.5, density=1100.0))
+    low = sa.solve(arm, [sa.Gravity()], s=26).positions[:, 2].min()
+    table = sa.Contact(sa.Plane((0.0, 0.0, low - 0.03), (0.0, 0.0, 1.0)))
+
+    def base(t):
+        pose = np.eye(4)
+        pose[2, 3] = -0.06 * min(t / 0.2, 1.0, max((0.6 - t) / 0.2, 0.0))
+        return pose
+
+    ends = []
+    for loads in ([sa.Gravity(), table], [sa.Gravity()]):
+        path = sa.simulate(arm, loads, duration=12.0, dt=4e-3, stations=26, base=base,
+                           damping=sa.Damping(retardation=0.3), tol=1e-10)
+        ends.append(path.positions[-1])
+        touching = np.linalg.norm(path.contact_forces, axis=-1).max(axis=-1) > 0 \
+            if path.contact_forces is not None else np.zeros(1, dtype=bool)
+        assert touching.any() == (len(loads) == 2)  # (it touched, and lifted off)
+        assert not touching[-1]
+    rest = sa.solve(arm, [sa.Gravity()], s=26, tol=1e-10)
+    # measured 5.4e-7 L: Hermite's rule on 26 stations, with the table and without
+    assert np.abs(ends[1] - rest.positions).max() < 1e-6 * arm.length
+    assert np.abs(ends[0] - ends[1]).max() < 1e-9 * arm.length
+
+
 @pytest.mark.slow
 def test_an_undamped_impact_keeps_the_energy_to_the_steps_accuracy():
     """Undamped, the impact's energy goes into the penalty and back (restitution 1): kinetic

@@ -211,8 +211,10 @@ def _settled_error(arm, loads, actuators, stations):
     path = simulate(arm, loads, actuators=actuators, duration=9.0, dt=4e-3, stations=stations,
                     damping=Damping(retardation=0.3), tol=1e-10)
     eq = softarm.solve(arm, [*loads, *actuators], s=stations, tol=1e-10)
-    # at rest: the shape still over the last 2 s (a magnetic arm's velocity states q, ω
-    # decay slower than its shape settles: 5e-7 m/s at 9 s while it moves by 1.6e-12 m)
+    # at rest: the shape still over the last 2 s (the velocity states of a thinner arm
+    # ring from step to step under the trapezoidal rule in time, α = -1/2, and decay slower
+    # than its shape settles: 5e-7 m/s at 9 s for the magnetic arm, alternating in sign,
+    # while it moves by 1.6e-12 m)
     assert np.abs(path.velocities[-1]).max() < 1e-5
     assert np.abs(path.positions[-1] - path.positions[-500]).max() < 1e-10 * arm.length
     error = np.abs(path.positions[-1] - eq.positions).max() / arm.length

@@ -333,16 +333,13 @@ def _dyn_residual(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, r, 
         if _node_rates(Z[k], node_s[k], node_piece[k], props, now, hh[k], coef, rates[k],
                        eps[k], act, actuation, lengths[0][k], tmp):
             touching = True
+    # (the slopes even where the trapezoidal rule holds: the history keeps them, and a
+    # history without them after a contact leaves ε̇' wrong by c0 ε' for the steps after)
+    _node_slopes(Z, grid, props, coef, now, hh, act, actuation, rates, eps, lengths[0],
+                 slopes, lengths[1], central, tmp)
     if touching:  # the trapezoidal rule for the rest of the step (_hermite)
         for k in range(G):
-            for i in range(DUNK + 6):
-                slopes[k, i] = 0.0
             slopes[k, _TRAPEZOID] = 1.0
-            for a in range(lengths[1].shape[1]):
-                lengths[1][k, a] = 0.0
-    else:
-        _node_slopes(Z, grid, props, coef, now, hh, act, actuation, rates, eps, lengths[0],
-                     slopes, lengths[1], central, tmp)
     lg = np.empty(3)
     jw = np.empty(6)
     worst = 0.0
