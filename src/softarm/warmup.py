@@ -162,6 +162,11 @@ def _dynamics_actuated():
     _steps(_moving(), actuators=[_tendon()])
     _steps(_moving(), [Gravity()], actuators=[_tendon()],
            initial=solve(_moving(), [Gravity(), _tendon(0.05)], s=5))
+    # from an equilibrium without a tendon (a chamber: the settle step has no lengths to
+    # integrate, another compiled version)
+    chamber = Chamber(1e3, area=1e-5, routing=Straight(0.0, -0.005))
+    _steps(_moving(), [Gravity()], actuators=[chamber],
+           initial=solve(_moving(), [Gravity(), chamber], s=5))
 
 
 def _dynamics_contact():
