@@ -60,7 +60,9 @@ _DYN_REFRESH = 4
 _SLOPE_STEP = 1e-3  # the central difference's step in s, in mean spacings
 _SLOPE_STEP_FORWARD = 1e-4  # the forward difference's (_node_slopes)
 _CENTRAL_BELOW = 1e-9  # Newton's tol below which the slopes take central differences
-_TRAPEZOID = DUNK + 6  # the slopes' column that asks for the trapezoidal rule (_hermite)
+# The step's flag for the trapezoidal rule (_hermite): slopes[0, _TRAPEZOID], 1.0 once an
+# iterate of the step touched an obstacle, cleared at each step's start
+_TRAPEZOID = DUNK + 6
 
 
 @_jit
@@ -323,23 +325,19 @@ def _dyn_residual(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, r, 
     (interval lengths, piece of each node, s of each node). ``rates`` (G, 18), ``eps`` (G,
     6) and ``lengths`` ((G, tendons) twice) get each node's rates, strains, dℓ/ds and its
     slope, ``slopes`` (G, 25) the rates' and the strain's slopes in s, and 1.0 where the
-    trapezoidal rule holds instead (_hermite: ``slopes[0, 24]`` set by an earlier iterate
-    of the step keeps it). Returns the largest |r|."""
+    trapezoidal rule holds instead (``slopes[0, _TRAPEZOID]``, set by this or an earlier
+    iterate of the step: _hermite). Returns the largest |r|."""
     h, node_piece, node_s = grid
     G = Z.shape[0]
     tmp = np.empty(12)
-    touching = slopes[0, _TRAPEZOID] != 0.0  # (an earlier iterate of this step touched)
     for k in range(G):
         if _node_rates(Z[k], node_s[k], node_piece[k], props, now, hh[k], coef, rates[k],
                        eps[k], act, actuation, lengths[0][k], tmp):
-            touching = True
+            slopes[0, _TRAPEZOID] = 1.0  # the trapezoidal rule for the rest of the step
     # (the slopes even where the trapezoidal rule holds: the history keeps them, and a
     # history without them after a contact leaves ε̇' wrong by c0 ε' for the steps after)
     _node_slopes(Z, grid, props, coef, now, hh, act, actuation, rates, eps, lengths[0],
                  slopes, lengths[1], central, tmp)
-    if touching:  # the trapezoidal rule for the rest of the step (_hermite)
-        for k in range(G):
-            slopes[k, _TRAPEZOID] = 1.0
     lg = np.empty(3)
     jw = np.empty(6)
     worst = 0.0
@@ -347,7 +345,7 @@ def _dyn_residual(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, r, 
         za, zb = Z[k], Z[k + 1]
         o = DUNK * k
         hk = h[k]
-        c12 = _hermite(hk, slopes, k)
+        c12 = _hermite(hk, slopes)
         fa, fb, ga, gb = rates[k], rates[k + 1], slopes[k], slopes[k + 1]
         _log_relative(za, zb, lg)
         # the rotation's Magnus term h²/12 u_a × u_b (R' = R û)
@@ -380,16 +378,16 @@ def _dyn_residual(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, r, 
 
 
 @_jit
-def _hermite(hk, slopes, k):
-    """Hermite's coefficient h²/12 of interval k, or 0 (the trapezoidal rule) where the
-    slopes say so: in a step where the arm touches an obstacle (at any iterate). The
+def _hermite(hk, slopes):
+    """Hermite's coefficient h²/12 of an interval of length hk, or 0 (the trapezoidal rule)
+    in a step where the arm touches an obstacle (at any iterate: the step's flag). The
     penalty's rates are not smooth (their slope jumps at the band's edge, and friction's
     with the sliding); Hermite's rule taken only between nodes that do not touch, switching
     node by node as the contact spreads, failed Newton at a touchdown with friction and
     lost the balance of an undamped impact's energy (11 % at Δt = 0.5 ms, 4.6 % with the
     trapezoidal rule). In contact, the static limit is the penalty's, which its band δ
     limits anyway; an arm that does not touch its obstacles moves as without them."""
-    if slopes[k, _TRAPEZOID] != 0.0:
+    if slopes[0, _TRAPEZOID] != 0.0:
         return 0.0
     return hk * hk / 12.0
 
@@ -448,7 +446,6 @@ def _node_slopes(Z, grid, props, coef, now, hh, act, actuation, rates, eps, leng
             g[DUNK + i] = (e1[i] - em[i]) / width
         for a in range(lslopes.shape[1]):
             lslopes[k, a] = (l1[a] - lm[a]) / width
-        g[_TRAPEZOID] = 0.0
 
 
 @_jit
@@ -513,7 +510,7 @@ def _dyn_jacobian(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, rat
         for i in range(DUNK):
             for c in range(first):
                 Gk[k, i, c] = 0.0
-        if slopes[k, _TRAPEZOID] != 0.0:
+        if slopes[0, _TRAPEZOID] != 0.0:
             continue  # (no G²: the trapezoidal rule, _hermite)
         for i in range(DUNK):  # G² (G is sparse: the products of its nonzeros)
             for c in range(DUNK):
@@ -528,7 +525,7 @@ def _dyn_jacobian(Z, grid, props, coef, S, now, tip_now, hh, act, actuation, rat
         za, zb = Z[k], Z[k + 1]
         row0 = DUNK * k
         hk = h[k]
-        c12 = _hermite(hk, slopes, k)
+        c12 = _hermite(hk, slopes)
         _log_relative(za, zb, lg)
         _inverse_jacobian(lg[0], lg[1], lg[2], -1.0, Ja)
         _inverse_jacobian(lg[0], lg[1], lg[2], 1.0, Jb)
@@ -949,8 +946,7 @@ def dynamic_steps(Z, Zold, H, aux, props, loads, tip, grid, coef, S, options, ba
                 for i in range(3):
                     Zp[k, i] = Zw[k, _DP + i]  # (the predicted centreline)
             _set_base(Zw, base[bb, t])
-            for k in range(G):
-                slopes[k, _TRAPEZOID] = 0.0  # (Hermite's rule until the arm touches)
+            slopes[0, _TRAPEZOID] = 0.0  # (Hermite's rule until the arm touches)
             code, res, its, nf = _dyn_newton(Zw, grid, props, coef, S, now, tip_now, hh, act,
                                              actuation, tol, max_iter, fac, kl, work)
             if code != DYN_OK and act is not None and act[5].shape[0] > 0:
@@ -1019,7 +1015,7 @@ def dynamic_steps(Z, Zold, H, aux, props, loads, tip, grid, coef, S, options, ba
                     acc = 0.0
                     for k in range(G - 1):
                         acc += (0.5 * h[k] * (w[k, a] + w[k + 1, a])
-                                + _hermite(h[k], slopes, k) * (dw[k, a] - dw[k + 1, a]))
+                                + _hermite(h[k], slopes) * (dw[k, a] - dw[k + 1, a]))
                     tendons[b, t, a] = acc
             for si in range(stations.size):
                 k = stations[si]
