@@ -27,7 +27,7 @@ the one a quasi-static path with friction would reach: docs/contact.md, "Frictio
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import ClassVar
 
 import numpy as np
@@ -338,6 +338,11 @@ class Contact(Load):
     radius: float | None = None
     stiffness: float | None = None
     slip_velocity: float = 1e-4
+    #: Hard contact zones of a solve (statics/contact_zones.py sets them; not a user
+    #: setting): ((obstacle index, s_a, s_b), ...), on each of which the arm's surface is
+    #: held on that obstacle by the pressure that keeps its gap at zero, and the penalty is
+    #: off everywhere.
+    zones: tuple = field(default=(), repr=False)
     kind: ClassVar[str] = "contact"
     schema: ClassVar = (Key("friction", "number"), Key("distance", "number", "m"),
                         Key("radius", "number", "m"), Key("stiffness", "number", "N/m²"),
@@ -356,6 +361,14 @@ class Contact(Load):
         object.__setattr__(self, "stiffness", _stiffness(self.stiffness))
         if self.slip_velocity is None:
             raise ValueError("Contact.slip_velocity must be a positive speed in m/s, got None")
+        zones = tuple((int(k), float(a), float(b)) for k, a, b in self.zones)
+        if any(not (0 <= k < len(self.obstacles) and 0.0 <= a < b) for k, a, b in zones):
+            raise ValueError(f"Contact.zones must be (obstacle index, s_a, s_b) with "
+                             f"0 <= s_a < s_b, got {self.zones!r}")
+        object.__setattr__(self, "zones", zones)
+
+    def cuts(self, arm) -> tuple[float, ...]:
+        return tuple(s for _, a, b in self.zones for s in (a, b) if 0.0 < s < arm.length)
 
     @property
     def batch_shape(self) -> tuple[int, ...]:

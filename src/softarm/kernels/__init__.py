@@ -42,7 +42,7 @@ _INTERFACE = {
                "MEMORY", "MPREDICTED", "MSTEP", "NEWTON_FAILED", "NOT_FINITE", "OK", "OPTIONS",
                "PATH_FAILED", "PIECE_LOADS", "SINGULAR", "TD", "TENDON", "TF", "TIP_LOADS",
                "TOO_MANY_STEPS"),
-    "rod": ("_law", "_route"),
+    "rod": ("CONTACT_PARAMS", "ZONE", "_law", "_route"),
     "shooting": ("solve_cases", "shoot", "_fill_steps", "_implicit_function", "_scratch"),
     "stability": ("stability_cases", "sweep_point", "record_points"),
     "inverse": ("box_least_squares", "regularised_step", "inverse_newton", "task_error",

@@ -32,7 +32,7 @@ from .layout import (
     TOO_MANY_STEPS,
 )
 from .linear import _band_factor, _band_solve, _copy, _crossings
-from .rod import _jump, _rotated, _set_loads, _start, _steps, _tip_residual
+from .rod import ZONE, _jump, _rotated, _set_loads, _start, _steps, _tip_residual
 from .shooting import (
     _CONTRACTION_MAX,
     _DIST_MAX,
@@ -128,6 +128,8 @@ def _stiffness_size(arm, act, w, loads):
             shear = max(C[1, 1], C[2, 2])
             bending = max(C[4, 4], C[5, 5])
             kl = max(kl, arm[6] * max(math.sqrt(k * shear), (k * bending) ** 0.25))
+            if act[6][j, ZONE] > 0.0:  # a hard contact zone: rates ±1/ℓ, ℓ = √(EI/GA)
+                kl = max(kl, arm[6] * math.sqrt(bending / shear))
     return kl
 
 

@@ -451,15 +451,29 @@ def _deriv(work, twork, nt, stage, s, arm, act, j, now, rate, law):
         for i in range(3):
             w[_N + i] -= law[2][3, i]
             w[_M + i] -= law[2][3, 3 + i]
-    # contact with the obstacles: a force per unit length through the centreline (_contact)
+    # contact with the obstacles: a force per unit length through the centreline (_contact),
+    # or on a hard contact zone the pressure that holds the gap at zero (_zone_pressure)
     cf0 = cf1 = cf2 = c00 = c01 = c02 = c11 = c12 = c22 = 0.0
     touching = False
+    zoned = False
+    zone = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
+            0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     contact = 0.0  # the penalty's scale at this λ (the channel CT)
     if act is not None and act[5].shape[0] > 0:
         contact = now[j, _CT]
-        cf0, cf1, cf2, c00, c01, c02, c11, c12, c22 = _contact(
-            work[Y, _P], work[Y, _P + 1], work[Y, _P + 2], act[5], act[6][j])
-        touching = cf0 != 0.0 or cf1 != 0.0 or cf2 != 0.0
+        params = act[6][j]
+        if params[ZONE] > 0.0:
+            zoned = True
+            zone = _zone_pressure(
+                act[5][int(params[ZONE]) - 1], C[j],
+                work[Y, _P], work[Y, _P + 1], work[Y, _P + 2], R00, R01, R02, R10, R11, R12,
+                R20, R21, R22, v0, v1, v2, u0, u1, u2, s0, s1, s2, s3, s4, s5, px, py, pz,
+                w[_N], w[_N + 1], w[_N + 2], w[_M], w[_M + 1], w[_M + 2])
+            cf0, cf1, cf2 = zone[0] * zone[1], zone[0] * zone[2], zone[0] * zone[3]
+        else:
+            cf0, cf1, cf2, c00, c01, c02, c11, c12, c22 = _contact(
+                work[Y, _P], work[Y, _P + 1], work[Y, _P + 2], act[5], params)
+            touching = cf0 != 0.0 or cf1 != 0.0 or cf2 != 0.0
         w[_N] -= contact * cf0
         w[_N + 1] -= contact * cf1
         w[_N + 2] -= contact * cf2
@@ -503,19 +517,19 @@ def _deriv(work, twork, nt, stage, s, arm, act, j, now, rate, law):
         t = twork[Y, d]
         th0, th1, th2 = t[_TT], t[_TT + 1], t[_TT + 2]
         dn0, dn1, dn2 = t[_TN], t[_TN + 1], t[_TN + 2]
+        ds0 = ds1 = ds2 = ds3 = ds4 = ds5 = 0.0
         if act is not None and actuated:
             c0, c1, c2 = M[0, 6 + d], M[1, 6 + d], M[2, 6 + d]
             c3, c4, c5 = M[3, 6 + d], M[4, 6 + d], M[5, 6 + d]
         else:  # δσ = (Rᵀδn + σ_n × δθ; Rᵀδm + σ_m × δθ), then the constitutive step
             dm0, dm1, dm2 = t[_TM], t[_TM + 1], t[_TM + 2]
-            c0, c1, c2, c3, c4, c5 = _strain(
-                C, zero, j, diag,
-                R00 * dn0 + R10 * dn1 + R20 * dn2 + s1 * th2 - s2 * th1,
-                R01 * dn0 + R11 * dn1 + R21 * dn2 + s2 * th0 - s0 * th2,
-                R02 * dn0 + R12 * dn1 + R22 * dn2 + s0 * th1 - s1 * th0,
-                R00 * dm0 + R10 * dm1 + R20 * dm2 + s4 * th2 - s5 * th1,
-                R01 * dm0 + R11 * dm1 + R21 * dm2 + s5 * th0 - s3 * th2,
-                R02 * dm0 + R12 * dm1 + R22 * dm2 + s3 * th1 - s4 * th0)
+            ds0 = R00 * dn0 + R10 * dn1 + R20 * dn2 + s1 * th2 - s2 * th1
+            ds1 = R01 * dn0 + R11 * dn1 + R21 * dn2 + s2 * th0 - s0 * th2
+            ds2 = R02 * dn0 + R12 * dn1 + R22 * dn2 + s0 * th1 - s1 * th0
+            ds3 = R00 * dm0 + R10 * dm1 + R20 * dm2 + s4 * th2 - s5 * th1
+            ds4 = R01 * dm0 + R11 * dm1 + R21 * dm2 + s5 * th0 - s3 * th2
+            ds5 = R02 * dm0 + R12 * dm1 + R22 * dm2 + s3 * th1 - s4 * th0
+            c0, c1, c2, c3, c4, c5 = _strain(C, zero, j, diag, ds0, ds1, ds2, ds3, ds4, ds5)
         # δp' = R (δθ × v + δv)
         a0 = th1 * v2 - th2 * v1 + c0
         a1 = th2 * v0 - th0 * v2 + c1
@@ -568,6 +582,25 @@ def _deriv(work, twork, nt, stage, s, arm, act, j, now, rate, law):
                 g0 -= rate[rr, j, _CT] * cf0
                 g1 -= rate[rr, j, _CT] * cf1
                 g2 -= rate[rr, j, _CT] * cf2
+        # δm' = -δp' × n - p' × δn - R (δθ × l_f) - ∂_λ l
+        k0 = -(q1 * nz - q2 * ny) - (py * dn2 - pz * dn1) + k0
+        k1 = -(q2 * nx - q0 * nz) - (pz * dn0 - px * dn2) + k1
+        k2 = -(q0 * ny - q1 * nx) - (px * dn1 - py * dn0) + k2
+        if act is not None and zoned:  # the zone's pressure's variation (and along the path)
+            z0, z1, z2 = _zone_variation(
+                zone, C[j], R00, R01, R02, R10, R11, R12, R20, R21, R22,
+                v0, v1, v2, u0, u1, u2, s0, s1, s2, s3, s4, s5, px, py, pz,
+                w[_N] + contact * cf0, w[_N + 1] + contact * cf1, w[_N + 2] + contact * cf2,
+                w[_M], w[_M + 1], w[_M + 2], t[_TP], t[_TP + 1], t[_TP + 2], th0, th1, th2,
+                ds0, ds1, ds2, ds3, ds4, ds5, c0, c1, c2, c3, c4, c5, q0, q1, q2, g0, g1, g2,
+                k0, k1, k2)
+            g0 -= contact * z0
+            g1 -= contact * z1
+            g2 -= contact * z2
+            if d >= LAM:
+                g0 -= rate[rr, j, _CT] * cf0
+                g1 -= rate[rr, j, _CT] * cf1
+                g2 -= rate[rr, j, _CT] * cf2
         o = twork[stage, d]
         o[_TP] = q0
         o[_TP + 1] = q1
@@ -578,10 +611,9 @@ def _deriv(work, twork, nt, stage, s, arm, act, j, now, rate, law):
         o[_TN] = g0
         o[_TN + 1] = g1
         o[_TN + 2] = g2
-        # δm' = -δp' × n - p' × δn - R (δθ × l_f) - ∂_λ l
-        o[_TM] = -(q1 * nz - q2 * ny) - (py * dn2 - pz * dn1) + k0
-        o[_TM + 1] = -(q2 * nx - q0 * nz) - (pz * dn0 - px * dn2) + k1
-        o[_TM + 2] = -(q0 * ny - q1 * nx) - (px * dn1 - py * dn0) + k2
+        o[_TM] = k0
+        o[_TM + 1] = k1
+        o[_TM + 2] = k2
     if act is not None and twork.shape[2] > NT:  # the tendons' lengths' tangents
         _length_rates(twork[stage], nt, act, j, actuated, law)
 
@@ -665,11 +697,16 @@ def _dipole(y, T, which, m0, m1, m2, now, rate, out):
 
 # Contact (issue 33; docs/contact.md). ``act[5]``: the obstacles (K, 8), one row each: kind,
 # then a plane's point and outward unit normal, a sphere's centre (and 0, 0, 0), or a
-# capsule's two axis ends, then the radius (0 for a plane). ``act[6]`` (P, 5): per piece the
+# capsule's two axis ends, then the radius (0 for a plane). ``act[6]`` (P, 6): per piece the
 # arm's surface radius r (m), the contact distance δ (m), the penalty stiffness k
-# (N/m per m of arm), Coulomb's μ and the friction's regularising speed w_ε (m/s; dynamics).
+# (N/m per m of arm), Coulomb's μ, the friction's regularising speed w_ε (m/s; dynamics),
+# then for a hard contact zone (:func:`_zone_pressure`) its obstacle's index + 1 (0: the
+# piece is not a zone).
 PLANE, SPHERE, CAPSULE = 0, 1, 2
 OBSTACLE = 8
+#: act[6]'s column of a zone's obstacle (index + 1), and its number of columns.
+ZONE = 5
+CONTACT_PARAMS = 6
 
 
 @_jit
@@ -754,6 +791,125 @@ def _contact(px, py, pz, obstacles, params):
         j12 += dphi * n1 * n2 - pc * (n1 * n2 + e1 * e2)
         j22 += dphi * n2 * n2 + pc * (1.0 - n2 * n2 - e2 * e2)
     return f0, f1, f2, j00, j01, j02, j11, j12, j22
+
+
+@_jit
+def _zone_pressure(row, Cj, px, py, pz, R00, R01, R02, R10, R11, R12, R20,
+                   R21, R22, v0, v1, v2, u0, u1, u2, s0, s1, s2, s3, s4, s5, dx, dy, dz,
+                   fn0, fn1, fn2, fm0, fm1, fm2):
+    """The pressure c (N/m) that holds the arm on a hard contact zone of the obstacle ``row``
+    (docs/contact.md, "Hard contact"), for the linear law's strains (v; u) = f⁰ + C σ
+    (``Cj`` the piece's C, σ = (s0..s5) in material components), the centreline at p with
+    p' = (dx, dy, dz) = R v, and n', m' without the contact (fn, fm: spatial).
+
+    On the zone the gap g = d(p) - r is held at zero: with n̂ = ∇d, g' = n̂ · p' and
+    g'' = p'ᵀ ∇²d p' + n̂ · R (u × v + v') = a - c b, where v' = C_v (σ') with
+    σ' = (-u × σ_n + Rᵀ n'; -u × σ_m + Rᵀ m') and n' = fn - c n̂, so
+    b = ñᵀ C_vv ñ (ñ = Rᵀ n̂, the section's compliance along the normal) and a is g'' at
+    c = 0. The pressure that keeps g'' = 0 is
+
+        c = a / b,
+
+    so that g and g' keep the values they enter the zone with (zero on the hard-contact
+    answer, which conditions at the zone's start must impose: contact.md). Returns c, n̂ (3),
+    the curvature κ = 1/ρ of the obstacle's surface and its axis e (∇²d = κ (I - n̂ n̂ᵀ -
+    e eᵀ)), ñ, C_vv ñ, C_vvᵀ ñ, b, the material vector u × v + v' at c = 0, ∇²d p', and g'
+    (what :func:`_zone_variation` needs)."""
+    _, n0, n1, n2, kappa, e0, e1, e2 = _nearest(px, py, pz, row)
+    m0 = R00 * n0 + R10 * n1 + R20 * n2  # ñ = Rᵀ n̂
+    m1 = R01 * n0 + R11 * n1 + R21 * n2
+    m2 = R02 * n0 + R12 * n1 + R22 * n2
+    slope = n0 * dx + n1 * dy + n2 * dz  # g'
+    # σ' at c = 0: -u × σ + Rᵀ (n'; m')
+    a0 = -(u1 * s2 - u2 * s1) + R00 * fn0 + R10 * fn1 + R20 * fn2
+    a1 = -(u2 * s0 - u0 * s2) + R01 * fn0 + R11 * fn1 + R21 * fn2
+    a2 = -(u0 * s1 - u1 * s0) + R02 * fn0 + R12 * fn1 + R22 * fn2
+    a3 = -(u1 * s5 - u2 * s4) + R00 * fm0 + R10 * fm1 + R20 * fm2
+    a4 = -(u2 * s3 - u0 * s5) + R01 * fm0 + R11 * fm1 + R21 * fm2
+    a5 = -(u0 * s4 - u1 * s3) + R02 * fm0 + R12 * fm1 + R22 * fm2
+    w0 = u1 * v2 - u2 * v1 + (Cj[0, 0] * a0 + Cj[0, 1] * a1 + Cj[0, 2] * a2 + Cj[0, 3] * a3
+                              + Cj[0, 4] * a4 + Cj[0, 5] * a5)
+    w1 = u2 * v0 - u0 * v2 + (Cj[1, 0] * a0 + Cj[1, 1] * a1 + Cj[1, 2] * a2 + Cj[1, 3] * a3
+                              + Cj[1, 4] * a4 + Cj[1, 5] * a5)
+    w2 = u0 * v1 - u1 * v0 + (Cj[2, 0] * a0 + Cj[2, 1] * a1 + Cj[2, 2] * a2 + Cj[2, 3] * a3
+                              + Cj[2, 4] * a4 + Cj[2, 5] * a5)
+    # ∇²d p' = κ (p' - n̂ (n̂·p') - e (e·p'))
+    ep = e0 * dx + e1 * dy + e2 * dz
+    h0 = kappa * (dx - n0 * slope - e0 * ep)
+    h1 = kappa * (dy - n1 * slope - e1 * ep)
+    h2 = kappa * (dz - n2 * slope - e2 * ep)
+    k0 = Cj[0, 0] * m0 + Cj[0, 1] * m1 + Cj[0, 2] * m2  # C_vv ñ
+    k1 = Cj[1, 0] * m0 + Cj[1, 1] * m1 + Cj[1, 2] * m2
+    k2 = Cj[2, 0] * m0 + Cj[2, 1] * m1 + Cj[2, 2] * m2
+    l0 = Cj[0, 0] * m0 + Cj[1, 0] * m1 + Cj[2, 0] * m2  # C_vvᵀ ñ
+    l1 = Cj[0, 1] * m0 + Cj[1, 1] * m1 + Cj[2, 1] * m2
+    l2 = Cj[0, 2] * m0 + Cj[1, 2] * m1 + Cj[2, 2] * m2
+    b = m0 * k0 + m1 * k1 + m2 * k2
+    a = dx * h0 + dy * h1 + dz * h2 + m0 * w0 + m1 * w1 + m2 * w2
+    c = a / b
+    return (c, n0, n1, n2, kappa, e0, e1, e2, m0, m1, m2, k0, k1, k2, l0, l1, l2, b, w0, w1,
+            w2, h0, h1, h2, slope)
+
+
+@_jit
+def _zone_variation(z, Cj, R00, R01, R02, R10, R11, R12, R20, R21, R22, v0, v1, v2,
+                    u0, u1, u2, s0, s1, s2, s3, s4, s5, dx, dy, dz, fn0, fn1, fn2, fm0, fm1,
+                    fm2, dp0, dp1, dp2, th0, th1, th2, ds0, ds1, ds2, ds3, ds4, ds5, c0, c1,
+                    c2, c3, c4, c5, q0, q1, q2, dfn0, dfn1, dfn2, dfm0, dfm1, dfm2):
+    """The variation of a zone's contact force per unit length c n̂ (spatial) along a
+    tangent column: δp, δθ (material), δσ, δ(v; u) = (c0..c5), δp' = q, δn' and δm' without
+    the contact (dfn, dfm); ``z`` is :func:`_zone_pressure`'s tuple at the state. Exact
+    (the derivative of its formula, with ∇²d's own change on a ball or a cylinder:
+    δκ = -κ² n̂·δp, δn̂ = ∇²d δp, the axis fixed)."""
+    (c, n0, n1, n2, kappa, e0, e1, e2, m0, m1, m2, k0, k1, k2, l0, l1, l2, b, w0, w1, w2,
+     h0, h1, h2, slope) = z
+    dg = n0 * dp0 + n1 * dp1 + n2 * dp2
+    ed = e0 * dp0 + e1 * dp1 + e2 * dp2
+    dn0 = kappa * (dp0 - n0 * dg - e0 * ed)  # δn̂ = ∇²d δp
+    dn1 = kappa * (dp1 - n1 * dg - e1 * ed)
+    dn2 = kappa * (dp2 - n2 * dg - e2 * ed)
+    # δñ = Rᵀ δn̂ - δθ × ñ
+    r0 = R00 * dn0 + R10 * dn1 + R20 * dn2 - (th1 * m2 - th2 * m1)
+    r1 = R01 * dn0 + R11 * dn1 + R21 * dn2 - (th2 * m0 - th0 * m2)
+    r2 = R02 * dn0 + R12 * dn1 + R22 * dn2 - (th0 * m1 - th1 * m0)
+    # δσ' = -δu × σ - u × δσ + Rᵀ δ(n'; m') - δθ × Rᵀ (n'; m')
+    f0 = R00 * fn0 + R10 * fn1 + R20 * fn2
+    f1 = R01 * fn0 + R11 * fn1 + R21 * fn2
+    f2 = R02 * fn0 + R12 * fn1 + R22 * fn2
+    g0 = R00 * fm0 + R10 * fm1 + R20 * fm2
+    g1 = R01 * fm0 + R11 * fm1 + R21 * fm2
+    g2 = R02 * fm0 + R12 * fm1 + R22 * fm2
+    a0 = (-(c4 * s2 - c5 * s1) - (u1 * ds2 - u2 * ds1) + R00 * dfn0 + R10 * dfn1 + R20 * dfn2
+          - (th1 * f2 - th2 * f1))
+    a1 = (-(c5 * s0 - c3 * s2) - (u2 * ds0 - u0 * ds2) + R01 * dfn0 + R11 * dfn1 + R21 * dfn2
+          - (th2 * f0 - th0 * f2))
+    a2 = (-(c3 * s1 - c4 * s0) - (u0 * ds1 - u1 * ds0) + R02 * dfn0 + R12 * dfn1 + R22 * dfn2
+          - (th0 * f1 - th1 * f0))
+    a3 = (-(c4 * s5 - c5 * s4) - (u1 * ds5 - u2 * ds4) + R00 * dfm0 + R10 * dfm1 + R20 * dfm2
+          - (th1 * g2 - th2 * g1))
+    a4 = (-(c5 * s3 - c3 * s5) - (u2 * ds3 - u0 * ds5) + R01 * dfm0 + R11 * dfm1 + R21 * dfm2
+          - (th2 * g0 - th0 * g2))
+    a5 = (-(c3 * s4 - c4 * s3) - (u0 * ds4 - u1 * ds3) + R02 * dfm0 + R12 * dfm1 + R22 * dfm2
+          - (th0 * g1 - th1 * g0))
+    # δ(u × v + v')
+    x0 = c4 * v2 - c5 * v1 + u1 * c2 - u2 * c1 + (
+        Cj[0, 0] * a0 + Cj[0, 1] * a1 + Cj[0, 2] * a2 + Cj[0, 3] * a3 + Cj[0, 4] * a4
+        + Cj[0, 5] * a5)
+    x1 = c5 * v0 - c3 * v2 + u2 * c0 - u0 * c2 + (
+        Cj[1, 0] * a0 + Cj[1, 1] * a1 + Cj[1, 2] * a2 + Cj[1, 3] * a3 + Cj[1, 4] * a4
+        + Cj[1, 5] * a5)
+    x2 = c3 * v1 - c4 * v0 + u0 * c1 - u1 * c0 + (
+        Cj[2, 0] * a0 + Cj[2, 1] * a1 + Cj[2, 2] * a2 + Cj[2, 3] * a3 + Cj[2, 4] * a4
+        + Cj[2, 5] * a5)
+    # δa = 2 (∇²d p')·δp' + p'ᵀ δ(∇²d) p' + δñ·(u × v + v') + ñ·δ(u × v + v'), with
+    # p'ᵀ δ(∇²d) p' = -κ (n̂·δp) p'ᵀ∇²d p' - 2 κ (δn̂·p') (n̂·p')
+    hp = dx * h0 + dy * h1 + dz * h2
+    da = (2.0 * (h0 * q0 + h1 * q1 + h2 * q2) - kappa * dg * hp
+          - 2.0 * kappa * (dn0 * dx + dn1 * dy + dn2 * dz) * slope
+          + r0 * w0 + r1 * w1 + r2 * w2 + m0 * x0 + m1 * x1 + m2 * x2)
+    db = r0 * (k0 + l0) + r1 * (k1 + l1) + r2 * (k2 + l2)
+    dc = (da - c * db) / b
+    return dc * n0 + c * dn0, dc * n1 + c * dn1, dc * n2 + c * dn2
 
 
 @_inline

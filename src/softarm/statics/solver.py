@@ -194,8 +194,10 @@ class _ArmData:
                 self.mu[segment], segment)
 
 
-#: ``act``'s contact arrays out of contact: no obstacle (kernels/rod.py, act[5], act[6])
-_NO_CONTACT = (np.zeros((0, 8)), np.zeros((1, 5)))
+
+def _no_contact() -> tuple:
+    """``act``'s contact arrays out of contact: no obstacle (kernels/rod.py, act[5], act[6])."""
+    return np.zeros((0, 8)), np.zeros((1, kernels.CONTACT_PARAMS))
 
 
 #: Retries of a solve whose answer penetrates an obstacle, each with the penalty raised
@@ -454,7 +456,7 @@ class _Channels:
         contact (see softarm.kernels: a passive arm's solve is compiled without them)."""
         arm, act = self._actuated_arm()[0]
         if self.contact_load is None:
-            return arm, (None if act is None else (*act, *_NO_CONTACT))
+            return arm, (None if act is None else (*act, *_no_contact()))
         if self._contact_arrays is None:
             self._contact_arrays = self._contact_kernel_arrays()
         if act is None:  # a passive arm: no actuators, no magnets
@@ -484,6 +486,12 @@ class _Channels:
         if load is None:
             return None
         band = load.band(self.length)
+        if load.zones:  # hard contact zones (contact_zones.py): their law at full strength
+            self.piece[:, :, self.k.CT] = 1.0
+            self.contact_given_stiffness = False
+            self.contact_load = load.replace(distance=band)
+            self._contact_arrays = None
+            return self.contact_load
         if load.stiffness is not None and np.ndim(load.stiffness):
             raise ValueError("Contact.stiffness must be one number for a solve (N/m²), got an "
                              "array: it varies per case only where the solver raised it")
@@ -532,12 +540,17 @@ class _Channels:
     def _contact_kernel_arrays(self) -> tuple:
         load = self.contact_load
         radii = load.surface_radii(self.arm)[self.pieces[12]]
-        params = np.empty((self.starts.size, 5))
+        params = np.zeros((self.starts.size, kernels.CONTACT_PARAMS))
         params[:, 0] = radii
         params[:, 1] = load.distance
         params[:, 2] = 1.0  # (each case's k is in its channel CT)
         params[:, 3] = load.friction
         params[:, 4] = load.slip_velocity
+        if load.zones:  # hard contact zones: the penalty off, each zone's pieces flagged
+            params[:, 2] = 0.0
+            middles = self.starts + 0.5 * self.lengths
+            for obstacle, start, end in load.zones:
+                params[(middles > start) & (middles < end), kernels.ZONE] = obstacle + 1
         return load.kernel_rows(), params
 
     def tendons(self) -> tuple[np.ndarray, np.ndarray]:
@@ -1574,8 +1587,8 @@ class Solver:
         if contact is not None:  # (the gaps and forces on the solver's stations, once)
             law = channels.contact_load
             gaps, forces = law.gaps(poses[..., :3, 3], law.station_radii(self.arm, s_kernel))
-            stiffer = _penetration(self, law, gaps, forces, attempt,
-                                   channels.contact_given_stiffness)
+            stiffer = None if law.zones else _penetration(
+                self, law, gaps, forces, attempt, channels.contact_given_stiffness)
             if stiffer is not None:  # raise the penalty until the pressure fits the band
                 if chained or (along_chain and count > 1):
                     self.reset()
