@@ -338,10 +338,10 @@ class Contact(Load):
     radius: float | None = None
     stiffness: float | None = None
     slip_velocity: float = 1e-4
-    #: Hard contact zones of a solve (statics/contact_zones.py sets them; not a user
-    #: setting): ((obstacle index, s_a, s_b), ...), on each of which the arm's surface is
-    #: held on that obstacle by the pressure that keeps its gap at zero, and the penalty is
-    #: off everywhere.
+    #: Hard contact zones ((obstacle index, s_a, s_b), ...): on each, the pressure that
+    #: keeps the gap's second derivative at zero (kernels/rod.py, ``_zone_pressure``), and
+    #: the penalty off everywhere. Groundwork of issue 39, not a user setting: nothing in
+    #: softarm.solve places zones yet (docs/contact.md, "Hard contact").
     zones: tuple = field(default=(), repr=False)
     kind: ClassVar[str] = "contact"
     schema: ClassVar = (Key("friction", "number"), Key("distance", "number", "m"),
