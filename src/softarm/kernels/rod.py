@@ -452,27 +452,17 @@ def _deriv(work, twork, nt, stage, s, arm, act, j, now, rate, law):
             w[_N + i] -= law[2][3, i]
             w[_M + i] -= law[2][3, 3 + i]
     # contact with the obstacles: a force per unit length through the centreline (_contact),
-    # or on a hard contact zone the pressure that holds the gap at zero (_zone_pressure)
+    # or on a hard contact zone the pressure that holds the arm on it (_zone_forces)
     cf0 = cf1 = cf2 = c00 = c01 = c02 = c11 = c12 = c22 = 0.0
     touching = False
-    zoned = False
-    zone = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
-            0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     contact = 0.0  # the penalty's scale at this λ (the channel CT)
+    zoned = False  # a hard contact zone's piece (_zone_forces)
     if act is not None and act[5].shape[0] > 0:
         contact = now[j, _CT]
-        params = act[6][j]
-        if params[ZONE] > 0.0:
-            zoned = True
-            zone = _zone_pressure(
-                act[5][int(params[ZONE]) - 1], C[j],
-                work[Y, _P], work[Y, _P + 1], work[Y, _P + 2], R00, R01, R02, R10, R11, R12,
-                R20, R21, R22, v0, v1, v2, u0, u1, u2, s0, s1, s2, s3, s4, s5, px, py, pz,
-                w[_N], w[_N + 1], w[_N + 2], w[_M], w[_M + 1], w[_M + 2])
-            cf0, cf1, cf2 = zone[0] * zone[1], zone[0] * zone[2], zone[0] * zone[3]
-        else:
+        zoned = act[6][j, ZONE] > 0.0
+        if not zoned:
             cf0, cf1, cf2, c00, c01, c02, c11, c12, c22 = _contact(
-                work[Y, _P], work[Y, _P + 1], work[Y, _P + 2], act[5], params)
+                work[Y, _P], work[Y, _P + 1], work[Y, _P + 2], act[5], act[6][j])
             touching = cf0 != 0.0 or cf1 != 0.0 or cf2 != 0.0
         w[_N] -= contact * cf0
         w[_N + 1] -= contact * cf1
@@ -483,6 +473,8 @@ def _deriv(work, twork, nt, stage, s, arm, act, j, now, rate, law):
             w[18 + a] = law[1][a, 3] if actuated and act[2][j, a] != 0.0 and \
                 act[1][a] == TENDON else 0.0
     if nt == 0:
+        if act is not None and zoned:
+            _zone_forces(work, twork, 0, stage, arm, act, j, rate, contact)
         return
     # δσ = (Rᵀδn + σ_n × δθ; Rᵀδm + σ_m × δθ), then δ(v; u) = dstrain δσ (+ the actuators'
     # own change with λ), all columns at once (a passive arm's δ(v; u) are computed in the
@@ -517,19 +509,19 @@ def _deriv(work, twork, nt, stage, s, arm, act, j, now, rate, law):
         t = twork[Y, d]
         th0, th1, th2 = t[_TT], t[_TT + 1], t[_TT + 2]
         dn0, dn1, dn2 = t[_TN], t[_TN + 1], t[_TN + 2]
-        ds0 = ds1 = ds2 = ds3 = ds4 = ds5 = 0.0
         if act is not None and actuated:
             c0, c1, c2 = M[0, 6 + d], M[1, 6 + d], M[2, 6 + d]
             c3, c4, c5 = M[3, 6 + d], M[4, 6 + d], M[5, 6 + d]
         else:  # δσ = (Rᵀδn + σ_n × δθ; Rᵀδm + σ_m × δθ), then the constitutive step
             dm0, dm1, dm2 = t[_TM], t[_TM + 1], t[_TM + 2]
-            ds0 = R00 * dn0 + R10 * dn1 + R20 * dn2 + s1 * th2 - s2 * th1
-            ds1 = R01 * dn0 + R11 * dn1 + R21 * dn2 + s2 * th0 - s0 * th2
-            ds2 = R02 * dn0 + R12 * dn1 + R22 * dn2 + s0 * th1 - s1 * th0
-            ds3 = R00 * dm0 + R10 * dm1 + R20 * dm2 + s4 * th2 - s5 * th1
-            ds4 = R01 * dm0 + R11 * dm1 + R21 * dm2 + s5 * th0 - s3 * th2
-            ds5 = R02 * dm0 + R12 * dm1 + R22 * dm2 + s3 * th1 - s4 * th0
-            c0, c1, c2, c3, c4, c5 = _strain(C, zero, j, diag, ds0, ds1, ds2, ds3, ds4, ds5)
+            c0, c1, c2, c3, c4, c5 = _strain(
+                C, zero, j, diag,
+                R00 * dn0 + R10 * dn1 + R20 * dn2 + s1 * th2 - s2 * th1,
+                R01 * dn0 + R11 * dn1 + R21 * dn2 + s2 * th0 - s0 * th2,
+                R02 * dn0 + R12 * dn1 + R22 * dn2 + s0 * th1 - s1 * th0,
+                R00 * dm0 + R10 * dm1 + R20 * dm2 + s4 * th2 - s5 * th1,
+                R01 * dm0 + R11 * dm1 + R21 * dm2 + s5 * th0 - s3 * th2,
+                R02 * dm0 + R12 * dm1 + R22 * dm2 + s3 * th1 - s4 * th0)
         # δp' = R (δθ × v + δv)
         a0 = th1 * v2 - th2 * v1 + c0
         a1 = th2 * v0 - th0 * v2 + c1
@@ -582,25 +574,6 @@ def _deriv(work, twork, nt, stage, s, arm, act, j, now, rate, law):
                 g0 -= rate[rr, j, _CT] * cf0
                 g1 -= rate[rr, j, _CT] * cf1
                 g2 -= rate[rr, j, _CT] * cf2
-        # δm' = -δp' × n - p' × δn - R (δθ × l_f) - ∂_λ l
-        k0 = -(q1 * nz - q2 * ny) - (py * dn2 - pz * dn1) + k0
-        k1 = -(q2 * nx - q0 * nz) - (pz * dn0 - px * dn2) + k1
-        k2 = -(q0 * ny - q1 * nx) - (px * dn1 - py * dn0) + k2
-        if act is not None and zoned:  # the zone's pressure's variation (and along the path)
-            z0, z1, z2 = _zone_variation(
-                zone, C[j], R00, R01, R02, R10, R11, R12, R20, R21, R22,
-                v0, v1, v2, u0, u1, u2, s0, s1, s2, s3, s4, s5, px, py, pz,
-                w[_N] + contact * cf0, w[_N + 1] + contact * cf1, w[_N + 2] + contact * cf2,
-                w[_M], w[_M + 1], w[_M + 2], t[_TP], t[_TP + 1], t[_TP + 2], th0, th1, th2,
-                ds0, ds1, ds2, ds3, ds4, ds5, c0, c1, c2, c3, c4, c5, q0, q1, q2, g0, g1, g2,
-                k0, k1, k2)
-            g0 -= contact * z0
-            g1 -= contact * z1
-            g2 -= contact * z2
-            if d >= LAM:
-                g0 -= rate[rr, j, _CT] * cf0
-                g1 -= rate[rr, j, _CT] * cf1
-                g2 -= rate[rr, j, _CT] * cf2
         o = twork[stage, d]
         o[_TP] = q0
         o[_TP + 1] = q1
@@ -611,9 +584,12 @@ def _deriv(work, twork, nt, stage, s, arm, act, j, now, rate, law):
         o[_TN] = g0
         o[_TN + 1] = g1
         o[_TN + 2] = g2
-        o[_TM] = k0
-        o[_TM + 1] = k1
-        o[_TM + 2] = k2
+        # δm' = -δp' × n - p' × δn - R (δθ × l_f) - ∂_λ l
+        o[_TM] = -(q1 * nz - q2 * ny) - (py * dn2 - pz * dn1) + k0
+        o[_TM + 1] = -(q2 * nx - q0 * nz) - (pz * dn0 - px * dn2) + k1
+        o[_TM + 2] = -(q0 * ny - q1 * nx) - (px * dn1 - py * dn0) + k2
+    if act is not None and zoned:
+        _zone_forces(work, twork, nt, stage, arm, act, j, rate, contact)
     if act is not None and twork.shape[2] > NT:  # the tendons' lengths' tangents
         _length_rates(twork[stage], nt, act, j, actuated, law)
 
@@ -910,6 +886,59 @@ def _zone_variation(z, Cj, R00, R01, R02, R10, R11, R12, R20, R21, R22, v0, v1, 
     db = r0 * (k0 + l0) + r1 * (k1 + l1) + r2 * (k2 + l2)
     dc = (da - c * db) / b
     return dc * n0 + c * dn0, dc * n1 + c * dn1, dc * n2 + c * dn2
+
+
+@_jit
+def _zone_forces(work, twork, nt, stage, arm, act, j, rate, contact):
+    """On a hard contact zone's piece j (a passive one: the linear law), subtract the zone's
+    force per unit length ``contact`` × c n̂ (:func:`_zone_pressure`, ``contact`` the
+    channel CT) from the stage's n' in ``work[stage]``, and its variation from the first nt
+    tangent columns' δn' in ``twork[stage]`` (:func:`_zone_variation`; with the contact's
+    own change along the path in the columns from LAM on). Called by :func:`_deriv` after
+    the rest of the right-hand side, which it reads there (n', m', δp', δn', δm' without the
+    contact): kept out of _deriv's loops, which it would slow on every other arm."""
+    C, f0 = arm[2], arm[3]
+    Y = 4
+    y, w = work[Y], work[stage]
+    R00, R01, R02 = y[_R], y[_R + 1], y[_R + 2]
+    R10, R11, R12 = y[_R + 3], y[_R + 4], y[_R + 5]
+    R20, R21, R22 = y[_R + 6], y[_R + 7], y[_R + 8]
+    nx, ny, nz, mx, my, mz = y[_N], y[_N + 1], y[_N + 2], y[_M], y[_M + 1], y[_M + 2]
+    s0 = R00 * nx + R10 * ny + R20 * nz
+    s1 = R01 * nx + R11 * ny + R21 * nz
+    s2 = R02 * nx + R12 * ny + R22 * nz
+    s3 = R00 * mx + R10 * my + R20 * mz
+    s4 = R01 * mx + R11 * my + R21 * mz
+    s5 = R02 * mx + R12 * my + R22 * mz
+    v0, v1, v2, u0, u1, u2 = _strain(C, f0, j, False, s0, s1, s2, s3, s4, s5)
+    zone = _zone_pressure(
+        act[5][int(act[6][j, ZONE]) - 1], C[j], y[_P], y[_P + 1], y[_P + 2], R00, R01, R02,
+        R10, R11, R12, R20, R21, R22, v0, v1, v2, u0, u1, u2, s0, s1, s2, s3, s4, s5,
+        w[_P], w[_P + 1], w[_P + 2], w[_N], w[_N + 1], w[_N + 2], w[_M], w[_M + 1], w[_M + 2])
+    c = zone[0]
+    for d in range(nt):
+        t, o = twork[Y, d], twork[stage, d]
+        th0, th1, th2 = t[_TT], t[_TT + 1], t[_TT + 2]
+        dn0, dn1, dn2 = t[_TN], t[_TN + 1], t[_TN + 2]
+        dm0, dm1, dm2 = t[_TM], t[_TM + 1], t[_TM + 2]
+        ds0 = R00 * dn0 + R10 * dn1 + R20 * dn2 + s1 * th2 - s2 * th1
+        ds1 = R01 * dn0 + R11 * dn1 + R21 * dn2 + s2 * th0 - s0 * th2
+        ds2 = R02 * dn0 + R12 * dn1 + R22 * dn2 + s0 * th1 - s1 * th0
+        ds3 = R00 * dm0 + R10 * dm1 + R20 * dm2 + s4 * th2 - s5 * th1
+        ds4 = R01 * dm0 + R11 * dm1 + R21 * dm2 + s5 * th0 - s3 * th2
+        ds5 = R02 * dm0 + R12 * dm1 + R22 * dm2 + s3 * th1 - s4 * th0
+        c0, c1, c2, c3, c4, c5 = _strain(C, arm[4], j, False, ds0, ds1, ds2, ds3, ds4, ds5)
+        z0, z1, z2 = _zone_variation(
+            zone, C[j], R00, R01, R02, R10, R11, R12, R20, R21, R22, v0, v1, v2, u0, u1, u2,
+            s0, s1, s2, s3, s4, s5, w[_P], w[_P + 1], w[_P + 2], w[_N], w[_N + 1], w[_N + 2],
+            w[_M], w[_M + 1], w[_M + 2], t[_TP], t[_TP + 1], t[_TP + 2], th0, th1, th2,
+            ds0, ds1, ds2, ds3, ds4, ds5, c0, c1, c2, c3, c4, c5, o[_TP], o[_TP + 1],
+            o[_TP + 2], o[_TN], o[_TN + 1], o[_TN + 2], o[_TM], o[_TM + 1], o[_TM + 2])
+        scale = rate[d - LAM, j, _CT] if d >= LAM else 0.0  # the contact's own change
+        for i in range(3):
+            o[_TN + i] -= contact * (z0, z1, z2)[i] + scale * c * zone[1 + i]
+    for i in range(3):
+        w[_N + i] -= contact * c * zone[1 + i]
 
 
 @_inline
