@@ -121,6 +121,14 @@ def _node_bytes() -> tuple[int, int]:
     return state, storage
 
 
+def _shared(arrays) -> tuple:
+    """The simulator's state arrays made read-only, for a State to hold without a copy: the
+    simulator never writes into them again (a step or a run advances copies of them)."""
+    for array in arrays:
+        array.setflags(write=False)
+    return arrays
+
+
 def _check_base(base):
     """(callable t -> (4, 4) pose or None, the fixed pose)."""
     if base is None:
@@ -356,6 +364,16 @@ class Simulator:
                    pieces[6], pieces[7], stiffness)
         A = max(1, act[0].shape[0])
         return law_arm, (np.empty((6, 7)), np.zeros((A, 8)), np.zeros((6, 6)), np.zeros((6, 6)))
+
+    def _thread_actuation(self, props, slot: int):
+        """:meth:`_actuation` for ``props`` (the first step's or the others') and a thread's
+        ``slot``, made once and kept (a step of a 41-station robot spent 20 µs inverting
+        its compliances again)."""
+        kept = self.__dict__.setdefault("_actuations", {})
+        key = (id(props), slot)
+        if key not in kept:
+            kept[key] = self._actuation(self._pieces, props, self._act)
+        return kept[key]
 
     def _follow_contact(self, inputs) -> None:
         """The contact law sized for ``inputs`` (C, ..., n) too, C = 1 or the batch's cases:
@@ -713,7 +731,7 @@ class Simulator:
         shared = factors is None
         count_ = max(1, threads or 1)
         local = [self._storage(False, 1) for _ in range(count_)] if shared else None
-        actuations = [self._actuation(self._pieces, props, self._act) for _ in range(count_)]
+        actuations = [self._thread_actuation(props, slot) for slot in range(count_)]
         # a step with friction that fails is solved again along a continuation in the
         # friction's band, which the kernel writes into act[6] (and restores): a thread's own
         acts = [self._act] * count_
@@ -768,6 +786,8 @@ class Simulator:
         self._arrays = arrays
         self._fresh = False
         self.time = float(times[-1])
+        for value in out.values():  # (fresh: the State takes them without a copy)
+            value.setflags(write=False)
         self._state = self._make_state(
             {name: value[:, 0] for name, value in out.items()},
             info[:, 0, 3].reshape(self.shape), info[:, 0, 1].astype(np.int64).reshape(
@@ -974,7 +994,7 @@ class Simulator:
             error=_frozen(error), iterations=np.asarray(iterations),
             tendon_lengths=None if lengths is None else _frozen(
                 lengths.reshape(*shape, lengths.shape[-1])),
-            _arrays=tuple(a.copy() for a in self._arrays), _signature=self._signature,
+            _arrays=_shared(self._arrays), _signature=self._signature,
             _fresh=self._fresh)
 
     def _energy_now(self, first: State) -> np.ndarray:

@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from ._compile import _entry, _given, _jit
+from ._compile import _entry, _given, _inline, _jit
 from .layout import _CT, _FD, _FF, _JD, _JF, _LD, _LF, _P, _R, _TD, _TF, TENDON
 from .linear import _band_factor, _band_solve, _copy
 from .rod import _actuated, _dipole, _law, _nearest, _pressure, _rotated
@@ -65,7 +65,7 @@ _CENTRAL_BELOW = 1e-9  # Newton's tol below which the slopes take central differ
 _TRAPEZOID = DUNK + 6
 
 
-@_jit
+@_inline
 def _mat_t_vec(R, o, x0, x1, x2, out, k):
     """out[k:k+3] = Rᵀ x with R row-major at R[o:o+9]."""
     out[k] = R[o] * x0 + R[o + 3] * x1 + R[o + 6] * x2
@@ -73,7 +73,7 @@ def _mat_t_vec(R, o, x0, x1, x2, out, k):
     out[k + 2] = R[o + 2] * x0 + R[o + 5] * x1 + R[o + 8] * x2
 
 
-@_jit
+@_inline
 def _log_relative(za, zb, out):
     """out = log(R_aᵀ R_b) (material components of a); returns its angle θ."""
     ra, rb = _DR, _DR
@@ -119,7 +119,7 @@ def _inverse_jacobian(a0, a1, a2, sign, out):
     out[2, 1] = h * a0 + beta * a1 * a2
 
 
-@_jit
+@_inline
 def _node_rates(z, s, j, props, now, hist_h, coef, out, eps, act, actuation, lengths, tmp):
     """The node's rates (p', u, n', m', q', ω') on piece j (arc length s) with the step's
     history terms ``hist_h`` (ε_h, q_h, ω_h) and loads ``now`` (the statics' channels per
