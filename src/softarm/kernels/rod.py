@@ -769,6 +769,13 @@ def _contact(px, py, pz, obstacles, params):
     return f0, f1, f2, j00, j01, j02, j11, j12, j22
 
 
+@_inline
+def _material(R00, R01, R02, R10, R11, R12, R20, R21, R22, x0, x1, x2):
+    """Rᵀ x: a spatial vector's material components (R row-major, as scalars)."""
+    return (R00 * x0 + R10 * x1 + R20 * x2, R01 * x0 + R11 * x1 + R21 * x2,
+            R02 * x0 + R12 * x1 + R22 * x2)
+
+
 @_jit
 def _zone_pressure(row, Cj, px, py, pz, R00, R01, R02, R10, R11, R12, R20,
                    R21, R22, v0, v1, v2, u0, u1, u2, s0, s1, s2, s3, s4, s5, dx, dy, dz,
@@ -792,17 +799,17 @@ def _zone_pressure(row, Cj, px, py, pz, R00, R01, R02, R10, R11, R12, R20,
     e eᵀ)), ñ, C_vv ñ, C_vvᵀ ñ, b, the material vector u × v + v' at c = 0, ∇²d p', and g'
     (what :func:`_zone_variation` needs)."""
     _, n0, n1, n2, kappa, e0, e1, e2 = _nearest(px, py, pz, row)
-    m0 = R00 * n0 + R10 * n1 + R20 * n2  # ñ = Rᵀ n̂
-    m1 = R01 * n0 + R11 * n1 + R21 * n2
-    m2 = R02 * n0 + R12 * n1 + R22 * n2
+    m0, m1, m2 = _material(R00, R01, R02, R10, R11, R12, R20, R21, R22, n0, n1, n2)  # ñ = Rᵀ n̂
     slope = n0 * dx + n1 * dy + n2 * dz  # g'
     # σ' at c = 0: -u × σ + Rᵀ (n'; m')
-    a0 = -(u1 * s2 - u2 * s1) + R00 * fn0 + R10 * fn1 + R20 * fn2
-    a1 = -(u2 * s0 - u0 * s2) + R01 * fn0 + R11 * fn1 + R21 * fn2
-    a2 = -(u0 * s1 - u1 * s0) + R02 * fn0 + R12 * fn1 + R22 * fn2
-    a3 = -(u1 * s5 - u2 * s4) + R00 * fm0 + R10 * fm1 + R20 * fm2
-    a4 = -(u2 * s3 - u0 * s5) + R01 * fm0 + R11 * fm1 + R21 * fm2
-    a5 = -(u0 * s4 - u1 * s3) + R02 * fm0 + R12 * fm1 + R22 * fm2
+    f0, f1, f2 = _material(R00, R01, R02, R10, R11, R12, R20, R21, R22, fn0, fn1, fn2)
+    g0, g1, g2 = _material(R00, R01, R02, R10, R11, R12, R20, R21, R22, fm0, fm1, fm2)
+    a0 = -(u1 * s2 - u2 * s1) + f0
+    a1 = -(u2 * s0 - u0 * s2) + f1
+    a2 = -(u0 * s1 - u1 * s0) + f2
+    a3 = -(u1 * s5 - u2 * s4) + g0
+    a4 = -(u2 * s3 - u0 * s5) + g1
+    a5 = -(u0 * s4 - u1 * s3) + g2
     w0 = u1 * v2 - u2 * v1 + (Cj[0, 0] * a0 + Cj[0, 1] * a1 + Cj[0, 2] * a2 + Cj[0, 3] * a3
                               + Cj[0, 4] * a4 + Cj[0, 5] * a5)
     w1 = u2 * v0 - u0 * v2 + (Cj[1, 0] * a0 + Cj[1, 1] * a1 + Cj[1, 2] * a2 + Cj[1, 3] * a3
@@ -845,28 +852,21 @@ def _zone_variation(z, Cj, R00, R01, R02, R10, R11, R12, R20, R21, R22, v0, v1, 
     dn1 = kappa * (dp1 - n1 * dg - e1 * ed)
     dn2 = kappa * (dp2 - n2 * dg - e2 * ed)
     # δñ = Rᵀ δn̂ - δθ × ñ
-    r0 = R00 * dn0 + R10 * dn1 + R20 * dn2 - (th1 * m2 - th2 * m1)
-    r1 = R01 * dn0 + R11 * dn1 + R21 * dn2 - (th2 * m0 - th0 * m2)
-    r2 = R02 * dn0 + R12 * dn1 + R22 * dn2 - (th0 * m1 - th1 * m0)
+    r0, r1, r2 = _material(R00, R01, R02, R10, R11, R12, R20, R21, R22, dn0, dn1, dn2)
+    r0 -= th1 * m2 - th2 * m1
+    r1 -= th2 * m0 - th0 * m2
+    r2 -= th0 * m1 - th1 * m0
     # δσ' = -δu × σ - u × δσ + Rᵀ δ(n'; m') - δθ × Rᵀ (n'; m')
-    f0 = R00 * fn0 + R10 * fn1 + R20 * fn2
-    f1 = R01 * fn0 + R11 * fn1 + R21 * fn2
-    f2 = R02 * fn0 + R12 * fn1 + R22 * fn2
-    g0 = R00 * fm0 + R10 * fm1 + R20 * fm2
-    g1 = R01 * fm0 + R11 * fm1 + R21 * fm2
-    g2 = R02 * fm0 + R12 * fm1 + R22 * fm2
-    a0 = (-(c4 * s2 - c5 * s1) - (u1 * ds2 - u2 * ds1) + R00 * dfn0 + R10 * dfn1 + R20 * dfn2
-          - (th1 * f2 - th2 * f1))
-    a1 = (-(c5 * s0 - c3 * s2) - (u2 * ds0 - u0 * ds2) + R01 * dfn0 + R11 * dfn1 + R21 * dfn2
-          - (th2 * f0 - th0 * f2))
-    a2 = (-(c3 * s1 - c4 * s0) - (u0 * ds1 - u1 * ds0) + R02 * dfn0 + R12 * dfn1 + R22 * dfn2
-          - (th0 * f1 - th1 * f0))
-    a3 = (-(c4 * s5 - c5 * s4) - (u1 * ds5 - u2 * ds4) + R00 * dfm0 + R10 * dfm1 + R20 * dfm2
-          - (th1 * g2 - th2 * g1))
-    a4 = (-(c5 * s3 - c3 * s5) - (u2 * ds3 - u0 * ds5) + R01 * dfm0 + R11 * dfm1 + R21 * dfm2
-          - (th2 * g0 - th0 * g2))
-    a5 = (-(c3 * s4 - c4 * s3) - (u0 * ds4 - u1 * ds3) + R02 * dfm0 + R12 * dfm1 + R22 * dfm2
-          - (th0 * g1 - th1 * g0))
+    f0, f1, f2 = _material(R00, R01, R02, R10, R11, R12, R20, R21, R22, fn0, fn1, fn2)
+    g0, g1, g2 = _material(R00, R01, R02, R10, R11, R12, R20, R21, R22, fm0, fm1, fm2)
+    b0, b1, b2 = _material(R00, R01, R02, R10, R11, R12, R20, R21, R22, dfn0, dfn1, dfn2)
+    b3, b4, b5 = _material(R00, R01, R02, R10, R11, R12, R20, R21, R22, dfm0, dfm1, dfm2)
+    a0 = -(c4 * s2 - c5 * s1) - (u1 * ds2 - u2 * ds1) + b0 - (th1 * f2 - th2 * f1)
+    a1 = -(c5 * s0 - c3 * s2) - (u2 * ds0 - u0 * ds2) + b1 - (th2 * f0 - th0 * f2)
+    a2 = -(c3 * s1 - c4 * s0) - (u0 * ds1 - u1 * ds0) + b2 - (th0 * f1 - th1 * f0)
+    a3 = -(c4 * s5 - c5 * s4) - (u1 * ds5 - u2 * ds4) + b3 - (th1 * g2 - th2 * g1)
+    a4 = -(c5 * s3 - c3 * s5) - (u2 * ds3 - u0 * ds5) + b4 - (th2 * g0 - th0 * g2)
+    a5 = -(c3 * s4 - c4 * s3) - (u0 * ds4 - u1 * ds3) + b5 - (th0 * g1 - th1 * g0)
     # δ(u × v + v')
     x0 = c4 * v2 - c5 * v1 + u1 * c2 - u2 * c1 + (
         Cj[0, 0] * a0 + Cj[0, 1] * a1 + Cj[0, 2] * a2 + Cj[0, 3] * a3 + Cj[0, 4] * a4
@@ -903,13 +903,11 @@ def _zone_forces(work, twork, nt, stage, arm, act, j, rate, contact):
     R00, R01, R02 = y[_R], y[_R + 1], y[_R + 2]
     R10, R11, R12 = y[_R + 3], y[_R + 4], y[_R + 5]
     R20, R21, R22 = y[_R + 6], y[_R + 7], y[_R + 8]
-    nx, ny, nz, mx, my, mz = y[_N], y[_N + 1], y[_N + 2], y[_M], y[_M + 1], y[_M + 2]
-    s0 = R00 * nx + R10 * ny + R20 * nz
-    s1 = R01 * nx + R11 * ny + R21 * nz
-    s2 = R02 * nx + R12 * ny + R22 * nz
-    s3 = R00 * mx + R10 * my + R20 * mz
-    s4 = R01 * mx + R11 * my + R21 * mz
-    s5 = R02 * mx + R12 * my + R22 * mz
+    # σ (material)
+    s0, s1, s2 = _material(R00, R01, R02, R10, R11, R12, R20, R21, R22, y[_N], y[_N + 1],
+                           y[_N + 2])
+    s3, s4, s5 = _material(R00, R01, R02, R10, R11, R12, R20, R21, R22, y[_M], y[_M + 1],
+                           y[_M + 2])
     v0, v1, v2, u0, u1, u2 = _strain(C, f0, j, False, s0, s1, s2, s3, s4, s5)
     zone = _zone_pressure(
         act[5][int(act[6][j, ZONE]) - 1], C[j], y[_P], y[_P + 1], y[_P + 2], R00, R01, R02,
@@ -919,14 +917,17 @@ def _zone_forces(work, twork, nt, stage, arm, act, j, rate, contact):
     for d in range(nt):
         t, o = twork[Y, d], twork[stage, d]
         th0, th1, th2 = t[_TT], t[_TT + 1], t[_TT + 2]
-        dn0, dn1, dn2 = t[_TN], t[_TN + 1], t[_TN + 2]
-        dm0, dm1, dm2 = t[_TM], t[_TM + 1], t[_TM + 2]
-        ds0 = R00 * dn0 + R10 * dn1 + R20 * dn2 + s1 * th2 - s2 * th1
-        ds1 = R01 * dn0 + R11 * dn1 + R21 * dn2 + s2 * th0 - s0 * th2
-        ds2 = R02 * dn0 + R12 * dn1 + R22 * dn2 + s0 * th1 - s1 * th0
-        ds3 = R00 * dm0 + R10 * dm1 + R20 * dm2 + s4 * th2 - s5 * th1
-        ds4 = R01 * dm0 + R11 * dm1 + R21 * dm2 + s5 * th0 - s3 * th2
-        ds5 = R02 * dm0 + R12 * dm1 + R22 * dm2 + s3 * th1 - s4 * th0
+        # δσ = (Rᵀδn + σ_n × δθ; Rᵀδm + σ_m × δθ)
+        ds0, ds1, ds2 = _material(R00, R01, R02, R10, R11, R12, R20, R21, R22, t[_TN],
+                                  t[_TN + 1], t[_TN + 2])
+        ds3, ds4, ds5 = _material(R00, R01, R02, R10, R11, R12, R20, R21, R22, t[_TM],
+                                  t[_TM + 1], t[_TM + 2])
+        ds0 += s1 * th2 - s2 * th1
+        ds1 += s2 * th0 - s0 * th2
+        ds2 += s0 * th1 - s1 * th0
+        ds3 += s4 * th2 - s5 * th1
+        ds4 += s5 * th0 - s3 * th2
+        ds5 += s3 * th1 - s4 * th0
         c0, c1, c2, c3, c4, c5 = _strain(C, arm[4], j, False, ds0, ds1, ds2, ds3, ds4, ds5)
         z0, z1, z2 = _zone_variation(
             zone, C[j], R00, R01, R02, R10, R11, R12, R20, R21, R22, v0, v1, v2, u0, u1, u2,
