@@ -194,9 +194,10 @@ class _ArmData:
                 self.mu[segment], segment)
 
 
-
+@functools.cache
 def _no_contact() -> tuple:
-    """``act``'s contact arrays out of contact: no obstacle (kernels/rod.py, act[5], act[6])."""
+    """``act``'s contact arrays out of contact: no obstacle (kernels/rod.py, act[5], act[6];
+    made on first use: reading the kernels' layout loads them)."""
     return np.zeros((0, 8)), np.zeros((1, kernels.CONTACT_PARAMS))
 
 
@@ -486,7 +487,7 @@ class _Channels:
         if load is None:
             return None
         band = load.band(self.length)
-        if load.zones:  # hard contact zones (contact_zones.py): their law at full strength
+        if load.zones:  # hard contact zones (Contact.zones): their law at full strength
             self.piece[:, :, self.k.CT] = 1.0
             self.contact_given_stiffness = False
             self.contact_load = load.replace(distance=band)
