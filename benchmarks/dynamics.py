@@ -18,7 +18,7 @@
    trajectories whole would take 30 GB), and the projection to a Dask cluster of W workers.
 5. Building a Simulator (a tendon, gravity, an obstacle) against its stations, 10³ to
    4·10⁵: linear (it was quadratic, issue 42: 17 s at 10⁵); 10⁶ stations need more memory
-   for a step than half of a 24 GB machine (31 kB a station) and are refused at once.
+   for a step than half of a 24 GB machine (33 kB a station) and are refused at once.
 
 CPU time (``process_time``) beside wall time (``perf_counter``), per step or per run; best of
 ``--repeats`` after a warm-up (the compile is not timed). Run::

@@ -148,9 +148,9 @@ def test_the_guard_assumes_at_least_what_a_batch_takes(kind, method, count, stat
 
 # A node of a step holds its state (Z 24, Zold 2 × 24, H 72 float64) nine times and 30
 # outputs twice, 8 (9 × 144 + 60) = 10848 B, one factorisation's banded rows, 18 rows of
-# 3 × 29 + 1 band columns, 29 multipliers and a pivot: 8 × 18 × 118 = 16992 B, and
-# Hermite's G² (18 × 18) and slopes (25): 8 × 349 = 2792 B.
-NODE = 10848 + 16992 + 2792
+# 3 × 29 + 1 band columns, 29 multipliers and a pivot: 8 × 18 × 118 = 16992 B, and the
+# node's Jacobian G and Hermite's G² (2 × 18 × 18) and slopes (25): 8 × 673 = 5384 B.
+NODE = 10848 + 16992 + 5384
 
 
 def test_a_simulator_and_its_runs_are_refused_before_allocating(monkeypatch):
@@ -158,7 +158,7 @@ def test_a_simulator_and_its_runs_are_refused_before_allocating(monkeypatch):
     they cover what a step and a run take). Before issue 42 a Simulator of 10⁹ stations
     began a 16 GB linspace (then an out-of-memory kill), run(10**12) a 7 TiB arange."""
     monkeypatch.setattr(softarm._validate, "memory_limit", lambda: 10**8)
-    # 10⁴ stations and the two ends of the one piece: (10⁴ + 2) × 30632 B + 3 × 12288 B
+    # 10⁴ stations and the two ends of the one piece: (10⁴ + 2) × 33224 B + 3 × 12288 B
     need = (10_000 + 2) * NODE + 3 * 12288
     with pytest.raises(ValueError, match=rf"^stations: 1 load case × 10002 stations would "
                                          rf"need {need / 1e6:.3g} MB of memory"):

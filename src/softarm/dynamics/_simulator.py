@@ -111,13 +111,14 @@ def _node_bytes() -> tuple[int, int]:
     (the initial state, the current one, a step's working copy, the last and the new
     State's, their stacks and temporaries) with the outputs at the stations (30 numbers,
     twice); the banded Jacobian's rows (DUNK a node: 3 KL + 1 columns of the band, KL of
-    the multipliers, a pivot) and Hermite's work (a node's G², DUNK², and its slopes,
-    DUNK + 7). Measured (tracemalloc and the peak resident memory): 24.5 kB a node over the
-    steps of one case, 1.8 kB after construction (tests/test_memory.py; before Hermite's
-    rule, issue 40)."""
+    the multipliers, a pivot), the nodes' Jacobians G and Hermite's G² (2 DUNK², kept with
+    the factorisation) and the slopes (DUNK + 7). Measured (tracemalloc and the peak
+    resident memory): 24.5 kB a node over the steps of one case, 1.8 kB after construction
+    (tests/test_memory.py; before Hermite's rule, issue 40)."""
     k = kernels
     state = 8 * (9 * (3 * k.DYN + k.DHIST) + 2 * 30)
-    storage = 8 * (k.DUNK * ((3 * k._DKL + 1) + k._DKL + 1) + k.DUNK * k.DUNK + k.DUNK + 7)
+    storage = 8 * (k.DUNK * ((3 * k._DKL + 1) + k._DKL + 1) + 2 * k.DUNK * k.DUNK + k.DUNK
+                   + 7)
     return state, storage
 
 
@@ -679,7 +680,8 @@ class Simulator:
         n = k.DUNK * (self._nodes.size - 1) + 6
         C = B if per_case else 1
         return (np.zeros((C, n, 3 * k._DKL + 1)), np.zeros((C, n, k._DKL)),
-                np.zeros((C, 3, n), dtype=np.int64), np.zeros((C, 2)))
+                np.zeros((C, 3, n), dtype=np.int64), np.zeros((C, 2)),
+                np.empty((2, self._nodes.size, k.DUNK, k.DUNK)))
 
     def _advance(self, steps: int, factors, threads: int | None = None, *, arrays,
                  inputs=None):
@@ -695,11 +697,11 @@ class Simulator:
                                   (first, steps, self._coef, self._props)):
             if b > a:
                 q = None if inputs is None else inputs[:, a:b]
-                if factors is not None and factors[4] is not coef:
+                if factors is not None and factors[5] is not coef:
                     factors[3][:] = 0  # (the Jacobian changes with the scheme)
-                    factors[4] = coef
+                    factors[5] = coef
                 parts.append(self._kernel_run(arrays, times[a:b], coef, props,
-                                              None if factors is None else tuple(factors[:4]),
+                                              None if factors is None else tuple(factors[:5]),
                                               threads, q, skip))
                 skip |= parts[-1][3] < b - a  # (a case failed in the first part: not after)
         if len(parts) == 1:

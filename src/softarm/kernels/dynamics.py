@@ -868,7 +868,8 @@ def dynamic_steps(Z, Zold, H, aux, props, loads, tip, grid, coef, S, options, ba
     node, s of each node); coef (DCOEF,), S (18,) scales, options = (tol, max_iter). base
     (B or 1, T, 18): the base's p, R (row-major), q, ω (material) at each new step;
     gravity (B, 3) (for the energy); stations (S,) the recorded nodes; factors = (Bm, Lm,
-    piv, state): per case (B) or one shared (1; reused only by the first case of the call);
+    piv, state, jacobian): per case (B) or one shared (1; reused only by the first case of
+    the call), and a scratch (2, G, 18, 18) for the nodes' Jacobians;
     a case's state (2,) says whether its factors are valid (1.0) and holds the contraction
     last measured on them (_dyn_newton).
     Outputs per case and step: positions,
@@ -895,9 +896,12 @@ def dynamic_steps(Z, Zold, H, aux, props, loads, tip, grid, coef, S, options, ba
     kl = np.int64(_DKL)
     n = DUNK * (G - 1) + 6
     A = 1 if act is None else max(1, act[0].shape[0])
+    Bm_all, Lm_all, piv_all, valid_all, jacobian = factors
+    # (the nodes' G and G², 2 × G × 18 × 18: the caller's scratch, kept with the factors, so
+    # that the memory guard counts what a step holds; _node_bytes)
     work = (np.empty(n), np.empty(n), np.empty((G, DUNK)), np.empty((G, 6)),
-            (np.zeros((G, A)), np.zeros((G, A))), np.empty((G, DUNK, DUNK)),
-            np.empty((G, DUNK + 7)), np.empty((G, DUNK, DUNK)))
+            (np.zeros((G, A)), np.zeros((G, A))), jacobian[0],
+            np.empty((G, DUNK + 7)), jacobian[1])
     eps, lengths, rates, slopes = work[3], work[4], work[2], work[6]
     hh = np.empty((G, 24))  # the history terms and their slopes in s
     Zw = np.empty((G, DYN))
@@ -906,7 +910,6 @@ def dynamic_steps(Z, Zold, H, aux, props, loads, tip, grid, coef, S, options, ba
     c0 = coef[0]
     now = np.empty((loads.shape[1], loads.shape[2]))
     tip_now = np.empty(tip.shape[1])
-    Bm_all, Lm_all, piv_all, valid_all = factors
     for b in range(first, last):
         if status[b] < 0:
             continue  # a case that failed in an earlier call: left where it stopped
