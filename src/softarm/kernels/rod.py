@@ -796,8 +796,8 @@ def _zone_pressure(row, Cj, px, py, pz, R00, R01, R02, R10, R11, R12, R20,
     so that g and g' keep the values they enter the zone with (zero on the hard-contact
     answer, which conditions at the zone's start must impose: contact.md). Returns c, n̂ (3),
     the curvature κ = 1/ρ of the obstacle's surface and its axis e (∇²d = κ (I - n̂ n̂ᵀ -
-    e eᵀ)), ñ, C_vv ñ, C_vvᵀ ñ, b, the material vector u × v + v' at c = 0, ∇²d p', and g'
-    (what :func:`_zone_variation` needs)."""
+    e eᵀ)), ñ, C_vv ñ, b, the material vector u × v + v' at c = 0, ∇²d p', g', and Rᵀ n',
+    Rᵀ m' (what :func:`_zone_variation` needs; C is symmetric, as the sections' K are)."""
     _, n0, n1, n2, kappa, e0, e1, e2 = _nearest(px, py, pz, row)
     m0, m1, m2 = _material(R00, R01, R02, R10, R11, R12, R20, R21, R22, n0, n1, n2)  # ñ = Rᵀ n̂
     slope = n0 * dx + n1 * dy + n2 * dz  # g'
@@ -824,28 +824,25 @@ def _zone_pressure(row, Cj, px, py, pz, R00, R01, R02, R10, R11, R12, R20,
     k0 = Cj[0, 0] * m0 + Cj[0, 1] * m1 + Cj[0, 2] * m2  # C_vv ñ
     k1 = Cj[1, 0] * m0 + Cj[1, 1] * m1 + Cj[1, 2] * m2
     k2 = Cj[2, 0] * m0 + Cj[2, 1] * m1 + Cj[2, 2] * m2
-    l0 = Cj[0, 0] * m0 + Cj[1, 0] * m1 + Cj[2, 0] * m2  # C_vvᵀ ñ
-    l1 = Cj[0, 1] * m0 + Cj[1, 1] * m1 + Cj[2, 1] * m2
-    l2 = Cj[0, 2] * m0 + Cj[1, 2] * m1 + Cj[2, 2] * m2
     b = m0 * k0 + m1 * k1 + m2 * k2
     a = dx * h0 + dy * h1 + dz * h2 + m0 * w0 + m1 * w1 + m2 * w2
     c = a / b
-    return (c, n0, n1, n2, kappa, e0, e1, e2, m0, m1, m2, k0, k1, k2, l0, l1, l2, b, w0, w1,
-            w2, h0, h1, h2, slope)
+    return (c, n0, n1, n2, kappa, e0, e1, e2, m0, m1, m2, k0, k1, k2, b, w0, w1, w2, h0, h1,
+            h2, slope, f0, f1, f2, g0, g1, g2)
 
 
 @_jit
 def _zone_variation(z, Cj, R00, R01, R02, R10, R11, R12, R20, R21, R22, v0, v1, v2,
-                    u0, u1, u2, s0, s1, s2, s3, s4, s5, dx, dy, dz, fn0, fn1, fn2, fm0, fm1,
-                    fm2, dp0, dp1, dp2, th0, th1, th2, ds0, ds1, ds2, ds3, ds4, ds5, c0, c1,
-                    c2, c3, c4, c5, q0, q1, q2, dfn0, dfn1, dfn2, dfm0, dfm1, dfm2):
+                    u0, u1, u2, s0, s1, s2, s3, s4, s5, dx, dy, dz, dp0, dp1, dp2, th0, th1,
+                    th2, ds0, ds1, ds2, ds3, ds4, ds5, c0, c1, c2, c3, c4, c5, q0, q1, q2,
+                    dfn0, dfn1, dfn2, dfm0, dfm1, dfm2):
     """The variation of a zone's contact force per unit length c n̂ (spatial) along a
     tangent column: δp, δθ (material), δσ, δ(v; u) = (c0..c5), δp' = q, δn' and δm' without
     the contact (dfn, dfm); ``z`` is :func:`_zone_pressure`'s tuple at the state. Exact
     (the derivative of its formula, with ∇²d's own change on a ball or a cylinder:
     δκ = -κ² n̂·δp, δn̂ = ∇²d δp, the axis fixed)."""
-    (c, n0, n1, n2, kappa, e0, e1, e2, m0, m1, m2, k0, k1, k2, l0, l1, l2, b, w0, w1, w2,
-     h0, h1, h2, slope) = z
+    (c, n0, n1, n2, kappa, e0, e1, e2, m0, m1, m2, k0, k1, k2, b, w0, w1, w2, h0, h1, h2,
+     slope, f0, f1, f2, g0, g1, g2) = z
     dg = n0 * dp0 + n1 * dp1 + n2 * dp2
     ed = e0 * dp0 + e1 * dp1 + e2 * dp2
     dn0 = kappa * (dp0 - n0 * dg - e0 * ed)  # δn̂ = ∇²d δp
@@ -857,8 +854,6 @@ def _zone_variation(z, Cj, R00, R01, R02, R10, R11, R12, R20, R21, R22, v0, v1, 
     r1 -= th2 * m0 - th0 * m2
     r2 -= th0 * m1 - th1 * m0
     # δσ' = -δu × σ - u × δσ + Rᵀ δ(n'; m') - δθ × Rᵀ (n'; m')
-    f0, f1, f2 = _material(R00, R01, R02, R10, R11, R12, R20, R21, R22, fn0, fn1, fn2)
-    g0, g1, g2 = _material(R00, R01, R02, R10, R11, R12, R20, R21, R22, fm0, fm1, fm2)
     b0, b1, b2 = _material(R00, R01, R02, R10, R11, R12, R20, R21, R22, dfn0, dfn1, dfn2)
     b3, b4, b5 = _material(R00, R01, R02, R10, R11, R12, R20, R21, R22, dfm0, dfm1, dfm2)
     a0 = -(c4 * s2 - c5 * s1) - (u1 * ds2 - u2 * ds1) + b0 - (th1 * f2 - th2 * f1)
@@ -883,7 +878,7 @@ def _zone_variation(z, Cj, R00, R01, R02, R10, R11, R12, R20, R21, R22, v0, v1, 
     da = (2.0 * (h0 * q0 + h1 * q1 + h2 * q2) - kappa * dg * hp
           - 2.0 * kappa * (dn0 * dx + dn1 * dy + dn2 * dz) * slope
           + r0 * w0 + r1 * w1 + r2 * w2 + m0 * x0 + m1 * x1 + m2 * x2)
-    db = r0 * (k0 + l0) + r1 * (k1 + l1) + r2 * (k2 + l2)
+    db = 2.0 * (r0 * k0 + r1 * k1 + r2 * k2)  # (C_vv symmetric)
     dc = (da - c * db) / b
     return dc * n0 + c * dn0, dc * n1 + c * dn1, dc * n2 + c * dn2
 
@@ -931,8 +926,8 @@ def _zone_forces(work, twork, nt, stage, arm, act, j, rate, contact):
         c0, c1, c2, c3, c4, c5 = _strain(C, arm[4], j, False, ds0, ds1, ds2, ds3, ds4, ds5)
         z0, z1, z2 = _zone_variation(
             zone, C[j], R00, R01, R02, R10, R11, R12, R20, R21, R22, v0, v1, v2, u0, u1, u2,
-            s0, s1, s2, s3, s4, s5, w[_P], w[_P + 1], w[_P + 2], w[_N], w[_N + 1], w[_N + 2],
-            w[_M], w[_M + 1], w[_M + 2], t[_TP], t[_TP + 1], t[_TP + 2], th0, th1, th2,
+            s0, s1, s2, s3, s4, s5, w[_P], w[_P + 1], w[_P + 2], t[_TP], t[_TP + 1],
+            t[_TP + 2], th0, th1, th2,
             ds0, ds1, ds2, ds3, ds4, ds5, c0, c1, c2, c3, c4, c5, o[_TP], o[_TP + 1],
             o[_TP + 2], o[_TN], o[_TN + 1], o[_TN + 2], o[_TM], o[_TM + 1], o[_TM + 2])
         scale = rate[d - LAM, j, _CT] if d >= LAM else 0.0  # the contact's own change
